@@ -1,0 +1,1 @@
+"""camfab.cad — see the issue tracker for its planned contents."""

@@ -1,0 +1,186 @@
+"""The ``camfab`` command line: registered subcommands and exit codes.
+
+Exit codes (``../shared/design.md`` §6): 0 success; 1 computed but fails its
+checks; 2 invalid input (design file, options); 3 I/O error or a missing
+optional dependency.  Only core modules are imported at the top: exporters with
+heavy dependencies are imported inside the commands that need them.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from . import __version__
+from .errors import CamfabError, MissingDependencyError, SpecError
+from .io import atomic_write
+
+__all__ = ["main", "register", "COMMANDS", "EXAMPLES_DIR", "resolve_design_path"]
+
+EXIT_OK, EXIT_CHECKS, EXIT_INPUT, EXIT_IO = 0, 1, 2, 3
+EXAMPLES_DIR = Path(__file__).parent / "templates" / "examples"
+COMMANDS: dict[str, Callable] = {}
+
+
+class UsageError(CamfabError):
+    """A command-line option that cannot be honoured (exit code 2)."""
+
+
+def register(name: str, help: str):
+    """Register ``fn(args) -> int`` as a subcommand; ``fn.add_arguments(parser)`` adds its options."""
+
+    def deco(fn):
+        fn.command_name, fn.help = name, help
+        COMMANDS[name] = fn
+        return fn
+
+    return deco
+
+
+def resolve_design_path(name: str) -> Path:
+    """A design path, or the name of a built-in example (``ejemplo9rt``)."""
+    p = Path(name)
+    if p.exists():
+        return p
+    for cand in sorted(EXAMPLES_DIR.glob("*.toml")):
+        if cand.stem.lower() == name.lower():
+            return cand
+    return p  # load_design reports the missing file
+
+
+def _load(name: str):
+    from .design.spec import load_design
+
+    return load_design(resolve_design_path(name))
+
+
+# ---------------------------------------------------------------------------
+def _motion_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("file", help="design file (TOML) or built-in example name")
+    p.add_argument("--step-deg", type=float, default=1.0,
+                   help="sampling step of the CSV (degrees; mm for translating cams), default 1")
+    p.add_argument("--csv", metavar="OUT", help="write angle_deg,S,V,A,J to this CSV file")
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of the tables")
+    p.add_argument("--peaks", choices=("exact", "camdas"), default="exact",
+                   help="analytic extremes (default) or CAM-DAS 1-degree sampling")
+
+
+@register("motion", "follower motion: segment table, continuity, peaks, verdict, CSV")
+def cmd_motion(args: argparse.Namespace) -> int:
+    from .design.motion_report import analyse_motion
+
+    spec = _load(args.file)
+    prog = spec.program()
+    step = args.step_deg
+    if not (math.isfinite(step) and step > 0 and prog.period / _x_scale(prog) / step <= 1e7):
+        raise UsageError(f"--step-deg {step}: must be > 0 and give at most 1e7 rows")
+    report = analyse_motion(prog, name=spec.name, speed=spec.speed, lift_unit=spec.follower.lift_unit,
+                            peaks_mode=args.peaks,
+                            allow_acceleration_jump=spec.cam.kind in ("constant_width", "constant_diameter"))
+    if args.csv:
+        atomic_write(args.csv, motion_csv(prog, spec.speed, step))
+    if args.json:
+        data = report.to_dict()
+        data["segments"] = _segment_rows(prog)
+        print(json.dumps(data, indent=2))
+    else:
+        print(format_motion(spec, prog, report))
+        if args.csv:
+            print(f"wrote {args.csv}")
+    return EXIT_CHECKS if report.verdict == "unacceptable" else EXIT_OK
+
+
+cmd_motion.add_arguments = _motion_args
+
+
+def _x_scale(prog) -> float:
+    """Program units per user unit: radians per degree, or 1 (mm) for translating cams."""
+    return math.pi / 180.0 if abs(prog.period - 2 * math.pi) < 1e-12 else 1.0
+
+
+def motion_csv(prog, speed: float, step: float) -> str:
+    """``angle_deg,S,V,A,J`` rows from 0 to 360 (or the cam length) inclusive, time units."""
+    k = _x_scale(prog)
+    n = int(math.floor(prog.period / k / step + 1e-9))
+    xu = np.arange(n + 1) * step
+    vals = prog.evaluate(xu * k) * (speed ** np.arange(4))[:, None]
+    head = "angle_deg,S,V,A,J" if k != 1.0 else "position_mm,S,V,A,J"
+    body = np.column_stack([xu, vals.T])
+    lines = [head] + [",".join(f"{v:.10g}" for v in row) for row in body]
+    return "\n".join(lines) + "\n"
+
+
+def _segment_rows(prog) -> list[dict]:
+    k = _x_scale(prog)
+    rows = []
+    for i, s in enumerate(prog.segments):
+        rows.append({"index": i, "law": s.law, "title": s.title, "lift": s.lift,
+                     "from": s.start / k, "to": s.end / k, "span": s.span / k,
+                     "S_start": s.s0, "S_end": s.s0 + s.lift})
+    return rows
+
+
+def format_motion(spec, prog, report) -> str:
+    """The human-readable motion summary."""
+    lu = spec.follower.lift_unit
+    xu = "°" if _x_scale(prog) != 1.0 else "mm"
+    speed = (f"ω = {spec.speed:.6g} rad/s ({spec.speed * 60 / (2 * math.pi):.6g} rpm)"
+             if xu == "°" else f"v = {spec.speed:.6g} mm/s")
+    out = [f"{spec.name}: {spec.cam.kind} cam, {spec.follower.motion} {spec.follower.type} follower, {speed}"
+           + ("" if spec.cam.speed_given else " [default speed]"), ""]
+    out.append(f"{'#':>3}  {'law':<34}{'lift(' + lu + ')':>10}{'from(' + xu + ')':>10}{'to(' + xu + ')':>10}"
+               f"{'S start':>10}{'S end':>10}")
+    for r in _segment_rows(prog):
+        out.append(f"{r['index'] + 1:>3}  {r['title'][:33]:<34}{r['lift']:>+10.4f}{r['from']:>10.4f}"
+                   f"{r['to']:>10.4f}{r['S_start']:>10.4f}{r['S_end']:>10.4f}")
+    out += ["", "Junctions: " + ", ".join(f"{j['at_deg']:g}{xu} {j['continuity']}" for j in report.junctions), ""]
+    units = {"S": lu, "V": f"{lu}/s", "A": f"{lu}/s²", "J": f"{lu}/s³"}
+    out.append(f"Peaks ({report.peaks_mode}){'':14}{'max':>14}{'at':>10}{'min':>14}{'at':>10}")
+    for q, p in report.peaks.items():
+        out.append(f"  {q} ({units[q]}){'':<{22 - len(units[q])}}{p['max']:>14.6g}{p['at_max_deg']:>10.4f}"
+                   f"{p['min']:>14.6g}{p['at_min_deg']:>10.4f}")
+    out += ["", f"Verdict: {report.verdict}"]
+    out += [f"  [{f.severity}] {f.code}: {f.message}" for f in report.findings]
+    return "\n".join(out)
+
+
+# ---------------------------------------------------------------------------
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="camfab", description="Cam design, checks and manufacturing files.")
+    parser.add_argument("--version", action="version", version=f"camfab {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name, fn in COMMANDS.items():
+        p = sub.add_parser(name, help=fn.help, description=fn.help)
+        fn.add_arguments(p)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the command line; returns the exit code (testable in-process)."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # argparse: 0 for --help/--version, 2 for bad options
+        return int(exc.code or 0)
+    if not args.command:
+        parser.print_help(sys.stderr)
+        return EXIT_INPUT
+    try:
+        return COMMANDS[args.command](args)
+    except SpecError as exc:
+        print(f"camfab {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_INPUT
+    except UsageError as exc:
+        print(f"camfab {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_INPUT
+    except MissingDependencyError as exc:
+        print(f"camfab {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_IO
+    except OSError as exc:
+        print(f"camfab {args.command}: I/O error: {exc}", file=sys.stderr)
+        return EXIT_IO

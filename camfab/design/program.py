@@ -1,0 +1,507 @@
+"""Segment programs: a closed chain of motion-law segments, evaluated exactly.
+
+A :class:`MotionProgram` maps the cam's independent variable ``x`` (radians of
+cam angle for rotating cams, mm of travel for translating cams) to the follower
+coordinate ``S`` and its derivatives ``S′, S″, S‴`` per unit of ``x``.  It is
+periodic with period :attr:`MotionProgram.period` (2π or the cam length).
+
+Build one with :func:`build_program` (validating, reports every problem at
+once) or :meth:`MotionProgram.from_segments` (the same, with degrees for
+convenience).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Iterable, Sequence
+
+import numpy as np
+
+from ..errors import Problem, SpecError
+from ..tolerances import ANGLE_SUM_TOL_DEG
+from .laws import GENERIC, HALF_PERIOD, LAWS, Law, get_law, law_names
+
+__all__ = [
+    "SegmentInput",
+    "Segment",
+    "MotionProgram",
+    "build_program",
+    "solve_generic",
+    "hermite_coefficients",
+]
+
+TWO_PI = 2.0 * math.pi
+
+
+@dataclass(frozen=True, slots=True)
+class SegmentInput:
+    """One segment as the user wrote it (before neighbours are resolved).
+
+    Parameters
+    ----------
+    law : str
+        Law key (see :func:`camfab.design.laws.law_names`).
+    lift : float
+        Signed lift: mm (translating follower) or degrees (oscillating).
+    span : float or None
+        Segment span in the program's unit (radians, or mm for translating
+        cams).  ``None`` asks for a half-period law's span to be solved from
+        its neighbour's slope.
+    shape : str or None
+        Double-harmonic shape override ("rise" or "return").
+    """
+
+    law: str
+    lift: float
+    span: float | None
+    shape: str | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class Segment:
+    """A resolved segment: its law, span, start and exact polynomial data.
+
+    ``S(u) = s0 + lift·f(u)`` for standard laws, or ``S(u) = Σ coeffs[i]·uⁱ``
+    for polynomial segments (generic 5th/7th, knot-table Hermite pieces), with
+    ``u = (x − start)/span``.
+    """
+
+    law: str
+    lift: float
+    span: float
+    start: float
+    s0: float
+    coeffs: tuple[float, ...] | None = None
+    title: str = ""
+
+    @property
+    def end(self) -> float:
+        return self.start + self.span
+
+    @property
+    def breaks(self) -> tuple[float, ...]:
+        """Internal breakpoints in ``u``."""
+        return LAWS[self.law].breaks if self.law in LAWS else ()
+
+    def du(self, u: np.ndarray, nu: int) -> np.ndarray:
+        """``nu``-th derivative of S with respect to ``u`` (absolute units)."""
+        if self.coeffs is not None:
+            c = np.polynomial.polynomial.polyder(self.coeffs, nu) if nu else self.coeffs
+            return np.polynomial.polynomial.polyval(u, c)
+        out = self.lift * LAWS[self.law](u, nu)
+        return out + self.s0 if nu == 0 else out
+
+    def values(self, u: np.ndarray, nu: int) -> np.ndarray:
+        """``nu``-th derivative of S with respect to ``x`` at local ``u``."""
+        return self.du(u, nu) / self.span**nu
+
+    def end_values(self, at_end: bool, n: int = 4) -> np.ndarray:
+        """S, S′, S″, S‴ (per unit x) at the start (``at_end=False``) or end."""
+        u = np.array([1.0 if at_end else 0.0])
+        return np.array([self.values(u, k)[0] for k in range(n)])
+
+
+def hermite_coefficients(
+    start: Sequence[float], end: Sequence[float], span: float
+) -> tuple[float, ...]:
+    """Polynomial (in u) through end conditions given per unit x.
+
+    ``start`` and ``end`` hold ``(S, S′, S″)`` for a quintic or
+    ``(S, S′, S″, S‴)`` for a 7th-degree polynomial; this is the CAM-DAS linear
+    system of spec §5.4/§5.6 in closed form.
+    """
+    m = len(start)
+    if m not in (3, 4) or len(end) != m:
+        raise ValueError("hermite_coefficients needs 3 (quintic) or 4 (7th degree) values per end")
+    fact = [1.0, 1.0, 2.0, 6.0]
+    a = [start[k] * span**k / fact[k] for k in range(m)]  # C0..C(m-1)
+    # Δk = S^(k)(1)·β^k − d^k/du^k of the known low-order part at u=1
+    low = np.polynomial.Polynomial(a)
+    d = [end[k] * span**k - (low.deriv(k) if k else low)(1.0) for k in range(m)]
+    if m == 3:
+        c3 = 10 * d[0] - 4 * d[1] + d[2] / 2
+        c4 = -15 * d[0] + 7 * d[1] - d[2]
+        c5 = 6 * d[0] - 3 * d[1] + d[2] / 2
+        return (*a, c3, c4, c5)
+    c4 = 35 * d[0] - 15 * d[1] + 2.5 * d[2] - d[3] / 6
+    c5 = -84 * d[0] + 39 * d[1] - 7 * d[2] + d[3] / 2
+    c6 = 70 * d[0] - 34 * d[1] + 6.5 * d[2] - d[3] / 2
+    c7 = -20 * d[0] + 10 * d[1] - 2 * d[2] + d[3] / 6
+    return (*a, c4, c5, c6, c7)
+
+
+def solve_generic(degree: int, s0: float, lift: float, span: float,
+                  prev_end: np.ndarray, next_start: np.ndarray) -> tuple[float, ...]:
+    """Coefficients of a generic 5th/7th-degree segment from its neighbours.
+
+    ``prev_end`` and ``next_start`` are the neighbours' ``S, S′, S″, S‴`` (per
+    unit x); S itself is taken from ``s0`` and ``s0 + lift``.
+    """
+    m = 3 if degree == 5 else 4
+    start = [s0, *prev_end[1:m]]
+    end = [s0 + lift, *next_start[1:m]]
+    return hermite_coefficients(start, end, span)
+
+
+@dataclass(frozen=True)
+class Peak:
+    """Extremes of one quantity over the cycle (x in the program's unit)."""
+
+    max: float
+    min: float
+    at_max: float
+    at_min: float
+
+
+@dataclass(frozen=True)
+class Junction:
+    """Continuity at a breakpoint.
+
+    ``order`` is the highest derivative order k such that S…S⁽ᵏ⁾ are all
+    continuous (−1 if S itself jumps); ``jumps`` holds |right − left| for
+    S, S′, S″, S‴.
+    """
+
+    at: float
+    order: int
+    jumps: tuple[float, float, float, float]
+    segment: int | None  # index of the segment starting here; None for internal breaks
+
+    @property
+    def continuity(self) -> str:
+        return f"C{self.order}" if self.order >= 0 else "discontinuous"
+
+
+@dataclass(frozen=True)
+class MotionProgram:
+    """A closed chain of resolved segments.  See the module docstring."""
+
+    segments: tuple[Segment, ...]
+    period: float = TWO_PI
+    _starts: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "_starts", np.array([s.start for s in self.segments]))
+
+    # ---- construction -------------------------------------------------
+    @classmethod
+    def from_segments(cls, rows: Iterable[Sequence], *, unit: str = "deg",
+                      period: float | None = None) -> "MotionProgram":
+        """Build from ``(law, lift, span[, shape])`` rows; span in degrees by default.
+
+        ``unit="rad"`` takes spans in radians; ``unit="mm"`` builds a
+        translating-cam program whose period is the sum of the spans (or
+        ``period``).  A span of ``None`` is solved (half-period laws).
+        """
+        scale = {"deg": math.pi / 180.0, "rad": 1.0, "mm": 1.0}[unit]
+        inputs = []
+        for row in rows:
+            law, lift, span, *rest = row
+            inputs.append(SegmentInput(law, float(lift), None if span is None else float(span) * scale,
+                                       rest[0] if rest else None))
+        if period is None:
+            period = TWO_PI if unit != "mm" else sum(i.span or 0.0 for i in inputs)
+        return build_program(inputs, period=period, unit=unit)
+
+    # ---- evaluation ---------------------------------------------------
+    @property
+    def junctions_x(self) -> np.ndarray:
+        """Segment junctions in x, from 0 to :attr:`period` inclusive."""
+        return np.append(self._starts, self.period)
+
+    @property
+    def breakpoints(self) -> np.ndarray:
+        """Every point where a formula changes: junctions and internal law breaks."""
+        pts = [self.junctions_x]
+        for s in self.segments:
+            if s.breaks:
+                pts.append(s.start + s.span * np.asarray(s.breaks))
+        return np.unique(np.concatenate(pts))
+
+    def segment_index(self, x: np.ndarray) -> np.ndarray:
+        """Index of the segment containing each ``x`` (already reduced to [0, period))."""
+        idx = np.searchsorted(self._starts, x, side="right") - 1
+        return np.clip(idx, 0, len(self.segments) - 1)
+
+    def evaluate(self, x, orders: Sequence[int] = (0, 1, 2, 3)) -> np.ndarray:
+        """S and its derivatives at ``x``.
+
+        Parameters
+        ----------
+        x : (n,) float array or float
+            Cam angle in radians (or travel in mm); any real value, the program
+            is periodic.  A point on a junction takes the segment that starts there.
+        orders : sequence of int
+            Which derivatives to return (0 = S … 3 = S‴; 4 is available too).
+
+        Returns
+        -------
+        (len(orders), n) float array
+            Derivatives per unit of x (per radian or per mm).
+        """
+        xa = np.atleast_1d(np.asarray(x, dtype=float))
+        xr = np.mod(xa, self.period)
+        idx = self.segment_index(xr)
+        out = np.empty((len(orders), xr.size))
+        for k, seg in enumerate(self.segments):
+            sel = np.flatnonzero(idx == k)
+            if sel.size == 0:
+                continue
+            u = (xr[sel] - seg.start) / seg.span
+            for row, nu in enumerate(orders):
+                out[row, sel] = seg.values(u, nu)
+        return out
+
+    def __call__(self, x, nu: int = 0) -> np.ndarray:
+        """The ``nu``-th derivative of S at ``x`` (vectorised, periodic)."""
+        return self.evaluate(x, (nu,))[0]
+
+    # ---- analysis -----------------------------------------------------
+    def junctions(self, *, rel_tol: float | None = None, internal: bool = False) -> list[Junction]:
+        """Continuity at every segment junction (360°→0° included, listed first).
+
+        A jump counts as a discontinuity when it exceeds ``rel_tol`` times the
+        peak magnitude of that derivative over the cycle (at least 1e-9 in
+        absolute terms).  With ``internal=True`` the internal breakpoints of
+        piecewise laws are included.
+        """
+        from ..tolerances import CONTINUITY_REL_TOL
+
+        tol = CONTINUITY_REL_TOL if rel_tol is None else rel_tol
+        scale = [max(abs(p.max), abs(p.min), 1e-2) for p in self.peaks("exact")]
+        out = []
+        n = len(self.segments)
+        for k, seg in enumerate(self.segments):
+            left = self.segments[k - 1].end_values(True)
+            right = seg.end_values(False)
+            out.append(self._junction(seg.start, left, right, scale, tol, k))
+            if internal:
+                for ub in seg.breaks:
+                    lo, hi = np.nextafter(ub, -1.0), np.nextafter(ub, 2.0)
+                    left = np.array([seg.values(np.array([lo]), j)[0] for j in range(4)])
+                    right = np.array([seg.values(np.array([hi]), j)[0] for j in range(4)])
+                    out.append(self._junction(seg.start + ub * seg.span, left, right, scale, tol, None))
+        del n
+        return sorted(out, key=lambda j: j.at)
+
+    @staticmethod
+    def _junction(at, left, right, scale, tol, seg) -> Junction:
+        jumps = np.abs(right - left)
+        order = 3
+        for j in range(4):
+            if jumps[j] > tol * scale[j] + 1e-12:
+                order = j - 1
+                break
+        return Junction(at, order, tuple(float(v) for v in jumps), seg)
+
+    def peaks(self, mode: str = "exact", *, step: float | None = None) -> tuple[Peak, Peak, Peak, Peak]:
+        """Extremes of S, S′, S″, S‴ over the cycle (per unit x).
+
+        ``mode="exact"`` finds the analytic extrema: piece end values (one-sided
+        at junctions, so a jerk jump reports the value on the segment side) and
+        interior zeros of the next derivative, located to ~1e-12 in u.
+        ``mode="camdas"`` reproduces CAM-DAS: samples every ``step`` (default
+        1°, or 1 mm for translating cams) from 0 to the period inclusive, a
+        sample on a junction counted on both sides.
+        """
+        if mode == "exact":
+            return tuple(_exact_peak(self, nu) for nu in range(4))  # type: ignore[return-value]
+        if mode == "camdas":
+            if step is None:
+                step = math.pi / 180.0 if abs(self.period - TWO_PI) < 1e-12 else 1.0
+            return _sampled_peaks(self, step)
+        raise ValueError(f"'{mode}' is not a valid peaks mode, must be one of: exact, camdas")
+
+
+# ---------------------------------------------------------------------------
+# exact and sampled extrema
+def _pieces(seg: Segment) -> list[tuple[float, float]]:
+    edges = [0.0, *seg.breaks, 1.0]
+    return list(zip(edges[:-1], edges[1:]))
+
+
+def _exact_peak(prog: MotionProgram, nu: int) -> Peak:
+    from scipy.optimize import brentq
+
+    xs: list[float] = []
+    vals: list[float] = []
+    for seg in prog.segments:
+        for ua, ub in _pieces(seg):
+            lo, hi = np.nextafter(ua, 2.0) if ua > 0 else ua, np.nextafter(ub, -1.0) if ub < 1 else ub
+            grid = np.linspace(lo, hi, 129)
+            d = seg.du(grid, nu + 1)
+            cand = [lo, hi]
+            sgn = np.sign(d)
+            cand += list(grid[1:-1][sgn[1:-1] == 0])
+            for i in np.flatnonzero(sgn[:-1] * sgn[1:] < 0):
+                cand.append(brentq(lambda t: float(seg.du(np.array([t]), nu + 1)[0]),
+                                   grid[i], grid[i + 1], xtol=1e-15, rtol=4 * np.finfo(float).eps))
+            c = np.asarray(cand)
+            xs.extend(seg.start + c * seg.span)
+            vals.extend(seg.values(c, nu))
+    return _pick(np.asarray(xs), np.asarray(vals))
+
+
+def _pick(xs: np.ndarray, vals: np.ndarray) -> Peak:
+    order = np.argsort(xs, kind="stable")
+    xs, vals = xs[order], vals[order]
+    span = float(vals.max() - vals.min())
+    tol = 1e-12 * max(span, abs(float(vals.max())), 1.0)
+    imax = int(np.flatnonzero(vals >= vals.max() - tol)[0])
+    imin = int(np.flatnonzero(vals <= vals.min() + tol)[0])
+    return Peak(float(vals[imax]), float(vals[imin]), float(xs[imax]), float(xs[imin]))
+
+
+def _sampled_peaks(prog: MotionProgram, step: float) -> tuple[Peak, ...]:
+    n = int(round(prog.period / step))
+    grid = np.arange(n + 1) * step
+    xs, vals = [], []
+    eps = 1e-9 * step
+    for seg in prog.segments:
+        sel = grid[(grid >= seg.start - eps) & (grid <= seg.end + eps)]
+        u = np.clip((sel - seg.start) / seg.span, 0.0, 1.0)
+        xs.append(sel)
+        vals.append(np.array([seg.values(u, k) for k in range(4)]))
+    x = np.concatenate(xs)
+    v = np.concatenate(vals, axis=1)
+    return tuple(_pick(x, v[k]) for k in range(4))
+
+
+# ---------------------------------------------------------------------------
+# validation and resolution
+def _half_period_span(name: str, lift: float, slope: float) -> float:
+    """Span that gives a half-period law the neighbour's slope at its moving end."""
+    return HALF_PERIOD[name][1] * lift / slope
+
+
+def build_program(inputs: Sequence[SegmentInput], *, period: float = TWO_PI, unit: str = "rad",
+                  path: str = "motion", source: str | None = None) -> MotionProgram:
+    """Validate segment inputs and resolve them into a :class:`MotionProgram`.
+
+    Every rule of the CAM-DAS data entry (spec motion-laws §2, §3, §5.4, §5.9)
+    is checked and **all** problems are reported together in one
+    :class:`~camfab.errors.SpecError`, each naming its field path
+    (``motion[3].angle_deg``), the value, the rule and a fix.
+    """
+    problems: list[Problem] = []
+    n = len(inputs)
+    span_key = "length_mm" if unit == "mm" else "angle_deg"
+    to_user = (lambda v: v) if unit == "mm" else math.degrees
+    if n == 0:
+        raise SpecError(Problem(path, [], "the program has no segments",
+                                "add [[motion]] segments whose spans sum to the cycle"), source)
+    known = set(law_names())
+    for i, s in enumerate(inputs):
+        p = f"{path}[{i}]"
+        if s.law not in known:
+            problems.append(Problem(f"{p}.law", s.law, "unknown motion law",
+                                    "use one of: " + ", ".join(sorted(known))))
+        if not math.isfinite(s.lift):
+            problems.append(Problem(f"{p}.lift", s.lift, "lift must be a finite number", "give the lift in mm or degrees"))
+        elif abs(s.lift) > 1e5:
+            problems.append(Problem(f"{p}.lift", s.lift, "lift magnitude is absurd (> 1e5)",
+                                    "check the units: lift is in mm (translating) or degrees (oscillating)"))
+        if s.span is None:
+            if s.law not in HALF_PERIOD:
+                problems.append(Problem(f"{p}.{span_key}", "auto", "only half-period laws can solve their span",
+                                        f"give {span_key} for a '{s.law}' segment"))
+        elif not math.isfinite(s.span) or s.span <= 0:
+            problems.append(Problem(f"{p}.{span_key}", to_user(s.span) if math.isfinite(s.span) else s.span,
+                                    "segment span must be a finite number > 0", f"give a positive {span_key}"))
+        if s.shape is not None and (s.law != "double_harmonic" or s.shape not in ("rise", "return")):
+            problems.append(Problem(f"{p}.shape", s.shape, "shape applies to double_harmonic only, as 'rise' or 'return'",
+                                    "remove it or fix its value"))
+    if problems:
+        raise SpecError(problems, source)
+
+    laws = [get_law(s.law, s.lift, s.shape).name if s.law not in GENERIC else s.law for s in inputs]
+    generic = [lw in GENERIC for lw in laws]
+    if inputs[0].lift < 0:
+        problems.append(Problem(f"{path}[0].lift", inputs[0].lift, "the first segment cannot be a return",
+                                "start the program with a rise or a dwell (rotate the program)"))
+    for i in range(n):
+        if generic[i] and generic[(i + 1) % n]:
+            j = (i + 1) % n
+            problems.append(Problem(f"{path}[{j}].law", inputs[j].law,
+                                    f"two generic polynomials may not be adjacent ({path}[{i}] and {path}[{j}], cyclically)",
+                                    "put a standard law between them"))
+
+    # spans: solve half-period 'auto' spans from the neighbour's slope, check given ones
+    spans = [s.span for s in inputs]
+    for i, s in enumerate(inputs):
+        if laws[i] not in HALF_PERIOD:
+            continue
+        end, _ = HALF_PERIOD[laws[i]]
+        j = (i - 1) % n if end == "start" else (i + 1) % n
+        p = f"{path}[{i}]"
+        if generic[j]:
+            if s.span is None:
+                problems.append(Problem(f"{p}.{span_key}", "auto", "cannot solve the span next to a generic polynomial",
+                                        f"give {span_key} explicitly"))
+            continue
+        nb = inputs[j]
+        if nb.span is None:
+            problems.append(Problem(f"{p}.{span_key}", "auto",
+                                    f"its neighbour {path}[{j}] also has an unknown span", "give one of the two spans"))
+            continue
+        nseg = Segment(laws[j], nb.lift, nb.span, 0.0, 0.0)
+        slope = nseg.end_values(end == "start")[1]
+        side = "previous" if end == "start" else "next"
+        if slope == 0 or (s.lift != 0 and np.sign(slope) != np.sign(s.lift)):
+            problems.append(Problem(f"{p}.law", s.law,
+                                    f"a half-period law needs its {side} segment ({path}[{j}], "
+                                    f"slope {slope:.6g}/unit) to move in the same direction",
+                                    "put a constant-velocity (or other moving) segment of the same sense beside it"))
+            continue
+        need = _half_period_span(laws[i], s.lift, slope)
+        if s.span is None:
+            spans[i] = need
+        elif abs(need - s.span) > 1e-9 * max(need, 1e-9):
+            problems.append(Problem(f"{p}.{span_key}", to_user(s.span),
+                                    f"the velocity does not match the {side} segment ({path}[{j}])",
+                                    f"set {span_key} = {to_user(need):.12g} or \"auto\""))
+    if problems:
+        raise SpecError(problems, source)
+
+    total = sum(spans)  # type: ignore[arg-type]
+    tol = ANGLE_SUM_TOL_DEG if unit != "mm" else 1e-9
+    if abs(to_user(total) - to_user(period)) > tol:
+        problems.append(Problem(f"{path}[*].{span_key}", round(to_user(total), 12),
+                                f"segment spans must sum to {to_user(period):.12g}",
+                                f"change the spans by {to_user(period - total):+.12g} in total"))
+    net = sum(s.lift for s in inputs)
+    if abs(net) > 1e-9 * max(1.0, max(abs(s.lift) for s in inputs)):
+        problems.append(Problem(f"{path}[*].lift", round(net, 12), "lifts must sum to 0 so the cycle closes",
+                                f"change the lifts by {-net:+.12g} in total"))
+    if problems:
+        raise SpecError(problems, source)
+
+    # resolve standard segments (starts scaled so the spans close the period exactly)
+    k = period / total
+    spans = [sp * k for sp in spans]  # type: ignore[operator]
+    starts = np.concatenate([[0.0], np.cumsum(spans)[:-1]])
+    s0 = np.concatenate([[0.0], np.cumsum([s.lift for s in inputs])[:-1]])
+    segs: list[Segment] = [
+        Segment(laws[i], inputs[i].lift, spans[i], float(starts[i]), float(s0[i]), None,
+                LAWS[laws[i]].title if laws[i] in LAWS else f"Generic {GENERIC[laws[i]]}th-degree polynomial")
+        for i in range(n)
+    ]
+    for i in range(n):
+        if generic[i]:
+            prev_end = segs[(i - 1) % n].end_values(True)
+            next_start = segs[(i + 1) % n].end_values(False)
+            if n == 1:
+                prev_end = next_start = np.zeros(4)
+            c = solve_generic(GENERIC[laws[i]], segs[i].s0, segs[i].lift, segs[i].span, prev_end, next_start)
+            segs[i] = Segment(laws[i], segs[i].lift, segs[i].span, segs[i].start, segs[i].s0, c, segs[i].title)
+    prog = MotionProgram(tuple(segs), period)
+
+    smin = _exact_peak(prog, 0)
+    if smin.min < -1e-9 * max(1.0, abs(smin.max)):
+        i = int(prog.segment_index(np.array([smin.at_min]))[0])
+        problems.append(Problem(f"{path}[{i}]", round(smin.min, 9),
+                                f"S goes below 0 (to {smin.min:.6g} at {to_user(smin.at_min):.6g}); the follower would "
+                                "cross the base/prime circle",
+                                "reduce the return, or change the law or the neighbours of a generic polynomial"))
+        raise SpecError(problems, source)
+    return prog

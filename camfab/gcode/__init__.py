@@ -1,0 +1,1 @@
+"""camfab.gcode — see the issue tracker for its planned contents."""

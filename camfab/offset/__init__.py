@@ -1,0 +1,1 @@
+"""camfab.offset — see the issue tracker for its planned contents."""

@@ -1,0 +1,29 @@
+"""Named numerical tolerances, documented in one place."""
+from __future__ import annotations
+
+__all__ = [
+    "ABS_TOL",
+    "ANGLE_SUM_TOL_DEG",
+    "CONTINUITY_REL_TOL",
+    "PEAK_ANGLE_TOL_RAD",
+    "CAMDAS_STEP_DEG",
+    "DEFAULT_EXPORT_TOL_MM",
+    "MIN_EXPORT_TOL_MM",
+    "MAX_EXPORT_TOL_MM",
+]
+
+#: absolute tolerance for "equal" lengths in mm
+ABS_TOL = 1e-12
+#: the segment angles must sum to 360 degrees within this many degrees
+ANGLE_SUM_TOL_DEG = 1e-9
+#: a derivative is continuous at a junction when the jump is below this fraction of
+#: that derivative's peak magnitude over the cycle (or of 1 when the peak is smaller)
+CONTINUITY_REL_TOL = 1e-7
+#: analytic extrema are located to this accuracy in the independent variable
+PEAK_ANGLE_TOL_RAD = 1e-10
+#: CAM-DAS evaluated and reported everything at 1 degree steps
+CAMDAS_STEP_DEG = 1.0
+#: default export tolerance (mm) and its accepted range
+DEFAULT_EXPORT_TOL_MM = 0.001
+MIN_EXPORT_TOL_MM = 1e-6
+MAX_EXPORT_TOL_MM = 0.1

@@ -1,0 +1,38 @@
+"""Shared fixtures and helpers for the camfab tests."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "camfab" / "templates" / "examples"
+SHARED = Path(__file__).resolve().parents[2] / "shared"
+
+#: Ejemplo9RT's segment list (spec camdas-reference §2.1)
+EJEMPLO9RT = [("modified_sine", 10, 50), ("dwell", 0, 40), ("cycloidal", -10, 50), ("dwell", 0, 40),
+              ("poly345", 10, 50), ("dwell", 0, 40), ("poly4567", -10, 50), ("dwell", 0, 40)]
+#: Ejemplo11RO's law (degrees; spec camdas-reference §2.1, reproduces Fig 7.19)
+EJEMPLO11RO = [("dwell", 0, 90), ("poly4567", 25, 90), ("poly4567", -10, 45), ("poly4567", 10, 45),
+               ("poly4567", -25, 90)]
+
+
+def base_design(**over):
+    """A valid design dict (Ejemplo9RT) with top-level sections replaced by ``over``."""
+    d = {
+        "name": "T",
+        "cam": {"kind": "disc", "rotation": "cw", "omega_rad_s": 1.0},
+        "follower": {"type": "roller", "motion": "translating", "base_radius_mm": 35.0,
+                     "roller_radius_mm": 7.0, "offset_mm": 0.0},
+        "motion": [{"law": law, "lift": float(l), "angle_deg": float(b)} for law, l, b in EJEMPLO9RT],
+    }
+    d.update(over)
+    return d
+
+
+@pytest.fixture
+def design_dict():
+    return base_design()
+
+
+DEG = math.pi / 180

@@ -1,0 +1,156 @@
+"""Design-file validation: every rule refused with the field named, all problems at once."""
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from camfab.design.spec import design_from_dict, load_design
+from camfab.errors import SpecError
+from tests.conftest import EXAMPLES, base_design
+
+
+def _problems(data):
+    with pytest.raises(SpecError) as info:
+        design_from_dict(data)
+    return info.value
+
+
+def test_example_loads_and_builds_program():
+    spec = load_design(EXAMPLES / "ejemplo9rt.toml")
+    assert spec.name == "Ejemplo9RT"
+    assert spec.follower.base_radius_mm == 35.0
+    prog = spec.program()
+    assert len(prog.segments) == 8
+    assert spec.cam.omega_rad_s == 1.0 and spec.cam.speed_given
+
+
+def test_speed_from_rpm_and_default():
+    d = base_design(cam={"kind": "disc", "speed_rpm": 60.0})
+    assert design_from_dict(d).cam.omega_rad_s == pytest.approx(2 * math.pi)
+    d = base_design(cam={"kind": "disc"})
+    spec = design_from_dict(d)
+    assert spec.cam.omega_rad_s == 1.0 and not spec.cam.speed_given
+
+
+@pytest.mark.parametrize(
+    "section, value, field",
+    [
+        ("cam", {"kind": "disk"}, "cam.kind"),
+        ("cam", {"rotation": "left"}, "cam.rotation"),
+        ("cam", {"speed_rpm": -5.0}, "cam.speed_rpm"),
+        ("cam", {"speed_rpm": 10.0, "omega_rad_s": 1.0}, "cam.speed_rpm"),
+        ("cam", {"omega_rad_s": float("nan")}, "cam.omega_rad_s"),
+        ("cam", {"speed_mm_s": 5.0}, "cam.speed_mm_s"),
+        ("follower", {"type": "roller", "motion": "translating", "base_radius_mm": -35.0,
+                      "roller_radius_mm": 7.0}, "follower.base_radius_mm"),
+        ("follower", {"type": "roller", "motion": "translating", "base_radius_mm": 35.0}, "follower.roller_radius_mm"),
+        ("follower", {"type": "roller", "motion": "oscillating", "base_radius_mm": 35.0,
+                      "roller_radius_mm": 7.0}, "follower.pivot_distance_mm"),
+        ("follower", {"type": "flat", "motion": "translating", "base_radius_mm": 35.0,
+                      "roller_radius_mm": 7.0}, "follower.roller_radius_mm"),
+        ("follower", {"type": "knife", "motion": "translating", "base_radius_mm": 35.0,
+                      "roller_radius_mm": 7.0}, "follower.roller_radius_mm"),
+        ("follower", {"type": "cylinder"}, "follower.type"),
+        ("follower", {"type": "roller", "motion": "translating", "base_radius_mm": "35",
+                      "roller_radius_mm": 7.0}, "follower.base_radius_mm"),
+        ("manufacturing", {"bore_mm": 80.0}, "manufacturing.bore_mm"),
+        ("manufacturing", {"tolerance_mm": 1.0}, "manufacturing.tolerance_mm"),
+        ("manufacturing", {"tolerance_mm": 1e-9}, "manufacturing.tolerance_mm"),
+        ("manufacturing", {"keyway": True}, "manufacturing.keyway"),
+        ("manufacturing", {"thickness_mm": 0.0}, "manufacturing.thickness_mm"),
+        ("outputs", {"gcode": "heidenhain"}, "outputs.gcode"),
+        ("outputs", {"dxf": "yes"}, "outputs.dxf"),
+        ("checks", {"pressure_angle_limit_deg": 95.0}, "checks.pressure_angle_limit_deg"),
+    ],
+)
+def test_field_rules_name_the_field(section, value, field):
+    err = _problems(base_design(**{section: value}))
+    assert any(p.path == field for p in err.problems), str(err)
+    assert field in str(err)
+
+
+def test_unknown_key_suggests_the_right_one():
+    d = base_design()
+    d["motion"][1] = {"law": "dwell", "lfit": 0.0, "angle_deg": 40.0}
+    err = _problems(d)
+    assert "motion[1].lfit" in str(err) and "did you mean 'lift'" in str(err)
+
+
+def test_unknown_law_suggests():
+    d = base_design()
+    d["motion"][0]["law"] = "cycloid"
+    err = _problems(d)
+    assert "motion[0].law" in str(err) and "cycloidal" in str(err)
+
+
+def test_all_problems_reported_at_once():
+    d = base_design(cam={"kind": "disk", "speed_rpm": -1.0})
+    d["follower"]["base_radius_mm"] = -3.0
+    d["motion"][0]["angle_deg"] = -50.0
+    err = _problems(d)
+    paths = {p.path for p in err.problems}
+    assert {"cam.kind", "cam.speed_rpm", "follower.base_radius_mm", "motion[0].angle_deg"} <= paths
+
+
+def test_program_rules_are_merged_into_the_spec_error():
+    d = base_design()
+    d["motion"][1]["angle_deg"] = 45.0  # sum 365
+    err = _problems(d)
+    assert "motion[*].angle_deg" in str(err) and "360" in str(err) and "-5" in str(err)
+
+
+def test_motion_and_table_are_exclusive():
+    err = _problems(base_design(motion_table={"rows": []}))
+    assert any(p.path == "motion_table" for p in err.problems)
+
+
+def test_missing_motion():
+    d = base_design()
+    del d["motion"]
+    assert any(p.path == "motion" for p in _problems(d).problems)
+
+
+def test_translating_cam_uses_length_mm():
+    d = base_design(cam={"kind": "translating", "speed_mm_s": 10.0},
+                    follower={"type": "roller", "motion": "translating", "roller_radius_mm": 5.0,
+                              "cam_length_mm": 200.0},
+                    motion=[{"law": "cycloidal", "lift": 10.0, "length_mm": 100.0},
+                            {"law": "cycloidal", "lift": -10.0, "length_mm": 100.0}])
+    spec = design_from_dict(d)
+    assert spec.program().period == pytest.approx(200.0)
+    assert spec.speed == 10.0
+    d["motion"][0] = {"law": "cycloidal", "lift": 10.0, "angle_deg": 100.0}
+    err = _problems(d)
+    assert "motion[0].angle_deg" in str(err)
+
+
+def test_half_period_auto_span_from_file():
+    d = base_design(motion=[
+        {"law": "semicycloidal_vi0", "lift": 5.0, "angle_deg": "auto"},
+        {"law": "constant_velocity", "lift": 10.0, "angle_deg": 90.0},
+        {"law": "semicycloidal_vf0", "lift": 5.0, "angle_deg": "auto"},
+        {"law": "dwell", "lift": 0.0, "angle_deg": 45.0},
+        {"law": "poly4567", "lift": -20.0, "angle_deg": 45.0},
+    ])
+    prog = design_from_dict(d).program()
+    spans = [math.degrees(s.span) for s in prog.segments]
+    assert spans[0] == pytest.approx(90.0) and spans[2] == pytest.approx(90.0)
+
+
+def test_toml_syntax_error_names_the_file(tmp_path):
+    p = tmp_path / "bad.toml"
+    p.write_text("name = 'x'\n[cam\nkind='disc'\n")
+    with pytest.raises(SpecError, match="bad.toml.*not valid TOML"):
+        load_design(p)
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(SpecError, match="no such design file"):
+        load_design(tmp_path / "nope.toml")
+
+
+def test_spec_is_immutable(design_dict):
+    spec = design_from_dict(design_dict)
+    with pytest.raises(AttributeError):
+        spec.name = "other"  # type: ignore[misc]
