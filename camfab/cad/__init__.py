@@ -1,1 +1,1 @@
-"""camfab.cad — see the issue tracker for its planned contents."""
+"""CAD exports: plate geometry (bulge loops), STL (trimesh), STEP (cadquery, imported lazily)."""

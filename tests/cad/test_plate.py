@@ -1,0 +1,89 @@
+"""Plate geometry, STL and STEP solids: exact areas/volumes, validity, read-back, determinism."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from camfab.cad.plate import BulgeLoop, PlateSpec, bore_loop, circle_loop, keyway_size, plate_volume
+from camfab.errors import GeometryError
+
+
+def _regular_arc_loop(r=40.0, n=4):
+    ang = np.linspace(0, 2 * math.pi, n, endpoint=False)
+    return BulgeLoop(r * np.column_stack([np.cos(ang), np.sin(ang)]), np.full(n, math.tan(2 * math.pi / n / 4)))
+
+
+def _stadium():
+    # 60 x 30 stadium: two lines and two half circles (clockwise arcs negative bulge test below)
+    pts = np.array([[-15.0, -15.0], [15.0, -15.0], [15.0, 15.0], [-15.0, 15.0]])
+    return BulgeLoop(pts, np.array([0.0, 1.0, 0.0, 1.0]))
+
+
+def test_areas_are_exact():
+    assert _regular_arc_loop().area() == pytest.approx(math.pi * 1600, rel=1e-14)
+    assert circle_loop(7.0).area() == pytest.approx(math.pi * 49, rel=1e-14)
+    assert _stadium().area() == pytest.approx(30 * 30 + math.pi * 15**2, rel=1e-14)
+    cw = BulgeLoop(_stadium().points[::-1].copy(), -np.roll(_stadium().bulges[::-1], -1))
+    assert cw.area() == pytest.approx(-_stadium().area(), rel=1e-14)
+
+
+def test_keyway_proportions_and_bore_area():
+    assert keyway_size(12.0) == (4.0, 1.8)
+    assert keyway_size(20.0) == (6.0, 2.8)
+    with pytest.raises(GeometryError, match="bore_mm"):
+        keyway_size(3.0)
+    r, (b, t2) = 6.0, keyway_size(12.0)
+    # circle + rectangle above the chord y0 .. r + t2, minus the circular cap above y0
+    y0 = math.sqrt(r * r - b * b / 4)
+    half = math.asin(b / (2 * r))
+    cap = r * r * (2 * half - math.sin(2 * half)) / 2
+    expect = math.pi * r * r - cap + b * (r + t2 - y0)
+    assert bore_loop(12.0, True).area() == pytest.approx(expect, rel=1e-13)
+
+
+def test_flatten_within_sagitta():
+    loop = circle_loop(25.0)
+    for tol in (1e-2, 1e-3, 1e-4):
+        pts = loop.flatten(tol)
+        mids = (pts + np.roll(pts, -1, axis=0)) / 2
+        sag = 25.0 - np.hypot(*mids.T)
+        assert np.all(np.abs(np.hypot(*pts.T) - 25.0) < 1e-12)
+        assert sag.max() <= tol
+
+
+def test_stl_watertight_volume_within_chordal_bound():
+    trimesh = pytest.importorskip("trimesh")
+    from camfab.cad import stl
+
+    outline, plate = _regular_arc_loop(), PlateSpec(10.0, 12.0, True)
+    for tol in (1e-2, 1e-3):
+        mesh = stl.plate_mesh(outline, plate, tol=tol)
+        assert mesh.is_watertight and mesh.is_winding_consistent and mesh.volume > 0
+        exact = plate_volume(outline, plate)
+        perimeter = 2 * math.pi * 40 + 2 * math.pi * 6 + 20
+        assert exact - perimeter * tol * plate.thickness_mm <= mesh.volume <= exact
+    data = stl.dumps(outline, plate, tol=1e-3, name="x")
+    assert data == stl.dumps(outline, plate, tol=1e-3, name="x")
+    back = trimesh.load(trimesh.util.wrap_as_stream(data), file_type="stl")
+    assert back.is_watertight
+
+
+@pytest.mark.slow
+def test_step_solid_valid_volume_and_reimport(tmp_path):
+    cq = pytest.importorskip("cadquery")
+    from camfab.cad import step
+
+    outline = _stadium()
+    for plate in (PlateSpec(8.0, 12.0, True), PlateSpec(8.0, 10.0, False, 20.0, 5.0)):
+        exact = plate_volume(outline, plate)
+        text = step.dumps(outline, plate, name="t")
+        assert text == step.dumps(outline, plate, name="t")
+        path = tmp_path / "t.step"
+        path.write_text(text)
+        back = cq.importers.importStep(str(path)).val()
+        assert back.isValid()
+        assert back.Volume() == pytest.approx(exact, rel=1e-6)
+        bb = back.BoundingBox()
+        assert (bb.xmin, bb.xmax) == (pytest.approx(-30.0), pytest.approx(30.0))
