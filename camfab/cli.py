@@ -82,6 +82,7 @@ def cmd_motion(args: argparse.Namespace) -> int:
     report = analyse_motion(prog, name=spec.name, speed=spec.speed, lift_unit=spec.follower.lift_unit,
                             peaks_mode=args.peaks,
                             allow_acceleration_jump=spec.cam.kind in ("constant_width", "constant_diameter"))
+    report.findings.extend(knot_findings(spec))
     if args.csv:
         atomic_write(args.csv, motion_csv(prog, spec.speed, step))
     if args.json:
@@ -96,6 +97,18 @@ def cmd_motion(args: argparse.Namespace) -> int:
 
 
 cmd_motion.add_arguments = _motion_args
+
+
+def knot_findings(spec) -> list:
+    """KNOT_INCONSISTENT warnings of a knot-table design (none for segment programs)."""
+    if spec.motion_table is None:
+        return []
+    from .design.knots import load_motion_table
+    from .design.motion_report import Finding
+
+    base = Path(spec.base_dir) if spec.base_dir else None
+    return [Finding(w.code, "warning", w.from_deg, w.to_deg, w.implied_peak, w.knot_max, w.message)
+            for w in load_motion_table(spec.motion_table, base_dir=base).warnings()]
 
 
 def _x_scale(prog) -> float:

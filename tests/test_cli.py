@@ -107,3 +107,21 @@ def test_unwritable_csv_is_io_error(tmp_path):
     target = tmp_path / "file"
     target.write_text("x")
     assert main(["motion", "ejemplo9rt", "--csv", str(target / "sub" / "m.csv")]) == 3
+
+
+def test_knot_table_inconsistency_is_reported(tmp_path, capsys):
+    # a 2° knot segment asked to rise 1 mm with zero velocity and tiny accelerations at its knots
+    p = tmp_path / "k.toml"
+    p.write_text("""name = "k"
+[follower]
+type = "flat"
+motion = "translating"
+base_radius_mm = 20.0
+[motion_table]
+rows = [[0, 0, 0, 0], [90, 1, 0, 0.001], [92, 2, 0, 0.001], [180, 0, 0, 0]]
+units = { angle = "deg", s = "mm", v = "mm/deg", a = "mm/deg2" }
+""")
+    assert main(["motion", str(p), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    codes = [f["code"] for f in data["findings"]]
+    assert "KNOT_INCONSISTENT" in codes

@@ -402,7 +402,7 @@ def build_program(inputs: Sequence[SegmentInput], *, period: float = TWO_PI, uni
             problems.append(Problem(f"{p}.lift", s.lift, "lift magnitude is absurd (> 1e5)",
                                     "check the units: lift is in mm (translating) or degrees (oscillating)"))
         if s.span is None:
-            if s.law not in HALF_PERIOD:
+            if s.law not in HALF_PERIOD or s.lift == 0:  # lift 0 = dwell: no slope to match
                 problems.append(Problem(f"{p}.{span_key}", "auto", "only half-period laws can solve their span",
                                         f"give {span_key} for a '{s.law}' segment"))
         elif not math.isfinite(s.span) or s.span <= 0:
