@@ -320,26 +320,53 @@ def _pieces(seg: Segment) -> list[tuple[float, float]]:
     return list(zip(edges[:-1], edges[1:]))
 
 
-def _exact_peak(prog: MotionProgram, nu: int) -> Peak:
+def _critical_points(seg: Segment, nu: int, lo: float, hi: float) -> list[float]:
+    """Zeros of S^(nu+1) strictly inside (lo, hi) where it changes sign."""
+    if seg.coeffs is not None:  # polynomial: exact real roots
+        c = np.polynomial.polynomial.polyder(seg.coeffs, nu + 1)
+        if not np.any(c):
+            return []
+        r = np.polynomial.polynomial.polyroots(np.trim_zeros(c, "b")) if len(np.trim_zeros(c, "b")) > 1 else []
+        return [float(z.real) for z in np.atleast_1d(r) if abs(z.imag) < 1e-9 and lo < z.real < hi]
     from scipy.optimize import brentq
 
-    xs: list[float] = []
-    vals: list[float] = []
+    def d(t):
+        return float(seg.du(np.array([t]), nu + 1)[0])
+
+    grid = np.linspace(lo, hi, 129)
+    vals = seg.du(grid, nu + 1)
+    # at a flat end (derivative exactly 0) take the sign just inside, so an extremum in the
+    # first or last cell is still bracketed
+    inner = 1e-9 * (hi - lo)
+    if vals[0] == 0.0:
+        grid[0], vals[0] = lo + inner, d(lo + inner)
+    if vals[-1] == 0.0:
+        grid[-1], vals[-1] = hi - inner, d(hi - inner)
+    sgn = np.sign(vals)
+    out = list(grid[1:-1][sgn[1:-1] == 0])
+    for i in np.flatnonzero(sgn[:-1] * sgn[1:] < 0):
+        out.append(brentq(d, grid[i], grid[i + 1], xtol=1e-15, rtol=4 * np.finfo(float).eps))
+    return out
+
+
+def _segment_candidates(seg: Segment, nu: int) -> tuple[np.ndarray, np.ndarray]:
+    """Local coordinates u and values of every extremum candidate of S^(nu) in a segment."""
+    us: list[float] = []
+    for ua, ub in _pieces(seg):
+        lo = np.nextafter(ua, 2.0) if ua > 0 else ua
+        hi = np.nextafter(ub, -1.0) if ub < 1 else ub
+        us += [lo, hi, *_critical_points(seg, nu, lo, hi)]
+    u = np.asarray(us)
+    return u, seg.values(u, nu)
+
+
+def _exact_peak(prog: MotionProgram, nu: int) -> Peak:
+    xs, vals = [], []
     for seg in prog.segments:
-        for ua, ub in _pieces(seg):
-            lo, hi = np.nextafter(ua, 2.0) if ua > 0 else ua, np.nextafter(ub, -1.0) if ub < 1 else ub
-            grid = np.linspace(lo, hi, 129)
-            d = seg.du(grid, nu + 1)
-            cand = [lo, hi]
-            sgn = np.sign(d)
-            cand += list(grid[1:-1][sgn[1:-1] == 0])
-            for i in np.flatnonzero(sgn[:-1] * sgn[1:] < 0):
-                cand.append(brentq(lambda t: float(seg.du(np.array([t]), nu + 1)[0]),
-                                   grid[i], grid[i + 1], xtol=1e-15, rtol=4 * np.finfo(float).eps))
-            c = np.asarray(cand)
-            xs.extend(seg.start + c * seg.span)
-            vals.extend(seg.values(c, nu))
-    return _pick(np.asarray(xs), np.asarray(vals))
+        u, v = _segment_candidates(seg, nu)
+        xs.append(seg.start + u * seg.span)
+        vals.append(v)
+    return _pick(np.concatenate(xs), np.concatenate(vals))
 
 
 def _pick(xs: np.ndarray, vals: np.ndarray) -> Peak:
@@ -402,9 +429,13 @@ def build_program(inputs: Sequence[SegmentInput], *, period: float = TWO_PI, uni
             problems.append(Problem(f"{p}.lift", s.lift, "lift magnitude is absurd (> 1e5)",
                                     "check the units: lift is in mm (translating) or degrees (oscillating)"))
         if s.span is None:
-            if s.law not in HALF_PERIOD or s.lift == 0:  # lift 0 = dwell: no slope to match
+            if s.law not in HALF_PERIOD:
                 problems.append(Problem(f"{p}.{span_key}", "auto", "only half-period laws can solve their span",
                                         f"give {span_key} for a '{s.law}' segment"))
+            elif s.lift == 0:  # lift 0 = dwell: no slope to match
+                problems.append(Problem(f"{p}.{span_key}", "auto",
+                                        "a half-period segment with lift 0 is a dwell, which has no span to solve",
+                                        f"give {span_key} or a non-zero lift"))
         elif not math.isfinite(s.span) or s.span <= 0:
             problems.append(Problem(f"{p}.{span_key}", to_user(s.span) if math.isfinite(s.span) else s.span,
                                     "segment span must be a finite number > 0", f"give a positive {span_key}"))
@@ -496,12 +527,16 @@ def build_program(inputs: Sequence[SegmentInput], *, period: float = TWO_PI, uni
             segs[i] = Segment(laws[i], segs[i].lift, segs[i].span, segs[i].start, segs[i].s0, c, segs[i].title)
     prog = MotionProgram(tuple(segs), period)
 
-    smin = _exact_peak(prog, 0)
-    if smin.min < -1e-9 * max(1.0, abs(smin.max)):
-        i = int(prog.segment_index(np.array([smin.at_min]))[0])
-        problems.append(Problem(f"{path}[{i}]", round(smin.min, 9),
-                                f"S goes below 0 (to {smin.min:.6g} at {to_user(smin.at_min):.6g}); the follower would "
-                                "cross the base/prime circle",
-                                "reduce the return, or change the law or the neighbours of a generic polynomial"))
+    for i, seg in enumerate(prog.segments):
+        u, v = _segment_candidates(seg, 0)
+        k = int(np.argmin(v))
+        tol_s = 1e-9 * max(1.0, abs(seg.s0), abs(seg.s0 + seg.lift))
+        if v[k] < -tol_s and seg.s0 >= -tol_s:  # report where S goes below 0, not where it stays there
+            at = seg.start + u[k] * seg.span
+            problems.append(Problem(f"{path}[{i}]", round(float(v[k]), 9),
+                                    f"S goes below 0 (to {v[k]:.6g} at {to_user(at):.6g}); the follower would "
+                                    "cross the base/prime circle",
+                                    "reduce the return, or change the law or the neighbours of a generic polynomial"))
+    if problems:
         raise SpecError(problems, source)
     return prog
