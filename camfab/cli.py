@@ -8,6 +8,7 @@ heavy dependencies are imported inside the commands that need them.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 import sys
@@ -160,6 +161,82 @@ def format_motion(spec, prog, report) -> str:
     out += ["", f"Verdict: {report.verdict}"]
     out += [f"  [{f.severity}] {f.code}: {f.message}" for f in report.findings]
     return "\n".join(out)
+
+
+def _check_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("file", help="design file (TOML) or built-in example name")
+    p.add_argument("--json", action="store_true", help="print one JSON object (design.md §6) instead of the table")
+
+
+@register("check", "profile checks: CAM-DAS conclusions table, findings and verdict")
+def cmd_check(args: argparse.Namespace) -> int:
+    from .design.assemble import check_design
+
+    spec = _load(args.file)
+    tool = spec.manufacturing.tool_diameter_mm
+    report = check_design(spec, tool_radius_mm=tool / 2 if tool else None)
+    knots = knot_findings(spec)
+    if knots:
+        report = dataclasses.replace(report, findings=tuple(report.findings) + tuple(knots))
+    if args.json:
+        print(json.dumps(report.to_dict(), indent=2))
+    else:
+        print(format_check(spec, report))
+    return EXIT_CHECKS if report.verdict == "unacceptable" else EXIT_OK
+
+
+cmd_check.add_arguments = _check_args
+
+_VERDICT_TEXT = {"acceptable": "Cam OK (acceptable)",
+                 "not_for_high_speed": "Not suitable for high speeds",
+                 "unacceptable": "Cam KO (unacceptable)"}
+
+
+def format_check(spec, report) -> str:
+    """The CAM-DAS style conclusions table."""
+    d = report.to_dict()
+    lu = spec.follower.lift_unit
+    codes = {f.code for f in report.findings}
+    cont = {"S": "Continuous",
+            "V": "Discontinuous" if "VELOCITY_DISCONTINUITY" in codes else "Continuous",
+            "A": "Discontinuous" if "ACCELERATION_DISCONTINUITY" in codes else "Continuous",
+            "J": "Discontinuous" if "JERK_DISCONTINUITY" in codes else "Continuous"}
+    names = {"S": f"Displacement ({lu})", "V": f"Velocity ({lu}/s)", "A": f"Acceleration ({lu}/s²)",
+             "J": f"Jerk ({lu}/s³)"}
+    rows = [(names[q], _num(p["max"]), _num(p["min"]), cont[q]) for q, p in d.get("peaks", {}).items()]
+    roc = d.get("radius_of_curvature_mm") or {}
+    if roc:
+        bad = codes & {"UNDERCUT", "CUSP"}
+        rows.append(("Convex radius of curvature (mm)", "--", _num(roc.get("min_convex")),
+                     "undercut or cusp: see findings" if bad else "The profile is free of cusps and undercuts"))
+        if roc.get("min_concave") is not None:
+            rows.append(("Concave radius of curvature (mm)", "--", _num(roc.get("min_concave")),
+                         "smallest concave radius (cutter must be smaller)"))
+    pa = d.get("pressure_angle_deg")
+    if pa:
+        ok = "PRESSURE_ANGLE_EXCEEDED" not in codes
+        rows.append(("Pressure angle (°)", _num(pa["max"]), _num(pa["min"]),
+                     "Acceptable" if ok else f"High pressure angle (> {pa.get('limit', 0):g}°)"))
+    face = d.get("face_length_mm")
+    if face:
+        rows.append(("Face length left / right (mm)", _num(face.get("left")), _num(face.get("right")),
+                     "minimum face length on each side to keep contact"))
+    width = max(len(r[0]) for r in rows) + 2
+    out = [f"{spec.name}: {_VERDICT_TEXT[report.verdict]}", ""]
+    out.append(f"{'Concept':<{width}}{'Maximum':>13}{'Minimum':>13}  Comments")
+    out += [f"{a:<{width}}{b:>13}{c:>13}  {e}" for a, b, c, e in rows]
+    extra = [(k, d.get(k)) for k in ("base_radius_mm", "max_radius_mm", "area_mm2", "initial_arm_angle_deg")]
+    out += [""] + [f"{k}: {v:.6g}" for k, v in extra if v is not None]
+    if report.findings:
+        out += ["", "Findings:"]
+        out += [f"  [{f.severity}] {f.code}: {f.message}" for f in report.findings]
+    return "\n".join(out)
+
+
+def _num(v) -> str:
+    if v is None:
+        return "--"
+    return f"{v:.2f}" if abs(v) < 1e7 else f"{v:.5g}"
 
 
 # ---------------------------------------------------------------------------

@@ -43,7 +43,7 @@ POSTS = ("linuxcnc", "fanuc", "grbl")
 
 _TOP_KEYS = ("name", "description", "cam", "follower", "motion", "motion_table", "manufacturing",
              "outputs", "checks")
-_CAM_KEYS = ("kind", "rotation", "speed_rpm", "omega_rad_s", "speed_mm_s")
+_CAM_KEYS = ("kind", "rotation", "direction", "speed_rpm", "omega_rad_s", "speed_mm_s")
 _FOLLOWER_FLOATS = ("base_radius_mm", "roller_radius_mm", "offset_mm", "pivot_distance_mm",
                     "arm_length_mm", "face_offset_mm", "follower_distance_mm",
                     "second_roller_radius_mm", "follower_angle_deg", "cam_length_mm",
@@ -53,7 +53,7 @@ _SEGMENT_KEYS = ("law", "lift", "angle_deg", "length_mm", "shape")
 _MFG_KEYS = ("thickness_mm", "bore_mm", "keyway", "hub_diameter_mm", "hub_length_mm",
              "tool_diameter_mm", "tolerance_mm", "material")
 _OUTPUT_KEYS = ("dxf", "step", "stl", "gcode", "report", "xlsx", "drawing", "lift_table")
-_CHECK_KEYS = ("pressure_angle_limit_deg",)
+_CHECK_KEYS = ("pressure_angle_limit_deg", "face_margin_mm")
 
 
 @dataclass(frozen=True, slots=True)
@@ -71,6 +71,7 @@ class CamSpec:
     omega_rad_s: float = 1.0
     speed_mm_s: float | None = None
     speed_given: bool = False
+    direction: str = "left"
 
 
 @dataclass(frozen=True, slots=True)
@@ -151,6 +152,7 @@ class DesignSpec:
     description: str = ""
     source: str | None = None
     base_dir: str | None = None
+    face_margin_mm: float = 0.0
 
     @property
     def is_translating_cam(self) -> bool:
@@ -216,9 +218,10 @@ def design_from_dict(data: Mapping[str, Any], *, source: str | None = None,
     checks = _table(v, data, "checks")
     v.keys(checks, _CHECK_KEYS, "checks")
     pa = v.number(checks, "pressure_angle_limit_deg", "checks", None, lo=0.0, hi=90.0, lo_open=True, hi_open=True)
+    margin = v.number(checks, "face_margin_mm", "checks", 0.0, lo=0.0, hi=1e4)
     spec = DesignSpec(name.strip() if isinstance(name, str) else "cam", cam, fol, motion, table, mfg, out,
                       pa, str(data.get("description", "")), source,
-                      str(base_dir) if base_dir is not None else None)
+                      str(base_dir) if base_dir is not None else None, margin)
     if not v.problems:
         try:
             spec.program()
@@ -306,9 +309,13 @@ def _cam(v: _Validator, t: Mapping[str, Any]) -> CamSpec:
               "a translating cam has a linear speed", "use speed_mm_s")
     if kind != "translating" and vmm is not None:
         v.add("cam.speed_mm_s", vmm, "only translating cams have a linear speed", "use speed_rpm or omega_rad_s")
+    direction = v.choice(t, "direction", "cam", ("left", "right"), "left")
+    if "direction" in t and kind != "translating":
+        v.add("cam.direction", t["direction"], "only translating cams slide left or right",
+              "use rotation = \"cw\" | \"ccw\" for rotating cams")
     given = rpm is not None or omega is not None or vmm is not None
     w = omega if omega is not None else (rpm * RPM if rpm is not None else 1.0)
-    return CamSpec(kind, rotation, w, vmm, given)
+    return CamSpec(kind, rotation, w, vmm, given, direction)
 
 
 _REQUIRED = {

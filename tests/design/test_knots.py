@@ -263,7 +263,7 @@ def test_shipped_toml_example_uses_the_consistent_reconstruction():
     from camfab.design.spec import load_design
 
     spec = load_design(EXAMPLES / "valve_exhaust_ej1.toml")
-    assert spec.name == "ValveExhaustEj1" and spec.follower.base_radius_mm == 13.5
+    assert spec.name == "ValveExhaustEj1" and spec.follower.base_radius_mm == 24.0
     t = load_motion_table(spec.motion_table, base_dir=EXAMPLES)
     assert t.source == str(EXAMPLES / "valve_recon_ej1.csv")
     assert t.warnings() == []

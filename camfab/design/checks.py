@@ -1,0 +1,384 @@
+"""Profile verification: coded findings, CAM-DAS conclusions and verdict.
+
+Rules (``spec/profiles.md`` §13, ``spec/camdas-reference.md`` §1.6):
+
+* ``UNDERCUT`` (error) — rollers: the pitch curve is convex with radius
+  0 < ρ_p < R_r (tested on ρ_p, spec D10); flat faces: ρ < 0.
+* ``CUSP`` (error) — the limit case: ρ_p = R_r (roller) or ρ = 0 (flat face)
+  within :data:`CUSP_TOL_MM`, the profile has a sharp point.
+* ``CONCAVE_RADIUS_BELOW_ROLLER`` — a concave stretch whose radius is smaller
+  than the roller or than ``tool_radius_mm`` (whichever is larger).  For a true
+  roller envelope the concave radius is |ρ_p| + R_r > R_r, so the roller part
+  never fires (CAM-DAS's "|ρ| > R_f" rule only re-detects undercuts, D10); with
+  a tool radius it names the stretches a cutter cannot finish (warning) and the
+  largest tool that fits.
+* ``PRESSURE_ANGLE_EXCEEDED`` (error) — |δ| above the limit (30° translating
+  roller and translating cam, 35° oscillating roller; flat faces have none).
+* ``FACE_LENGTH`` (info) — flat faces: the face length needed on each side.
+* ``VELOCITY_/ACCELERATION_/JERK_DISCONTINUITY`` — from the motion program
+  (:func:`camfab.design.motion_report.analyse_motion`).
+
+Verdict: any error → ``unacceptable``; else a jerk (or allowed acceleration)
+jump → ``not_for_high_speed``; else ``acceptable``.  Angles in findings are
+degrees of cam angle (mm of travel for a translating cam); a range that wraps
+through 360° has ``from_deg > to_deg``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from enum import Enum
+from typing import Any, Callable
+
+import numpy as np
+from scipy.optimize import brentq, minimize_scalar
+
+from .motion_report import Finding, MotionReport, analyse_motion, verdict_of
+from .profile import CamGeometry, Contact, OscillatingRollerContact, _default_step, _intervals, extremum
+
+__all__ = ["Code", "Finding", "Report", "check", "positive_ranges", "CUSP_TOL_MM", "DEFAULT_PRESSURE_LIMIT_DEG"]
+
+#: a radius margin within this many mm of its limit is a cusp (not an undercut)
+CUSP_TOL_MM = 1e-7
+#: pressure-angle limits by follower motion (CAM-DAS, after Norton)
+DEFAULT_PRESSURE_LIMIT_DEG = {"translating": 30.0, "oscillating": 35.0}
+_PA_TOL_RAD = 1e-10
+
+
+class Code(str, Enum):
+    """Finding codes (stable strings, used in ``check --json``)."""
+
+    UNDERCUT = "UNDERCUT"
+    CUSP = "CUSP"
+    CONCAVE_RADIUS_BELOW_ROLLER = "CONCAVE_RADIUS_BELOW_ROLLER"
+    PRESSURE_ANGLE_EXCEEDED = "PRESSURE_ANGLE_EXCEEDED"
+    FACE_LENGTH = "FACE_LENGTH"
+    VELOCITY_DISCONTINUITY = "VELOCITY_DISCONTINUITY"
+    ACCELERATION_DISCONTINUITY = "ACCELERATION_DISCONTINUITY"
+    JERK_DISCONTINUITY = "JERK_DISCONTINUITY"
+
+
+@dataclass(frozen=True)
+class Report:
+    """Result of :func:`check`: findings, verdict and the CAM-DAS conclusions.
+
+    ``summary`` holds the geometry keys of ``check --json`` (design.md §6):
+    ``pressure_angle_deg``, ``radius_of_curvature_mm``, ``face_length_mm``,
+    ``base_radius_mm``, ``max_radius_mm``, ``area_mm2`` (None where they do not
+    apply) plus ``initial_arm_angle_deg``.
+    """
+
+    name: str
+    findings: tuple[Finding, ...]
+    summary: dict[str, Any]
+    motion: MotionReport | None = None
+    x_unit: str = "deg"
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def verdict(self) -> str:
+        return verdict_of(list(self.findings))
+
+    def codes(self) -> set[str]:
+        return {f.code for f in self.findings}
+
+    def by_code(self, code: str | Code) -> list[Finding]:
+        code = code.value if isinstance(code, Code) else code
+        return [f for f in self.findings if f.code == code]
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``check --json`` object (JSON-ready: floats, str, None, lists, dicts)."""
+        out: dict[str, Any] = {"name": self.name, "verdict": self.verdict}
+        if self.motion is not None:
+            m = self.motion.to_dict()
+            out["peaks"], out["junctions"] = m["peaks"], m["junctions"]
+        out.update(_plain(self.summary))
+        out["x_unit"] = self.x_unit
+        out["findings"] = [_plain(f.to_dict()) for f in self.findings]
+        return out
+
+
+def _plain(obj):
+    if isinstance(obj, dict):
+        return {k: _plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, (np.floating, np.integer)):
+        return obj.item()
+    return obj
+
+
+# ---------------------------------------------------------------------------
+def check(geometry: CamGeometry, *, pressure_angle_limit_deg: float | None = None,
+          allow_acceleration_jump: bool = False, tool_radius_mm: float | None = None,
+          face_margin_mm: float = 0.0, name: str = "cam", speed: float = 1.0) -> Report:
+    """Verify a cam geometry.
+
+    Parameters
+    ----------
+    geometry : CamGeometry
+    pressure_angle_limit_deg : float, optional
+        Limit on |δ| in degrees; default 30 (translating roller, translating
+        cam) or 35 (oscillating roller).
+    allow_acceleration_jump : bool
+        Accept acceleration jumps (constant-width / constant-diameter cams).
+    tool_radius_mm : float, optional
+        Cutter radius: concave stretches tighter than it are reported.
+    face_margin_mm : float
+        Safety margin added to each required flat-face length (mm).
+    name : str
+        Cam name for the report.
+    speed : float
+        ω in rad/s (mm/s for a translating cam), for the motion peaks.
+
+    Returns
+    -------
+    Report
+    """
+    findings: list[Finding] = []
+    motion_report = None
+    seen: list[Any] = []
+    for c in geometry.profiles:
+        if any(c.motion is m for m in seen) or not hasattr(c.motion, "junctions"):
+            continue
+        seen.append(c.motion)
+        lift_unit = "deg" if getattr(c, "xi0", None) is not None else "mm"
+        rep = analyse_motion(c.motion, name=name, speed=speed, lift_unit=lift_unit,
+                             allow_acceleration_jump=allow_acceleration_jump)
+        motion_report = motion_report or rep
+        findings += rep.findings
+    summary = _empty_summary()
+    to_user = geometry.to_user
+    for k, c in enumerate(geometry.profiles):
+        tag = f"profile {k + 1}: " if len(geometry.profiles) > 1 else ""
+        findings += _curvature(c, tag, to_user, tool_radius_mm, summary)
+        if c.kind == "roller":
+            lim = pressure_angle_limit_deg
+            if lim is None:
+                lim = DEFAULT_PRESSURE_LIMIT_DEG["oscillating" if isinstance(c, OscillatingRollerContact)
+                                                 else "translating"]
+            findings += _pressure(c, tag, to_user, lim, summary)
+        else:
+            findings += _face(c, tag, to_user, face_margin_mm, summary)
+    if geometry.closed:
+        ext = geometry.radius_extremes()
+        summary["base_radius_mm"] = ext.min
+        summary["max_radius_mm"] = max(geometry.radius_extremes(k).max for k in range(len(geometry.profiles)))
+    summary["area_mm2"] = geometry.area()
+    summary["initial_arm_angle_deg"] = geometry.initial_arm_angle_deg
+    return Report(name, tuple(findings), summary, motion_report, geometry.x_unit)
+
+
+def _empty_summary() -> dict[str, Any]:
+    return {"pressure_angle_deg": None, "radius_of_curvature_mm": None, "face_length_mm": None,
+            "base_radius_mm": None, "max_radius_mm": None, "area_mm2": None}
+
+
+def _where(to_user, x) -> float:
+    return float(to_user(x))
+
+
+def _span(to_user, lo, hi, unit) -> str:
+    a, b = _where(to_user, lo), _where(to_user, hi)
+    return f"at {a:.6g}{unit}" if abs(b - a) < 1e-9 else f"from {a:.6g}{unit} to {b:.6g}{unit}"
+
+
+def _curvature(c: Contact, tag, to_user, tool, summary) -> list[Finding]:
+    out: list[Finding] = []
+    edges, closed = c.breakpoints, c.closed
+    unit = "°" if closed else " mm"
+    if c.kind == "roller":
+        rr = c.roller_radius
+        kp = lambda x: c.evaluate(x).curvature_pitch  # noqa: E731
+        xa, kmax = extremum(kp, edges, maximize=True)
+        xb, kmin = extremum(kp, edges)
+        roc = {"min_convex": (1.0 / kmax - rr) if kmax > 0 else None,
+               "min_concave": (1.0 / -kmin + rr) if kmin < 0 else None,
+               "at_deg": _where(to_user, xa) if kmax > 0 else None,
+               "at_min_concave_deg": _where(to_user, xb) if kmin < 0 else None,
+               "pitch_min_convex": 1.0 / kmax if kmax > 0 else None, "max": None}
+        _merge_roc(summary, roc)
+        if rr > 0 and kmax > 0:
+            dev = rr - 1.0 / kmax  # > 0: undercut
+            if dev > CUSP_TOL_MM:
+                for lo, hi, xw, gw in positive_ranges(lambda x: rr * kp(x) - 1.0, edges, closed=closed):
+                    rp = rr / (1.0 + gw)
+                    out.append(Finding(Code.UNDERCUT.value, "error", _where(to_user, lo), _where(to_user, hi), rp, rr,
+                                       f"{tag}undercut {_span(to_user, lo, hi, unit)}: the pitch curve is convex with "
+                                       f"radius down to {rp:.6g} mm (at {_where(to_user, xw):.6g}{unit}), smaller than "
+                                       f"the roller ({rr:.6g} mm); the roller cannot follow the law there. Enlarge the "
+                                       "base circle or use a smaller roller"))
+            elif dev >= -CUSP_TOL_MM:
+                out.append(_cusp(tag, to_user, xa, 1.0 / kmax, rr, unit, "the pitch-curve radius equals the roller radius"))
+        lim = max(rr, tool or 0.0)
+        if lim > 0 and kmin < 0 and 1.0 / -kmin + rr < lim:
+            def g(x):
+                s = c.evaluate(x)
+                return np.where(s.curvature_pitch < 0, -lim * s.curvature - 1.0, -1.0)
+            fits = 1.0 / -kmin + rr
+            for lo, hi, xw, gw in positive_ranges(g, edges, closed=closed):
+                out.append(Finding(Code.CONCAVE_RADIUS_BELOW_ROLLER.value, "warning", _where(to_user, lo),
+                                   _where(to_user, hi), lim / (1.0 + gw), lim,
+                                   f"{tag}concave stretch {_span(to_user, lo, hi, unit)} with radius down to "
+                                   f"{fits:.6g} mm, tighter than the {lim:.6g} mm cutter; the largest tool radius "
+                                   f"that fits is {fits:.6g} mm"))
+        return out
+    rho = lambda x: c.evaluate(x).rho  # noqa: E731
+    xa, rmin = extremum(rho, edges)
+    xb, rmax = extremum(rho, edges, maximize=True)
+    _merge_roc(summary, {"min_convex": rmin, "min_concave": None, "at_deg": _where(to_user, xa),
+                         "at_min_concave_deg": None, "pitch_min_convex": None, "max": rmax})
+    if rmin < -CUSP_TOL_MM:
+        for lo, hi, xw, gw in positive_ranges(lambda x: -rho(x), edges, closed=closed):
+            out.append(Finding(Code.UNDERCUT.value, "error", _where(to_user, lo), _where(to_user, hi), -gw, 0.0,
+                               f"{tag}undercut {_span(to_user, lo, hi, unit)}: the radius of curvature is negative "
+                               f"(down to {-gw:.6g} mm at {_where(to_user, xw):.6g}{unit}); the profile crosses itself "
+                               "between two cusps and the face cannot follow the law. Enlarge the base circle"))
+    elif rmin <= CUSP_TOL_MM:
+        out.append(_cusp(tag, to_user, xa, rmin, 0.0, unit, "the radius of curvature reaches 0"))
+    return out
+
+
+def _merge_roc(summary, roc):
+    cur = summary["radius_of_curvature_mm"]
+    if cur is None:
+        summary["radius_of_curvature_mm"] = roc
+        return
+    for key, at in (("min_convex", "at_deg"), ("min_concave", "at_min_concave_deg"), ("pitch_min_convex", None)):
+        if roc[key] is not None and (cur[key] is None or roc[key] < cur[key]):
+            cur[key] = roc[key]
+            if at:
+                cur[at] = roc[at]
+    if roc["max"] is not None and (cur["max"] is None or roc["max"] > cur["max"]):
+        cur["max"] = roc["max"]
+
+
+def _cusp(tag, to_user, x, value, limit, unit, why) -> Finding:
+    a = _where(to_user, x)
+    return Finding(Code.CUSP.value, "error", a, a, value, limit,
+                   f"{tag}cusp at {a:.6g}{unit}: {why}, so the profile has a sharp point with very high contact "
+                   "stress. Enlarge the base circle (or use a smaller roller)")
+
+
+def _pressure(c: Contact, tag, to_user, lim_deg, summary) -> list[Finding]:
+    edges, unit = c.breakpoints, ("°" if c.closed else " mm")
+    pa = lambda x: c.evaluate(x).pressure_angle  # noqa: E731
+    xa, dmax = extremum(pa, edges, maximize=True)
+    xb, dmin = extremum(pa, edges)
+    cur = summary["pressure_angle_deg"]
+    new = {"max": math.degrees(dmax), "min": math.degrees(dmin), "at_max_deg": _where(to_user, xa),
+           "at_min_deg": _where(to_user, xb), "limit": lim_deg}
+    if cur is None:
+        summary["pressure_angle_deg"] = new
+    else:
+        if new["max"] > cur["max"]:
+            cur["max"], cur["at_max_deg"] = new["max"], new["at_max_deg"]
+        if new["min"] < cur["min"]:
+            cur["min"], cur["at_min_deg"] = new["min"], new["at_min_deg"]
+    lim = math.radians(lim_deg)
+    out = []
+    for sign, worst in ((1.0, dmax), (-1.0, dmin)):
+        if sign * worst - lim <= _PA_TOL_RAD:
+            continue
+        for lo, hi, xw, gw in positive_ranges(lambda x: sign * pa(x) - lim, edges, closed=c.closed):
+            val = sign * math.degrees(gw + lim)
+            out.append(Finding(Code.PRESSURE_ANGLE_EXCEEDED.value, "error", _where(to_user, lo), _where(to_user, hi),
+                               val, sign * lim_deg,
+                               f"{tag}pressure angle {val:.4g}° (at {_where(to_user, xw):.6g}{unit}) exceeds "
+                               f"±{lim_deg:.4g}° {_span(to_user, lo, hi, unit)}: high side load, risk of jamming. "
+                               "Enlarge the base circle, change the offset or the law, or use a larger roller"))
+    return out
+
+
+def _face(c: Contact, tag, to_user, margin, summary) -> list[Finding]:
+    edges = c.breakpoints
+    pos = lambda x: c.evaluate(x).face_position  # noqa: E731
+    xa, pmin = extremum(pos, edges)
+    xb, pmax = extremum(pos, edges, maximize=True)
+    out = []
+    a, b = _where(to_user, xa), _where(to_user, xb)
+    if getattr(c, "xi0", None) is None:  # translating face: either side of the stem
+        left, right = max(-pmin, 0.0) + margin, max(pmax, 0.0) + margin
+        fl = {"left": left, "right": right, "min": pmin, "max": pmax}
+        out.append(Finding(Code.FACE_LENGTH.value, "info", a, a, left, None,
+                           f"{tag}the face must reach {left:.6g} mm to the left of the stem axis (contact furthest "
+                           f"left at {a:.6g}°; margin {margin:g} mm included)"))
+        out.append(Finding(Code.FACE_LENGTH.value, "info", b, b, right, None,
+                           f"{tag}the face must reach {right:.6g} mm to the right of the stem axis (contact furthest "
+                           f"right at {b:.6g}°; margin {margin:g} mm included)"))
+    else:
+        fl = {"left": None, "right": None, "min": pmin, "max": pmax}
+        out.append(Finding(Code.FACE_LENGTH.value, "info", b, b, pmax + margin, None,
+                           f"{tag}the face must be at least {pmax + margin:.6g} mm long from the vertex (contact "
+                           f"between {pmin:.6g} mm at {a:.6g}° and {pmax:.6g} mm at {b:.6g}°; margin {margin:g} mm "
+                           "included)" + ("; the contact passes behind the vertex" if pmin < 0 else "")))
+    cur = summary["face_length_mm"]
+    if cur is None:
+        summary["face_length_mm"] = fl
+    else:
+        for k in fl:
+            if fl[k] is not None:
+                cur[k] = fl[k] if cur[k] is None else (min(cur[k], fl[k]) if k == "min" else max(cur[k], fl[k]))
+    return out
+
+
+# ---------------------------------------------------------------------------
+def positive_ranges(g: Callable[[np.ndarray], np.ndarray], edges, *, closed: bool = True,
+                    step: float | None = None) -> list[tuple[float, float, float, float]]:
+    """Ranges where ``g > 0``, ends located by root refinement.
+
+    Returns ``[(x_from, x_to, x_worst, g_worst), ...]``; ranges that meet at a
+    breakpoint are merged, and for ``closed`` curves a range crossing the
+    period end wraps (then ``x_from > x_to``).
+    """
+    edges = np.asarray(edges, dtype=float)
+    per0, per1 = edges[0], edges[-1]
+    step = step or _default_step(per1 - per0)
+    raw: list[list[float]] = []
+    for a, b, xs in _intervals(edges, step):
+        # add refined local maxima so that narrow bumps between samples are seen
+        v = g(xs)
+        i = int(np.nanargmax(v))
+        lo, hi = xs[max(i - 1, 0)], xs[min(i + 1, len(xs) - 1)]
+        r = minimize_scalar(lambda t: -float(g(np.array([t]))[0]), bounds=(lo, hi), method="bounded",
+                            options={"xatol": 1e-13 * max(1.0, abs(hi))})
+        if -r.fun > v[i] and lo < r.x < hi:
+            xs = np.sort(np.append(xs, r.x))
+            v = g(xs)
+        pos = v > 0
+        if not pos.any():
+            continue
+        start = a if pos[0] else None
+        for j in range(len(xs) - 1):
+            if pos[j] == pos[j + 1]:
+                continue
+            root = brentq(lambda t: float(g(np.array([t]))[0]), xs[j], xs[j + 1], xtol=1e-14, rtol=1e-15)
+            if pos[j + 1]:
+                start = root
+            else:
+                raw.append([start, root])
+                start = None
+        if start is not None:
+            raw.append([start, b])
+    merged: list[list[float]] = []
+    tol = 1e-9 * max(per1 - per0, 1.0)
+    for r in raw:
+        if merged and abs(r[0] - merged[-1][1]) < tol:
+            merged[-1][1] = r[1]
+        else:
+            merged.append(r)
+    if closed and len(merged) > 1 and merged[0][0] - per0 < tol and per1 - merged[-1][1] < tol:
+        last = merged.pop()
+        merged[0][0] = last[0]
+    out = []
+    for lo, hi in merged:
+        lo = per0 if lo - per0 < tol else lo
+        hi = per1 if per1 - hi < tol else hi
+        parts = [(lo, hi)] if lo <= hi else [(lo, per1), (per0, hi)]
+        sub = np.unique(np.concatenate([np.asarray(edges)[(edges > a) & (edges < b)] for a, b in parts]
+                                       + [np.array([a, b]) for a, b in parts]))
+        xw, gw = extremum(g, sub, maximize=True, step=step) if len(parts) == 1 else \
+            max((extremum(g, np.unique(np.r_[a, edges[(edges > a) & (edges < b)], b]), maximize=True, step=step)
+                 for a, b in parts), key=lambda t: t[1])
+        out.append((float(lo), float(hi), float(xw), float(gw)))
+    return out

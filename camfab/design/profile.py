@@ -1,0 +1,595 @@
+"""Exact cam profiles of single-follower cams (``spec/profiles.md`` §3–§6, §13.5).
+
+Everything is a closed-form function of the cam angle φ (radians) — or of the
+travel B (mm) for a translating cam — built from S, S′, S″ of the motion
+program; nothing is a fixed table and nothing is finite-differenced.
+
+Derivation (one scheme for every mechanism)
+-------------------------------------------
+The follower is described in the **fixed frame** (cam centre at the origin,
+follower above it, see :mod:`camfab.design.mechanisms`).  A cam turning by φ
+with sense σ (+1 cw, −1 ccw) maps a fixed-frame point q to the cam-frame point
+``R(σφ)·q``.  With J the +90° rotation, derivatives along the cam-frame curve
+are, expressed in fixed-frame components (then rotated by R(σφ))::
+
+    T  = σ·J·C + C′                     (tangent, per radian)
+    C̈  = −C + 2σ·J·C′ + C″              (second derivative)
+
+so with C the roller centre the pitch curve is exact, its signed curvature is
+``κ_p = σ·(T × C̈)/|T|³`` and the outward unit normal is ``n = −σ·J·T/|T|``.
+The profile is the parallel curve ``P = C − R_r·n`` with ``ρ = ρ_p − R_r``.
+A flat face with unit normal angle β(φ) and distance p(φ) from the cam centre
+envelopes the profile ``P = p·n + s·J·n`` with ``s = p′/(σ + β′)`` and
+``ρ = p + p″/(σ+β′)² − p′β″/(σ+β′)³`` (translating face: ρ = R_b + S + S″).
+
+Sign conventions
+----------------
+* Radius of curvature ρ (and curvature κ = 1/ρ): **positive = convex** (the
+  profile bulges towards the follower), negative = concave.  For rollers a
+  convex pitch radius 0 < ρ_p < R_r is an undercut, ρ_p = R_r a cusp (ρ = 0).
+* Outward unit normal; unit tangent ``t = σ·J·n`` points the way the contact
+  point travels for increasing φ on a regular stretch.
+* Pressure angle δ (radians, signed): the angle from the follower point's
+  rise-direction velocity to the contact normal (the line of force), positive
+  when the normal leans the way the cam surface moves past the follower.  It is
+  positive while rising on a centred translating follower:
+  ``tan δ = (S′ + σ·e)/(S + √(R_p² − e²))``.  Hence **a positive (right)
+  offset raises the rise pressure angle of a cw cam** (and lowers the return
+  magnitude); for a ccw cam it lowers it.  CAM-DAS's manual claims the
+  opposite for "+ = right" (spec D6); its own formulas put +m on the left.
+* Flat-face contact position: translating face — signed distance along the
+  face from the stem axis, positive to the right (a cw cam touches the left
+  side, −S′, while rising); oscillating face — distance along the face from
+  the right-angle vertex (the pivot's foot when f = 0), ``m·cos ξ + s``.
+* Oscillating arm angle ξ (radians): angle at the pivot between pivot→cam
+  centre and the arm; ξ = ξ₀ + lift, increasing = clockwise.
+
+A :class:`CamGeometry` holds one or more :class:`Contact` profiles (conjugate
+cams have two) and evaluates any of them at any φ.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable, Protocol, Sequence
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from ..errors import SpecError
+from .mechanisms import (Mechanism, OscillatingFlat, OscillatingRoller, TranslatingCamRoller,
+                         TranslatingFlat, TranslatingRoller)
+
+__all__ = [
+    "MotionLike",
+    "ProfileSample",
+    "Extremes",
+    "Contact",
+    "DiscRollerContact",
+    "TranslatingRollerContact",
+    "OscillatingRollerContact",
+    "DiscFlatContact",
+    "TranslatingFlatContact",
+    "OscillatingFlatContact",
+    "TranslatingCamContact",
+    "CamGeometry",
+    "extremum",
+    "integrate",
+]
+
+_K = math.pi / 180.0  # oscillating lifts are in degrees
+
+
+class MotionLike(Protocol):
+    """What a contact needs from a motion: S and derivatives, breakpoints, period."""
+
+    period: float
+
+    @property
+    def breakpoints(self) -> np.ndarray: ...
+
+    def evaluate(self, x, orders: Sequence[int] = (0, 1, 2, 3)) -> np.ndarray: ...
+
+
+@dataclass(frozen=True)
+class ProfileSample:
+    """One profile evaluated at n parameter values (all arrays, cam frame).
+
+    Attributes
+    ----------
+    phi : (n,) float
+        Cam angle in radians (travel in mm for a translating cam).
+    point : (n, 2) float
+        Profile contact point (mm).
+    point_d1 : (n, 2) float
+        d point / d phi (mm per radian, or mm/mm).
+    normal, tangent : (n, 2) float
+        Unit outward normal and unit tangent ``σ·J·normal``.
+    curvature, rho : (n,) float
+        Signed profile curvature (1/mm) and radius ρ = 1/κ (mm, ±inf at an
+        inflection); positive = convex.
+    pitch : (n, 2) float or None
+        Pitch curve (roller centre); None for flat faces.
+    curvature_pitch, rho_pitch : (n,) float or None
+        The same for the pitch curve (rollers only).
+    pressure_angle : (n,) float
+        Signed pressure angle in radians (0 for a translating flat face).
+    face_position : (n,) float or None
+        Flat faces: contact position along the face (mm), see module notes.
+    arm_angle : (n,) float or None
+        Oscillating followers: arm angle ξ (radians).
+    """
+
+    phi: np.ndarray
+    point: np.ndarray
+    point_d1: np.ndarray
+    normal: np.ndarray
+    tangent: np.ndarray
+    curvature: np.ndarray
+    rho: np.ndarray
+    pitch: np.ndarray | None = None
+    curvature_pitch: np.ndarray | None = None
+    rho_pitch: np.ndarray | None = None
+    pressure_angle: np.ndarray | None = None
+    face_position: np.ndarray | None = None
+    arm_angle: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class Extremes:
+    """Minimum and maximum of a quantity and where they occur (parameter units)."""
+
+    min: float
+    at_min: float
+    max: float
+    at_max: float
+
+
+# ---------------------------------------------------------------------------
+# small vector helpers on (n, 2) arrays
+def _J(v: np.ndarray) -> np.ndarray:
+    return np.stack([-v[:, 1], v[:, 0]], axis=1)
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1]
+
+
+def _rot(v: np.ndarray, c: np.ndarray, s: np.ndarray) -> np.ndarray:
+    return np.stack([v[:, 0] * c - v[:, 1] * s, v[:, 0] * s + v[:, 1] * c], axis=1)
+
+
+def _xy(x, y) -> np.ndarray:
+    x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
+    return np.stack([x, y], axis=1)
+
+
+def _pressure(v: np.ndarray, n: np.ndarray, sigma: int) -> np.ndarray:
+    """Signed angle from the follower's rise velocity ``v`` to the normal ``n``."""
+    return np.arctan2(-sigma * _cross(v, n), _dot(v, n))
+
+
+# ---------------------------------------------------------------------------
+class Contact:
+    """One profile of a cam: the envelope of one follower.  Subclasses fill in
+    :meth:`evaluate`.
+
+    Attributes
+    ----------
+    motion : MotionLike
+    sense : int
+        σ = +1 (cw) or −1 (ccw); for a translating cam +1 = slides right.
+    kind : {"roller", "flat"}
+    roller_radius : float
+        R_r in mm (0 for flat faces and knife edges).
+    closed : bool
+        True for disc cams (periodic closed curve), False for a translating cam.
+    """
+
+    kind = "roller"
+    closed = True
+    roller_radius = 0.0
+
+    def __init__(self, motion: MotionLike, sense: int = 1):
+        if sense not in (1, -1):
+            raise ValueError("sense must be +1 (cw) or -1 (ccw)")
+        self.motion = motion
+        self.sense = sense
+
+    @property
+    def period(self) -> float:
+        return float(self.motion.period)
+
+    @property
+    def breakpoints(self) -> np.ndarray:
+        """Parameter values where a formula changes, 0 and the period included."""
+        return np.asarray(self.motion.breakpoints, dtype=float)
+
+    def evaluate(self, phi) -> ProfileSample:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def _S(self, phi) -> tuple[np.ndarray, np.ndarray]:
+        x = np.atleast_1d(np.asarray(phi, dtype=float))
+        return x, self.motion.evaluate(x, (0, 1, 2))
+
+    def radius(self, phi) -> tuple[np.ndarray, np.ndarray]:
+        """Distance of the profile from the cam centre (mm; height above the bottom
+        edge for a translating cam) and its derivative per unit parameter."""
+        s = self.evaluate(phi)
+        if not self.closed:
+            return s.point[:, 1], s.point_d1[:, 1]
+        r = np.hypot(s.point[:, 0], s.point[:, 1])
+        return r, _dot(s.point, s.point_d1) / r
+
+
+class DiscRollerContact(Contact):
+    """Generic roller on a rotating cam.  Subclasses give the fixed-frame roller
+    centre path ``C, C′, C″`` (each (n, 2)), the unit rise velocity of the roller
+    centre (n, 2) and the arm angle (or None) from ``S, S′, S″``."""
+
+    def __init__(self, motion: MotionLike, roller_radius: float, sense: int = 1):
+        super().__init__(motion, sense)
+        self.roller_radius = float(roller_radius)
+
+    def _path(self, S: np.ndarray):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def evaluate(self, phi) -> ProfileSample:
+        x, S = self._S(phi)
+        C, C1, C2, v, arm = self._path(S)
+        sg = self.sense
+        T = sg * _J(C) + C1
+        A2 = -C + 2 * sg * _J(C1) + C2
+        out = _roller(C, T, A2, v, self.roller_radius, sg)
+        c, s = np.cos(sg * x), np.sin(sg * x)
+        pitch, point, dpoint, n, t, kp, k, delta = out
+        return ProfileSample(x, _rot(point, c, s), _rot(dpoint, c, s), _rot(n, c, s), _rot(t, c, s),
+                             k, _inv(k), _rot(pitch, c, s), kp, _inv(kp), delta, None, arm)
+
+
+def _inv(k: np.ndarray) -> np.ndarray:
+    with np.errstate(divide="ignore"):
+        return 1.0 / k
+
+
+def _roller(C, T, A2, v, rr, sg):
+    """Pitch/profile quantities from the cam-frame tangent T and second derivative A2."""
+    speed = np.hypot(T[:, 0], T[:, 1])
+    t = T / speed[:, None]
+    kp = sg * _cross(T, A2) / speed**3
+    n = -sg * _J(t)
+    point = C - rr * n
+    scale = 1.0 - rr * kp
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k = kp / scale
+    return C, point, T * scale[:, None], n, t, kp, k, _pressure(v, n, sg)
+
+
+class TranslatingRollerContact(DiscRollerContact):
+    """Translating roller with offset e: C = (e, √(R_p² − e²) + S) in the fixed frame."""
+
+    def __init__(self, motion: MotionLike, prime_radius: float, roller_radius: float,
+                 offset: float = 0.0, sense: int = 1):
+        super().__init__(motion, roller_radius, sense)
+        self.offset = float(offset)
+        self.axial_base = math.sqrt(prime_radius**2 - offset**2)
+
+    def _path(self, S):
+        s0, s1, s2 = S
+        z = np.zeros_like(s0)
+        return (_xy(self.offset + z, self.axial_base + s0), _xy(z, s1), _xy(z, s2), _xy(z, 1.0 + z), None)
+
+
+class OscillatingRollerContact(DiscRollerContact):
+    """Oscillating roller: pivot (m, 0), C = (m − A cos ξ, A sin ξ), ξ = ξ₀ + S (S in degrees)."""
+
+    def __init__(self, motion: MotionLike, pivot_distance: float, arm_length: float,
+                 initial_arm_angle: float, roller_radius: float, sense: int = 1):
+        super().__init__(motion, roller_radius, sense)
+        self.m, self.a, self.xi0 = float(pivot_distance), float(arm_length), float(initial_arm_angle)
+
+    def _path(self, S):
+        xi, x1, x2 = self.xi0 + _K * S[0], _K * S[1], _K * S[2]
+        sx, cx, a = np.sin(xi), np.cos(xi), self.a
+        C = _xy(self.m - a * cx, a * sx)
+        C1 = _xy(a * x1 * sx, a * x1 * cx)
+        C2 = _xy(a * (x2 * sx + x1**2 * cx), a * (x2 * cx - x1**2 * sx))
+        return C, C1, C2, _xy(sx, cx), xi
+
+
+class DiscFlatContact(Contact):
+    """Generic flat face on a rotating cam.  Subclasses give, from S, S′, S″, the
+    fixed-frame face normal angle β, β′, β″, its distance p, p′, p″ from the cam
+    centre, and implement :meth:`_extras` (follower velocity direction, face
+    position, arm angle)."""
+
+    kind = "flat"
+
+    def _face(self, S):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def _extras(self, P, s, S):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def evaluate(self, phi) -> ProfileSample:
+        x, S = self._S(phi)
+        beta, b1, b2, p, p1, p2 = self._face(S)
+        sg = self.sense
+        w = sg + b1
+        s = p1 / w
+        rho = p + p2 / w**2 - p1 * b2 / w**3
+        n = _xy(np.cos(beta), np.sin(beta))
+        jn = _J(n)
+        P = p[:, None] * n + s[:, None] * jn
+        v, pos, arm = self._extras(P, s, S)
+        delta = _pressure(v, n, sg)
+        c, sn = np.cos(sg * x), np.sin(sg * x)
+        return ProfileSample(x, _rot(P, c, sn), _rot(jn * (w * rho)[:, None], c, sn), _rot(n, c, sn),
+                             _rot(sg * jn, c, sn), _inv(rho), rho, None, None, None, delta, pos, arm)
+
+
+class TranslatingFlatContact(DiscFlatContact):
+    """Translating flat face at distance R_b + S; ρ = R_b + S + S″."""
+
+    def __init__(self, motion: MotionLike, base_radius: float, face_offset: float = 0.0, sense: int = 1):
+        super().__init__(motion, sense)
+        self.rb, self.face_offset = float(base_radius), float(face_offset)
+
+    def _face(self, S):
+        z = np.zeros_like(S[0])
+        return z + math.pi / 2, z, z, self.rb + S[0], S[1], S[2]
+
+    def _extras(self, P, s, S):
+        z = np.zeros_like(s)
+        return _xy(z, 1.0 + z), P[:, 0] - self.face_offset, None
+
+
+class OscillatingFlatContact(DiscFlatContact):
+    """Oscillating flat face: normal (sin ξ, cos ξ), distance f + m sin ξ (spec §6)."""
+
+    def __init__(self, motion: MotionLike, pivot_distance: float, face_offset: float,
+                 initial_arm_angle: float, sense: int = 1):
+        super().__init__(motion, sense)
+        self.m, self.f, self.xi0 = float(pivot_distance), float(face_offset), float(initial_arm_angle)
+
+    def _xi(self, S):
+        return self.xi0 + _K * S[0], _K * S[1], _K * S[2]
+
+    def _face(self, S):
+        xi, x1, x2 = self._xi(S)
+        sx, cx, m = np.sin(xi), np.cos(xi), self.m
+        return (math.pi / 2 - xi, -x1, -x2, self.f + m * sx, m * cx * x1, m * (cx * x2 - sx * x1**2))
+
+    def _extras(self, P, s, S):
+        xi = self._xi(S)[0]
+        r = P - np.array([self.m, 0.0])
+        v = -_J(r) / np.hypot(r[:, 0], r[:, 1])[:, None]  # clockwise about the pivot
+        return v, s + self.m * np.cos(xi), xi
+
+
+class TranslatingCamContact(Contact):
+    """Roller on a translating (wedge) cam: pitch (x₀ ± B, h + R_r + S) (spec §13.5)."""
+
+    closed = False
+
+    def __init__(self, motion: MotionLike, roller_radius: float, base_height: float = 0.0,
+                 direction: str = "left"):
+        super().__init__(motion, 1 if direction == "right" else -1)
+        self.roller_radius, self.base_height = float(roller_radius), float(base_height)
+
+    def evaluate(self, phi) -> ProfileSample:
+        x, (s0, s1, s2) = self._S(phi)
+        chi = -self.sense  # +1: x = B (cam slides left)
+        x0 = 0.0 if chi > 0 else self.period
+        z = np.zeros_like(s0)
+        C = _xy(x0 + chi * x, self.base_height + self.roller_radius + s0)
+        out = _roller(C, _xy(chi + z, s1), _xy(z, s2), _xy(z, 1.0 + z), self.roller_radius, self.sense)
+        pitch, point, dpoint, n, t, kp, k, delta = out
+        return ProfileSample(x, point, dpoint, n, t, k, _inv(k), pitch, kp, _inv(kp), delta, None, None)
+
+
+# ---------------------------------------------------------------------------
+# numerics shared with checks and sizing
+def _intervals(edges: np.ndarray, step: float):
+    """Sample grids per breakpoint interval, ends pulled in by a hair (one-sided limits)."""
+    per = edges[-1] - edges[0]
+    eps = 1e-11 * max(per, 1.0)
+    out = []
+    for a, b in zip(edges[:-1], edges[1:]):
+        if b - a <= 4 * eps:
+            continue
+        n = max(8, int(math.ceil((b - a) / step)))
+        out.append((a + eps, b - eps, np.linspace(a + eps, b - eps, n + 1)))
+    return out
+
+
+def _default_step(period: float) -> float:
+    return period / 1440.0
+
+
+def extremum(f: Callable[[np.ndarray], np.ndarray], edges, *, maximize: bool = False,
+             step: float | None = None, keep: int = 4) -> tuple[float, float]:
+    """Global extremum of a vectorised ``f`` between breakpoints ``edges``.
+
+    Dense sampling per interval, then bounded Brent refinement of the best
+    ``keep`` local candidates.  Returns ``(x, value)``.
+    """
+    edges = np.asarray(edges, dtype=float)
+    step = step or _default_step(edges[-1] - edges[0])
+    sgn = -1.0 if maximize else 1.0
+    cands = []
+    for a, b, xs in _intervals(edges, step):
+        v = sgn * f(xs)
+        v = np.where(np.isnan(v), np.inf, v)
+        loc = np.flatnonzero(np.r_[True, v[1:] <= v[:-1]] & np.r_[v[:-1] <= v[1:], True])
+        cands += [(v[i], a, b, xs, int(i)) for i in loc]
+    cands.sort(key=lambda c: c[0])
+    best = (math.inf, 0.0)
+    for v0, a, b, xs, i in cands[:keep]:
+        lo, hi = xs[max(i - 1, 0)], xs[min(i + 1, len(xs) - 1)]
+        if v0 < best[0]:
+            best = (v0, xs[i])
+        if hi > lo:
+            r = minimize_scalar(lambda t: float(sgn * f(np.array([t]))[0]), bounds=(lo, hi), method="bounded",
+                                options={"xatol": 1e-13 * max(1.0, abs(hi))})
+            if np.isfinite(r.fun) and r.fun < best[0]:
+                best = (float(r.fun), float(r.x))
+    return float(best[1]), float(sgn * best[0])
+
+
+def integrate(f: Callable[[np.ndarray], np.ndarray], edges, *, rtol: float = 1e-11) -> float:
+    """∫ f between breakpoints by adaptive 20-point Gauss–Legendre (vectorised per pass)."""
+    xg, wg = np.polynomial.legendre.leggauss(20)
+    edges = np.asarray(edges, dtype=float)
+    todo = np.stack([edges[:-1], edges[1:]], axis=1)
+    todo = todo[todo[:, 1] > todo[:, 0]]
+
+    def quad(iv):
+        mid, half = (iv[:, 0] + iv[:, 1]) / 2, (iv[:, 1] - iv[:, 0]) / 2
+        pts = mid[:, None] + half[:, None] * xg[None, :]
+        return half * (f(pts.ravel()).reshape(pts.shape) @ wg)
+
+    whole = quad(todo)
+    total, scale = 0.0, max(abs(whole.sum()), 1e-300)
+    span = edges[-1] - edges[0]
+    for _ in range(40):
+        if len(todo) == 0:
+            break
+        mid = (todo[:, 0] + todo[:, 1]) / 2
+        left, right = np.stack([todo[:, 0], mid], 1), np.stack([mid, todo[:, 1]], 1)
+        ql, qr = quad(left), quad(right)
+        ok = np.abs(ql + qr - whole) <= rtol * scale * (todo[:, 1] - todo[:, 0]) / span + 1e-300
+        total += float((ql + qr)[ok].sum())
+        todo = np.concatenate([left[~ok], right[~ok]])
+        whole = np.concatenate([ql[~ok], qr[~ok]])
+    return total + float(whole.sum())
+
+
+# ---------------------------------------------------------------------------
+class CamGeometry:
+    """Exact geometry of a cam: one or more :class:`Contact` profiles.
+
+    Parameters
+    ----------
+    mechanism : Mechanism
+        One of :mod:`camfab.design.mechanisms`.
+    program : MotionProgram (or MotionLike)
+        S in mm (translating followers) or degrees (oscillating), per radian;
+        per mm for a translating cam.
+
+    Raises
+    ------
+    SpecError
+        Every mechanism and motion/mechanism problem found, together.
+    """
+
+    def __init__(self, mechanism: Mechanism, program: MotionLike):
+        if not isinstance(mechanism, Mechanism):
+            raise TypeError(f"unsupported mechanism {type(mechanism).__name__}")
+        problems = mechanism.validate()
+        if not problems:
+            problems = mechanism.validate_motion(program)
+        if problems:
+            raise SpecError(problems)
+        self.mechanism, self.program = mechanism, program
+        self.profiles: tuple[Contact, ...] = (_contact(mechanism, program),)
+
+    @classmethod
+    def from_contacts(cls, contacts: Sequence[Contact], mechanism=None, program=None) -> "CamGeometry":
+        """A geometry made of ready-built contacts (conjugate cams and the like)."""
+        self = cls.__new__(cls)
+        self.mechanism, self.program, self.profiles = mechanism, program, tuple(contacts)
+        return self
+
+    # ---- basic properties ---------------------------------------------
+    @property
+    def closed(self) -> bool:
+        return self.profiles[0].closed
+
+    @property
+    def period(self) -> float:
+        return self.profiles[0].period
+
+    @property
+    def x_unit(self) -> str:
+        """"deg" (disc cams; internals in radians) or "mm" (translating cam)."""
+        return "deg" if self.closed else "mm"
+
+    def to_user(self, x):
+        """Parameter in internal units → user units (degrees, or mm)."""
+        return np.degrees(x) if self.closed else x
+
+    @property
+    def breakpoints(self) -> np.ndarray:
+        """Union of every profile's breakpoints (radians, or mm), 0 and period included."""
+        return np.unique(np.concatenate([c.breakpoints for c in self.profiles]))
+
+    def evaluate(self, phi, profile: int = 0) -> ProfileSample:
+        """Evaluate profile ``profile`` at cam angles ``phi`` (radians, any real; (n,))."""
+        return self.profiles[profile].evaluate(phi)
+
+    @property
+    def initial_arm_angle(self) -> float | None:
+        """ξ₀ (radians) of an oscillating follower, else None."""
+        return getattr(self.mechanism, "initial_arm_angle", None)
+
+    @property
+    def initial_arm_angle_deg(self) -> float | None:
+        a = self.initial_arm_angle
+        return None if a is None else math.degrees(a)
+
+    # ---- extremes and area --------------------------------------------
+    def radius_extremes(self, profile: int = 0) -> Extremes:
+        """DMIN/DMAX: extremes of the profile's distance from the cam centre (mm)."""
+        c = self.profiles[profile]
+        edges = c.breakpoints
+        lo = extremum(lambda x: c.radius(x)[0], edges)
+        hi = extremum(lambda x: c.radius(x)[0], edges, maximize=True)
+        return Extremes(lo[1], lo[0], hi[1], hi[0])
+
+    @property
+    def min_radius(self) -> float:
+        """Smallest distance of profile 0 from the cam centre (= R_b), mm."""
+        return self.radius_extremes().min
+
+    @property
+    def max_radius(self) -> float:
+        """Largest distance of profile 0 from the cam centre, mm."""
+        return self.radius_extremes().max
+
+    def area(self, profile: int = 0, *, rtol: float = 1e-11) -> float:
+        """Area enclosed by the profile (mm²), Green's theorem ½∮(x dy − y dx).
+
+        For a translating cam: the area between the profile and the bottom edge
+        (∫ y dx over one cam length).
+        """
+        c = self.profiles[profile]
+        if c.closed:
+            def f(x):
+                s = c.evaluate(x)
+                return 0.5 * _cross(s.point, s.point_d1)
+        else:
+            def f(x):
+                s = c.evaluate(x)
+                return s.point[:, 1] * s.point_d1[:, 0]
+        return abs(integrate(f, c.breakpoints, rtol=rtol))
+
+
+def _contact(mech: Mechanism, prog: MotionLike) -> Contact:
+    if isinstance(mech, TranslatingRoller):
+        return TranslatingRollerContact(prog, mech.prime_radius_mm, mech.roller_radius_mm, mech.offset_mm, mech.sense)
+    if isinstance(mech, OscillatingRoller):
+        return OscillatingRollerContact(prog, mech.pivot_distance_mm, mech.arm_length_mm, mech.initial_arm_angle,
+                                        mech.roller_radius_mm, mech.sense)
+    if isinstance(mech, TranslatingFlat):
+        return TranslatingFlatContact(prog, mech.base_radius_mm, mech.face_offset_mm, mech.sense)
+    if isinstance(mech, OscillatingFlat):
+        return OscillatingFlatContact(prog, mech.pivot_distance_mm, mech.face_offset_mm, mech.initial_arm_angle,
+                                      mech.sense)
+    if isinstance(mech, TranslatingCamRoller):
+        return TranslatingCamContact(prog, mech.roller_radius_mm, mech.base_height_mm, mech.direction)
+    raise TypeError(f"unsupported mechanism {type(mech).__name__}")

@@ -1,0 +1,201 @@
+"""Design helpers: the smallest base circle for a constraint, the best offset.
+
+Every helper returns the value at which its constraint is exactly active
+(so :func:`camfab.design.checks.check` passes just above it and fails just
+below), or the geometric lower bound when the constraint never binds.
+
+* :func:`min_base_radius_for_pressure_angle` — translating roller (closed
+  form: ``√(R_p² − e²) ≥ max_φ(|S′ + σe|/tan δ_max − S)``) and oscillating
+  roller (numerical).
+* :func:`min_base_radius_no_undercut` — rollers: min convex ρ_p = R_r.
+* :func:`min_base_radius_no_cusp` — flat faces: translating
+  ``R_b,min = −min(S + S″)`` (spec §5, Ejemplo3PT), oscillating numerical.
+* :func:`optimal_offset` — the offset of a translating roller that minimises
+  the peak |pressure angle| (bounded Brent).
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Callable
+
+import numpy as np
+from scipy.optimize import brentq, minimize_scalar
+
+from ..errors import SpecError
+from .checks import DEFAULT_PRESSURE_LIMIT_DEG
+from .mechanisms import (Mechanism, OscillatingFlat, OscillatingRoller, TranslatingFlat, TranslatingRoller)
+from .profile import CamGeometry, MotionLike, extremum
+
+__all__ = [
+    "peak_pressure_angle_deg",
+    "min_base_radius_for_pressure_angle",
+    "min_base_radius_no_undercut",
+    "min_base_radius_no_cusp",
+    "optimal_offset",
+]
+
+_TINY = 1e-9
+
+
+def peak_pressure_angle_deg(mechanism: Mechanism, program: MotionLike) -> float:
+    """max |δ| over the cycle in degrees (roller followers)."""
+    c = CamGeometry(mechanism, program).profiles[0]
+    f = lambda x: np.abs(c.evaluate(x).pressure_angle)  # noqa: E731
+    return math.degrees(extremum(f, c.breakpoints, maximize=True)[1])
+
+
+def _with_rb(mech: Mechanism, rb: float) -> Mechanism:
+    return dataclasses.replace(mech, base_radius_mm=rb)
+
+
+def _measure(mech: Mechanism, program: MotionLike, rb: float, fn: Callable) -> float:
+    """fn(contact) at base radius rb; +inf where the geometry cannot be built."""
+    try:
+        g = CamGeometry(_with_rb(mech, rb), program)
+    except SpecError:
+        return math.inf
+    return fn(g.profiles[0])
+
+
+def _smallest(f: Callable[[float], float], lo: float, hi: float, n: int = 40) -> float:
+    """Smallest r in [lo, hi] with f(r) <= 0 (the first feasible point from below).
+
+    Scans n points, then refines the infeasible→feasible step by Brent's method
+    (or bisection when the lower end cannot be built).
+    """
+    rs = np.geomspace(lo, hi, n) if lo > 0 else np.linspace(lo, hi, n)
+    vals = np.array([f(r) for r in rs])
+    good = np.flatnonzero(vals <= 0)
+    if good.size == 0:
+        raise ValueError(f"no base radius between {lo:.6g} and {hi:.6g} mm meets the constraint")
+    i = int(good[0])
+    if i == 0:
+        return float(lo)
+    a, b, fa = rs[i - 1], rs[i], vals[i - 1]
+    if math.isfinite(fa):
+        return float(brentq(f, a, b, xtol=1e-13 * b, rtol=1e-15))
+    for _ in range(200):  # bisection across a geometric-validity boundary
+        m = 0.5 * (a + b)
+        if f(m) > 0:
+            a = m
+        else:
+            b = m
+        if b - a < 1e-13 * b:
+            break
+    return float(b)
+
+
+def _upper(mech: Mechanism, program: MotionLike, f: Callable[[float], float], start: float) -> float:
+    """A base radius at which f <= 0, found by doubling from ``start``."""
+    hi = max(start, 1.0)
+    for _ in range(60):
+        if f(hi) <= 0:
+            return hi
+        hi *= 2.0
+    raise ValueError("no feasible base radius found")
+
+
+def _lift(program: MotionLike) -> float:
+    x = np.linspace(0.0, program.period, 2001)
+    return float(np.max(program.evaluate(x, (0,))[0]))
+
+
+def _osc_bounds(mech: Mechanism) -> tuple[float, float]:
+    if isinstance(mech, OscillatingRoller):
+        a, m, rr = mech.arm_length_mm, mech.pivot_distance_mm, mech.roller_radius_mm
+        return max(abs(a - m) - rr, 0.0) * (1 + _TINY) + _TINY, (a + m - rr) * (1 - _TINY)
+    f, m = mech.face_offset_mm, mech.pivot_distance_mm
+    return max(f - m, 0.0) * (1 + _TINY) + _TINY, (f + m) * (1 - _TINY)
+
+
+def min_base_radius_for_pressure_angle(mechanism: Mechanism, program: MotionLike,
+                                       limit_deg: float | None = None) -> float:
+    """Smallest R_b (mm) keeping |pressure angle| <= ``limit_deg`` everywhere.
+
+    Parameters
+    ----------
+    mechanism : TranslatingRoller or OscillatingRoller
+        Its roller, offset / pivot and arm are kept; ``base_radius_mm`` is ignored.
+    program : MotionProgram
+    limit_deg : float, optional
+        Default 30° (translating) or 35° (oscillating).
+    """
+    if isinstance(mechanism, TranslatingRoller):
+        lim = math.radians(limit_deg or DEFAULT_PRESSURE_LIMIT_DEG["translating"])
+        e, sg = mechanism.offset_mm, mechanism.sense
+
+        def need(x):
+            s = program.evaluate(x, (0, 1))
+            return np.abs(s[1] + sg * e) / math.tan(lim) - s[0]
+
+        d = extremum(need, np.asarray(program.breakpoints, float), maximize=True)[1]
+        rr = mechanism.roller_radius_mm
+        if d <= 0:  # never binds: the only bound is |e| < R_p
+            return max(abs(e) - rr, 0.0)
+        return math.sqrt(d * d + e * e) - rr
+    if isinstance(mechanism, OscillatingRoller):
+        lim = limit_deg or DEFAULT_PRESSURE_LIMIT_DEG["oscillating"]
+
+        def f(rb):
+            def peak(c):
+                g = lambda x: np.abs(c.evaluate(x).pressure_angle)  # noqa: E731
+                return math.degrees(extremum(g, c.breakpoints, maximize=True)[1]) - lim
+            return _measure(mechanism, program, rb, peak)
+
+        return _smallest(f, *_osc_bounds(mechanism))
+    raise TypeError("pressure-angle sizing applies to translating and oscillating roller followers")
+
+
+def min_base_radius_no_undercut(mechanism: Mechanism, program: MotionLike) -> float:
+    """Smallest R_b (mm) at which the smallest convex pitch radius equals the roller
+    radius (no undercut above it).  Roller followers (translating or oscillating)."""
+    if not isinstance(mechanism, (TranslatingRoller, OscillatingRoller)):
+        raise TypeError("undercut sizing applies to roller followers")
+    rr = mechanism.roller_radius_mm
+    if rr <= 0:
+        raise ValueError("a knife edge (roller radius 0) cannot undercut")
+
+    def f(rb):
+        def worst(c):
+            return rr * extremum(lambda x: c.evaluate(x).curvature_pitch, c.breakpoints, maximize=True)[1] - 1.0
+        return _measure(mechanism, program, rb, worst)
+
+    if isinstance(mechanism, TranslatingRoller):
+        lo = max(abs(mechanism.offset_mm) - rr, 0.0) * (1 + _TINY) + _TINY
+        return _smallest(f, lo, _upper(mechanism, program, f, 4 * max(rr, _lift(program))))
+    return _smallest(f, *_osc_bounds(mechanism))
+
+
+def min_base_radius_no_cusp(mechanism: Mechanism, program: MotionLike) -> float:
+    """Smallest R_b (mm) of a flat-face follower at which the profile's radius of
+    curvature reaches 0 (a cusp); above it the profile is free of cusps.
+
+    Translating face: ``R_b,min = −min(S + S″)`` exactly (spec §5).
+    """
+    if isinstance(mechanism, TranslatingFlat):
+        g = lambda x: np.sum(program.evaluate(x, (0, 2)), axis=0)  # noqa: E731
+        return max(-extremum(g, np.asarray(program.breakpoints, float))[1], 0.0)
+    if isinstance(mechanism, OscillatingFlat):
+        def f(rb):
+            return _measure(mechanism, program, rb,
+                            lambda c: -extremum(lambda x: c.evaluate(x).rho, c.breakpoints)[1])
+        return _smallest(f, *_osc_bounds(mechanism))
+    raise TypeError("cusp sizing applies to flat-face followers")
+
+
+def optimal_offset(mechanism: TranslatingRoller, program: MotionLike) -> float:
+    """Offset e (mm) that minimises the peak |pressure angle| of a translating roller.
+
+    Searched over |e| < 0.99·R_p by bounded Brent; the base and roller radii of
+    ``mechanism`` are kept.
+    """
+    if not isinstance(mechanism, TranslatingRoller):
+        raise TypeError("optimal_offset applies to translating roller followers")
+    rp = mechanism.prime_radius_mm
+
+    def peak(e):
+        return peak_pressure_angle_deg(dataclasses.replace(mechanism, offset_mm=e), program)
+
+    r = minimize_scalar(peak, bounds=(-0.99 * rp, 0.99 * rp), method="bounded", options={"xatol": 1e-7 * rp})
+    return float(r.x)

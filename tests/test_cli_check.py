@@ -1,0 +1,94 @@
+"""`camfab check`: conclusions table, JSON contract of design.md §6, exit codes, refusals."""
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from camfab.cli import main
+from tests.conftest import EXAMPLES
+
+KEYS = {"name", "verdict", "peaks", "junctions", "pressure_angle_deg", "radius_of_curvature_mm",
+        "face_length_mm", "base_radius_mm", "max_radius_mm", "area_mm2", "findings"}
+
+
+def _json(capsys, *argv):
+    code = main(["check", *argv, "--json"])
+    return code, json.loads(capsys.readouterr().out)
+
+
+def test_check_json_contract_ejemplo9rt(capsys):
+    code, d = _json(capsys, "ejemplo9rt")
+    assert code == 0
+    assert KEYS <= set(d)
+    assert d["verdict"] == "not_for_high_speed"
+    assert d["base_radius_mm"] == pytest.approx(35.0, abs=1e-9)
+    assert d["max_radius_mm"] == pytest.approx(45.0, abs=1e-9)
+    assert d["face_length_mm"] is None  # roller follower
+    assert set(d["radius_of_curvature_mm"]) >= {"min_convex", "min_concave", "at_deg"}
+    assert set(d["pressure_angle_deg"]) >= {"max", "min", "at_max_deg", "at_min_deg"}
+    for f in d["findings"]:
+        assert set(f) >= {"code", "severity", "from_deg", "to_deg", "value", "limit", "message"}
+
+
+def test_check_table_text(capsys):
+    assert main(["check", "ejemplo9rt"]) == 0
+    out = capsys.readouterr().out
+    assert "Not suitable for high speeds" in out
+    assert "Pressure angle" in out and "Jerk" in out and "Discontinuous" in out
+
+
+def _design(tmp_path, follower: str, motion: str = None) -> str:
+    text = (EXAMPLES / "ejemplo9rt.toml").read_text()
+    start, end = text.index("[follower]"), text.index("[[motion]]")
+    text = text[:start] + follower + "\n" + text[end:]
+    if motion is not None:
+        text = text[:text.index("[[motion]]")] + motion + text[text.index("[manufacturing]"):]
+    p = tmp_path / "d.toml"
+    p.write_text(text)
+    return str(p)
+
+
+def test_ejemplo1rt_pressure_angle(tmp_path, capsys):
+    p = _design(tmp_path, '[follower]\ntype = "roller"\nmotion = "translating"\nbase_radius_mm = 50.0\n'
+                          'roller_radius_mm = 5.0\n',
+                '[[motion]]\nlaw = "simple_harmonic"\nlift = 50.0\nangle_deg = 180.0\n'
+                '[[motion]]\nlaw = "simple_harmonic"\nlift = -50.0\nangle_deg = 180.0\n')
+    code, d = _json(capsys, p)
+    assert code == 0 and d["verdict"] == "acceptable"
+    pa = d["pressure_angle_deg"]
+    assert round(abs(pa["max"]), 2) == 18.21 and round(abs(pa["min"]), 2) == 18.21
+
+
+def test_unacceptable_exit_1(tmp_path, capsys):
+    # a small base circle: pressure angle far above 30°
+    p = _design(tmp_path, '[follower]\ntype = "roller"\nmotion = "translating"\nbase_radius_mm = 8.0\n'
+                          'roller_radius_mm = 2.0\n')
+    code, d = _json(capsys, p)
+    assert code == 1 and d["verdict"] == "unacceptable"
+    assert "PRESSURE_ANGLE_EXCEEDED" in {f["code"] for f in d["findings"]}
+
+
+@pytest.mark.parametrize("follower, field", [
+    ('type = "roller"\nmotion = "translating"\nbase_radius_mm = 35.0\nroller_radius_mm = 7.0\noffset_mm = 50.0\n',
+     "follower.offset_mm"),
+    ('type = "roller"\nmotion = "oscillating"\nbase_radius_mm = 35.0\nroller_radius_mm = 7.0\n'
+     'pivot_distance_mm = 80.0\narm_length_mm = 5.0\n', "follower.arm_length_mm"),
+])
+def test_bad_geometry_refused_exit_2(tmp_path, capsys, follower, field):
+    p = _design(tmp_path, "[follower]\n" + follower)
+    assert main(["check", p]) == 2
+    assert field in capsys.readouterr().err
+
+
+def test_flat_face_reports_face_lengths(tmp_path, capsys):
+    p = _design(tmp_path, '[follower]\ntype = "flat"\nmotion = "translating"\nbase_radius_mm = 100.0\n')
+    code, d = _json(capsys, p)
+    assert code == 0
+    assert d["face_length_mm"]["left"] > 0 and d["face_length_mm"]["right"] > 0
+    assert d["pressure_angle_deg"] is None
+
+
+def test_valve_example_runs(capsys):
+    code, d = _json(capsys, "valve_exhaust_ej1")
+    assert code == 0 and d["verdict"] == "not_for_high_speed"
