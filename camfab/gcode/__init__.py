@@ -1,1 +1,24 @@
-"""camfab.gcode — see the issue tracker for its planned contents."""
+"""camfab.gcode - contour milling programs, post-processors, a G-code reader/back-plotter and verifier.
+
+Flow: a closed tool-centre contour (lines and arcs, from :mod:`camfab.offset`) and a :class:`Job`
+-> :func:`contour_toolpath` -> :class:`Program` (common model, mm) -> :func:`dumps` / :func:`write_gcode`
+with a post-processor (``linuxcnc``, ``fanuc``, ``grbl``) -> G-code text -> :func:`parse` (back-plot)
+-> :func:`verify` against the exact curves.  :func:`lift_table_csv` writes the polar lift table for cam
+grinders.
+"""
+from camfab.gcode.geom import ContourDistance, arc_sweep
+from camfab.gcode.lift_table import lift_angles, lift_table_csv, write_lift_table
+from camfab.gcode.parse import Backplot, GcodeError, Move, Samples, backplot, parse, sample
+from camfab.gcode.post import POSTS, dumps, get_post, write_gcode
+from camfab.gcode.toolpath import (Arc, Comment, Coolant, CutterComp, Feed, Job, Program, Rapid, Segment,
+                                   Spindle, ToolChange, as_contour, contour_toolpath, offset_contour,
+                                   orient_contour)
+from camfab.gcode.verify import VerifyProblem, VerifyReport, verify
+
+__all__ = [
+    "Arc", "Backplot", "Comment", "ContourDistance", "Coolant", "CutterComp", "Feed", "GcodeError", "Job",
+    "Move", "POSTS", "Program", "Rapid", "Samples", "Segment", "Spindle", "ToolChange", "VerifyProblem",
+    "VerifyReport", "arc_sweep", "as_contour", "backplot", "contour_toolpath", "dumps", "get_post",
+    "lift_angles", "lift_table_csv", "offset_contour", "orient_contour", "parse", "sample", "verify",
+    "write_gcode", "write_lift_table",
+]
