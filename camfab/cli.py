@@ -18,7 +18,7 @@ from typing import Callable
 import numpy as np
 
 from . import __version__
-from .errors import CamfabError, MissingDependencyError, SpecError
+from .errors import CamfabError, GeometryError, MissingDependencyError, SpecError
 from .io import atomic_write
 
 __all__ = ["main", "register", "COMMANDS", "EXAMPLES_DIR", "resolve_design_path"]
@@ -239,6 +239,58 @@ def _num(v) -> str:
     return f"{v:.2f}" if abs(v) < 1e7 else f"{v:.5g}"
 
 
+def _export_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("file", help="design file (TOML) or built-in example name")
+    p.add_argument("--dxf", action="store_true", help="write the DXF drawing of the profile")
+    p.add_argument("--step", action="store_true", help="write the STEP solid (needs cadquery)")
+    p.add_argument("--stl", action="store_true", help="write the STL mesh")
+    p.add_argument("--tol", type=float, default=None,
+                   help="max distance of every entity from the exact profile, mm (default: the design's, 0.001)")
+    p.add_argument("--dxf-flavour", choices=("lwpolyline", "r12"), default="lwpolyline",
+                   help="LWPOLYLINE with bulges (default) or R12 LINE/ARC entities")
+    p.add_argument("--force", action="store_true", help="export even if the design's verdict is unacceptable")
+    p.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
+
+
+@register("export", "DXF, STEP and STL files within a measured tolerance of the exact profile")
+def cmd_export(args: argparse.Namespace) -> int:
+    from .cad.export import build_artifacts, write_artifacts
+    from .design.assemble import check_design, geometry_from_spec
+    from .offset.discretize import validate_tol
+
+    spec = _load(args.file)
+    formats = [f for f in ("dxf", "step", "stl") if getattr(args, f)]
+    if not formats:
+        formats = [f for f in ("dxf", "step", "stl") if getattr(spec.outputs, f)]
+    if not formats:
+        raise UsageError("nothing to export: give --dxf, --step or --stl, or enable them in [outputs]")
+    tol = spec.manufacturing.tolerance_mm if args.tol is None else args.tol
+    try:
+        tol = validate_tol(tol)
+    except ValueError as exc:
+        raise UsageError(f"--tol {args.tol}: {exc}") from None
+    report = check_design(spec)
+    if report.verdict == "unacceptable" and not args.force:
+        print(format_check(spec, report), file=sys.stderr)
+        print(f"camfab export: {spec.name} is unacceptable: nothing written (use --force to export anyway)",
+              file=sys.stderr)
+        return EXIT_CHECKS
+    geom = geometry_from_spec(spec)
+    arts = build_artifacts(spec, geom, formats, tol=tol, dxf_flavour=args.dxf_flavour,
+                           progress=lambda m: print(f"  ... {m}", file=sys.stderr))
+    paths = write_artifacts(arts, args.output)
+    print(f"{spec.name}: verdict {report.verdict}, tolerance {tol:g} mm")
+    print(f"  {'file':<32}{'entities':>10}{'max deviation (mm)':>22}")
+    for a, p in zip(arts, paths):
+        ents = "-" if a.entities is None else str(a.entities)
+        dev = "-" if a.deviation_mm is None else f"{a.deviation_mm:.3g}"
+        print(f"  {str(p):<32}{ents:>10}{dev:>22}")
+    return EXIT_OK
+
+
+cmd_export.add_arguments = _export_args
+
+
 # ---------------------------------------------------------------------------
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="camfab", description="Cam design, checks and manufacturing files.")
@@ -266,6 +318,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"camfab {args.command}: error: {exc}", file=sys.stderr)
         return EXIT_INPUT
     except UsageError as exc:
+        print(f"camfab {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_INPUT
+    except GeometryError as exc:
         print(f"camfab {args.command}: error: {exc}", file=sys.stderr)
         return EXIT_INPUT
     except MissingDependencyError as exc:

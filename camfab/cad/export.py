@@ -1,0 +1,148 @@
+"""Export pipeline: exact cam geometry → DXF / STEP / STL bytes with measured deviations.
+
+Everything is built in memory first and written only when every requested
+artifact succeeded, each file atomically, so an error never leaves partial
+output.  Only the stages a job asks for run (cadquery is imported only for
+STEP, tool paths only when a cutter is given).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Iterable
+
+import numpy as np
+
+from ..errors import GeometryError
+from ..io import atomic_write
+from ..offset.discretize import arcs, measure_deviation, validate_tol
+from ..offset.cutter import pitch_curve, profile_curve, tool_centre_path
+from . import dxf as dxf_mod
+from .plate import BulgeLoop, PlateSpec, bore_loop
+
+__all__ = ["Artifact", "CamShapes", "cam_shapes", "build_artifacts", "write_artifacts", "FORMATS"]
+
+FORMATS = ("dxf", "step", "stl")
+
+
+@dataclass(frozen=True)
+class Artifact:
+    """One file to write: name, bytes, and what was measured about it."""
+
+    filename: str
+    data: bytes
+    kind: str
+    entities: int | None = None
+    deviation_mm: float | None = None
+    note: str = ""
+
+
+@dataclass(frozen=True)
+class CamShapes:
+    """Arc-fitted loops of every profile (and pitch curve) of a cam, with their deviations."""
+
+    profiles: tuple[BulgeLoop, ...]
+    profile_deviation: tuple[float, ...]
+    pitch: tuple[BulgeLoop, ...]
+    curves: tuple  # exact ParametricCurve of each profile
+    tol: float
+
+
+def _loop(fit) -> BulgeLoop:
+    return BulgeLoop(np.asarray(fit.starts, dtype=float), np.asarray(fit.bulges, dtype=float))
+
+
+def cam_shapes(geometry, *, tol: float, with_pitch: bool = True) -> CamShapes:
+    """Arc-fit every profile of ``geometry`` within ``tol`` (measured)."""
+    tol = validate_tol(tol)
+    profiles, devs, pitch, curves = [], [], [], []
+    for c in geometry.profiles:
+        if not c.closed:
+            raise GeometryError("CAD export of translating (wedge) cams is not supported yet; "
+                                "use camfab check / motion for them")
+        curve = profile_curve(c)
+        fit = arcs(curve, tol=tol)
+        profiles.append(_loop(fit))
+        devs.append(float(fit.max_deviation))
+        curves.append(curve)
+        pc = pitch_curve(c) if with_pitch and c.roller_radius > 0 else None
+        if pc is not None:
+            pitch.append(_loop(arcs(pc, tol=tol)))
+    return CamShapes(tuple(profiles), tuple(devs), tuple(pitch), tuple(curves), tol)
+
+
+def _plate(spec) -> PlateSpec:
+    m = spec.manufacturing
+    return PlateSpec(m.thickness_mm, m.bore_mm, m.keyway, m.hub_diameter_mm, m.hub_length_mm)
+
+
+def _suffix(i: int, n: int) -> str:
+    return f"_cam{i + 1}" if n > 1 else ""
+
+
+def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_flavour: str = "lwpolyline",
+                    progress: Callable[[str], None] | None = None) -> list[Artifact]:
+    """Build the requested artifacts in memory.
+
+    Parameters
+    ----------
+    spec : DesignSpec
+    geometry : CamGeometry
+    formats : iterable of {"dxf", "step", "stl"}
+    tol : float
+        Maximum distance (mm) between every written entity and the exact profile.
+    """
+    say = progress or (lambda msg: None)
+    formats = [f for f in FORMATS if f in set(formats)]
+    say(f"fitting arcs within {tol:g} mm")
+    shapes = cam_shapes(geometry, tol=tol, with_pitch="dxf" in formats)
+    plate = _plate(spec)
+    out: list[Artifact] = []
+    n = len(shapes.profiles)
+    if "dxf" in formats:
+        say("DXF")
+        out.append(_dxf(spec, geometry, shapes, plate, tol, dxf_flavour))
+    if "stl" in formats:
+        from . import stl
+
+        for i, (loop, curve) in enumerate(zip(shapes.profiles, shapes.curves)):
+            say(f"STL{_suffix(i, n)}")
+            # arcs within tol/2 of the curve, flattened within tol/2 of the arcs: within tol overall
+            fine = _loop(arcs(curve, tol=tol / 2))
+            dev = float(measure_deviation(fine.flatten(tol / 2), curve).max)
+            data = stl.dumps(fine, plate, tol=tol / 2, name=spec.name)
+            out.append(Artifact(f"{spec.name}{_suffix(i, n)}.stl", data, "stl", None, dev))
+    if "step" in formats:
+        from . import step
+
+        for i, (loop, dev) in enumerate(zip(shapes.profiles, shapes.profile_deviation)):
+            say(f"STEP{_suffix(i, n)}")
+            text = step.dumps(loop, plate, name=f"{spec.name}{_suffix(i, n)}")
+            out.append(Artifact(f"{spec.name}{_suffix(i, n)}.step", text.encode("utf-8"), "step",
+                                len(loop.points), dev))
+    return out
+
+
+def _dxf(spec, geometry, shapes: CamShapes, plate: PlateSpec, tol: float, flavour: str) -> Artifact:
+    f = spec.follower
+    tools = ()
+    tool_d = spec.manufacturing.tool_diameter_mm
+    if tool_d:
+        tools = tuple(_loop(tool_centre_path(c, tool_d / 2, tol=tol).arcs) for c in geometry.profiles)
+    rr = f.roller_radius_mm or 0.0
+    content = dxf_mod.DxfContent(
+        profiles=shapes.profiles, pitch_curves=shapes.pitch, base_radius=f.base_radius_mm,
+        prime_radius=(f.base_radius_mm + rr) if (f.type == "roller" and rr > 0 and f.base_radius_mm) else None,
+        bore=bore_loop(plate.bore_mm, plate.keyway) if plate.bore_mm > 0 else None,
+        tool_paths=tools, tol_mm=tol, deviation_mm=max(shapes.profile_deviation), name=spec.name)
+    text = dxf_mod.dumps(content, flavour=flavour)
+    ents = sum(len(lp.points) for lp in shapes.profiles)
+    return Artifact(f"{spec.name}.dxf", text.encode("utf-8"), "dxf", ents, max(shapes.profile_deviation),
+                    f"{flavour}; {len(tools)} tool path(s)" if tools else flavour)
+
+
+def write_artifacts(artifacts: Iterable[Artifact], outdir: str | Path) -> list[Path]:
+    """Write every artifact atomically into ``outdir``; returns the paths."""
+    outdir = Path(outdir)
+    return [atomic_write(outdir / a.filename, a.data) for a in artifacts]

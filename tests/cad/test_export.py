@@ -1,0 +1,156 @@
+"""`camfab export`: every artifact read back independently and compared with the exact profile."""
+from __future__ import annotations
+
+import io
+import math
+
+import numpy as np
+import pytest
+
+from camfab.cad.export import build_artifacts, cam_shapes
+from camfab.cad.plate import PlateSpec, plate_volume
+from camfab.cli import main
+from camfab.design.assemble import geometry_from_spec
+from camfab.design.spec import design_from_dict, load_design
+from camfab.offset.cutter import profile_curve
+from camfab.offset.discretize import Chain, measure_deviation, polyline
+from tests.conftest import EXAMPLES, base_design
+
+ezdxf = pytest.importorskip("ezdxf")
+trimesh = pytest.importorskip("trimesh")
+
+OSC = base_design(follower={"type": "roller", "motion": "oscillating", "base_radius_mm": 40.0,
+                            "roller_radius_mm": 8.0, "pivot_distance_mm": 110.0, "arm_length_mm": 90.0},
+                  motion=[{"law": "dwell", "lift": 0.0, "angle_deg": 90.0},
+                          {"law": "poly4567", "lift": 15.0, "angle_deg": 90.0},
+                          {"law": "poly4567", "lift": -6.0, "angle_deg": 45.0},
+                          {"law": "poly4567", "lift": 6.0, "angle_deg": 45.0},
+                          {"law": "poly4567", "lift": -15.0, "angle_deg": 90.0}])
+FLAT = base_design(follower={"type": "flat", "motion": "translating", "base_radius_mm": 100.0})
+DESIGNS = {"ejemplo9rt": lambda: load_design(EXAMPLES / "ejemplo9rt.toml"),
+           "oscillating": lambda: design_from_dict(OSC), "flat": lambda: design_from_dict(FLAT)}
+
+
+def _by_angle(points):
+    """Unordered outline points (star-shaped about the cam centre) as a closed polyline."""
+    pts = np.unique(np.round(points, 12), axis=0)
+    return pts[np.argsort(np.arctan2(pts[:, 1], pts[:, 0]))]
+
+
+def _points_to_curve(points, curve):
+    """Upper bound of the largest distance from points to the exact curve (via a 1e-6 mm polyline)."""
+    fine = Chain.from_polyline(polyline(curve, tol=1e-6).points)
+    return float(fine.distance(points)[0].max()) + 1e-6
+
+
+def _profile_rows(text):
+    doc = ezdxf.read(io.StringIO(text))
+    assert doc.header["$INSUNITS"] == 4
+    assert not doc.audit().has_errors
+    (pl,) = doc.modelspace().query("LWPOLYLINE[layer=='PROFILE']")
+    return np.array(list(pl.get_points("xyb")))
+
+
+@pytest.mark.parametrize("name", sorted(DESIGNS))
+@pytest.mark.parametrize("tol", [1e-2, 1e-3, 1e-4])
+def test_dxf_read_back_within_tol(name, tol):
+    spec = DESIGNS[name]()
+    geom = geometry_from_spec(spec)
+    (art,) = build_artifacts(spec, geom, ["dxf"], tol=tol)
+    rows = _profile_rows(art.data.decode())
+    dev = measure_deviation(rows, profile_curve(geom.profiles[0]))
+    assert dev.max <= tol
+    assert art.deviation_mm <= tol
+
+
+def test_arc_count_far_below_polyline_at_1um():
+    spec = DESIGNS["ejemplo9rt"]()
+    shapes = cam_shapes(geometry_from_spec(spec), tol=1e-3, with_pitch=False)
+    assert len(shapes.profiles[0].points) < 120  # a uniform 1° polyline needs 360 vertices and is not within 1 µm
+
+
+def test_stl_watertight_volume_and_deviation():
+    spec = DESIGNS["ejemplo9rt"]()
+    geom = geometry_from_spec(spec)
+    (art,) = build_artifacts(spec, geom, ["stl"], tol=1e-3)
+    mesh = trimesh.load(trimesh.util.wrap_as_stream(art.data), file_type="stl")
+    assert mesh.is_watertight and mesh.is_winding_consistent
+    m = spec.manufacturing
+    hole = PlateSpec(m.thickness_mm, m.bore_mm, m.keyway).hole().area()
+    exact = (geom.area() - hole) * m.thickness_mm
+    perimeter = 2 * math.pi * 45 + 2 * math.pi * 6 + 10
+    assert abs(mesh.volume - exact) <= perimeter * 1e-3 * m.thickness_mm
+    assert art.deviation_mm <= 1e-3
+    # the mesh's top-face outline is within tol of the exact profile
+    top = mesh.vertices[np.isclose(mesh.vertices[:, 2], m.thickness_mm)][:, :2]
+    d = measure_deviation(_by_angle(top[np.hypot(*top.T) > 20]), profile_curve(geom.profiles[0]))
+    assert d.max <= 1e-3
+
+
+def test_same_export_twice_is_byte_identical():
+    spec = DESIGNS["ejemplo9rt"]()
+    geom = geometry_from_spec(spec)
+    a = build_artifacts(spec, geom, ["dxf", "stl"], tol=1e-3)
+    b = build_artifacts(spec, geom, ["dxf", "stl"], tol=1e-3)
+    assert [x.data for x in a] == [x.data for x in b]
+
+
+@pytest.mark.slow
+def test_step_valid_volume_reimport(tmp_path):
+    cq = pytest.importorskip("cadquery")
+    spec = DESIGNS["ejemplo9rt"]()
+    geom = geometry_from_spec(spec)
+    (art,) = build_artifacts(spec, geom, ["step"], tol=1e-5)
+    path = tmp_path / "c.step"
+    path.write_bytes(art.data)
+    solid = cq.importers.importStep(str(path)).val()
+    assert solid.isValid()
+    m = spec.manufacturing
+    plate = PlateSpec(m.thickness_mm, m.bore_mm, m.keyway)
+    loop = cam_shapes(geom, tol=1e-5, with_pitch=False).profiles[0]
+    assert solid.Volume() == pytest.approx(plate_volume(loop, plate), rel=1e-9)
+    exact = (geom.area() - plate.hole().area()) * m.thickness_mm
+    assert solid.Volume() == pytest.approx(exact, rel=1e-6)
+    # the solid's outline edges lie on the exact profile (a 1e-4 mm export, read back)
+    (art,) = build_artifacts(spec, geom, ["step"], tol=1e-4)
+    path.write_bytes(art.data)
+    solid = cq.importers.importStep(str(path)).val()
+    edges = cq.Workplane().add(solid).faces(">Z").edges().vals()
+    pts = np.array([(p.x, p.y) for e in edges for p in [e.positionAt(t) for t in np.linspace(0, 1, 400)]])
+    outer = pts[np.hypot(*pts.T) > 20]
+    assert _points_to_curve(outer, profile_curve(geom.profiles[0])) <= 1e-4
+
+
+def test_cli_export_writes_summary(tmp_path, capsys):
+    assert main(["export", "ejemplo9rt", "--dxf", "--stl", "--tol", "0.01", "-o", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "Ejemplo9RT.dxf" in out and "max deviation" in out
+    assert (tmp_path / "Ejemplo9RT.dxf").exists() and (tmp_path / "Ejemplo9RT.stl").exists()
+
+
+def test_cli_export_refuses_unacceptable_unless_forced(tmp_path, capsys):
+    d = tmp_path / "bad.toml"
+    d.write_text((EXAMPLES / "ejemplo9rt.toml").read_text().replace("base_radius_mm = 35.0", "base_radius_mm = 12.0"))
+    out = tmp_path / "out"
+    assert main(["export", str(d), "--dxf", "-o", str(out)]) == 1
+    assert "nothing written" in capsys.readouterr().err
+    assert not out.exists()
+    assert main(["export", str(d), "--dxf", "--force", "-o", str(out)]) == 0
+    assert (out / "Ejemplo9RT.dxf").exists()
+
+
+def test_cli_export_tool_too_big_is_refused(tmp_path, capsys):
+    d = tmp_path / "t.toml"
+    d.write_text((EXAMPLES / "ejemplo9rt.toml").read_text().replace("tool_diameter_mm = 6.0",
+                                                                      "tool_diameter_mm = 100.0"))
+    out = tmp_path / "out"
+    assert main(["export", str(d), "--dxf", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "largest cutter" in err and "47.5" in err and "°" in err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("tol", ["0", "1", "nan"])
+def test_cli_export_bad_tol(tmp_path, tol):
+    assert main(["export", "ejemplo9rt", "--dxf", "--tol", tol, "-o", str(tmp_path / "o")]) == 2
+    assert not (tmp_path / "o").exists()
