@@ -291,6 +291,160 @@ def cmd_export(args: argparse.Namespace) -> int:
 cmd_export.add_arguments = _export_args
 
 
+def _gcode_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("file", help="design file (TOML) or built-in example name")
+    p.add_argument("--post", choices=("linuxcnc", "fanuc", "grbl"), default=None,
+                   help="controller dialect (default: [outputs] gcode, else linuxcnc)")
+    p.add_argument("--tool-diameter", type=float, default=None, metavar="MM",
+                   help="end mill diameter (default: [manufacturing] tool_diameter_mm)")
+    p.add_argument("--tol", type=float, default=None, help="tool-path tolerance, mm (default: the design's)")
+    p.add_argument("--tool-number", type=int, default=1)
+    p.add_argument("--rpm", type=float, default=3000.0, help="spindle speed")
+    p.add_argument("--feed", type=float, default=600.0, help="cutting feed, mm/min")
+    p.add_argument("--plunge-feed", type=float, default=200.0, help="plunge feed, mm/min")
+    p.add_argument("--step-down", type=float, default=3.0, help="largest depth per level, mm")
+    p.add_argument("--roughing-passes", type=int, default=1)
+    p.add_argument("--allowance", type=float, default=0.2, help="radial finishing allowance, mm")
+    p.add_argument("--direction", choices=("climb", "conventional"), default="climb")
+    p.add_argument("--coolant", choices=("flood", "mist", "off"), default="flood")
+    p.add_argument("--units", choices=("mm", "inch"), default="mm")
+    p.add_argument("--safe-z", type=float, default=25.0, help="safe height for rapids, mm")
+    p.add_argument("--compensation", choices=("G41", "G42"), default=None,
+                   help="emit the part contour with cutter compensation instead of tool-centre coordinates")
+    p.add_argument("--lift-table", metavar="CSV", help="also write the polar lift table for cam grinders")
+    p.add_argument("--lift-step", type=float, default=1.0, help="lift-table step in degrees (divides 360)")
+    p.add_argument("--force", action="store_true", help="write even if the design's verdict is unacceptable")
+    p.add_argument("-o", "--output", required=True, metavar="OUT.nc")
+
+
+def _job(spec, args, tol):
+    from .gcode import Job
+
+    tool = args.tool_diameter if args.tool_diameter is not None else spec.manufacturing.tool_diameter_mm
+    if tool is None:
+        raise UsageError("no tool: give --tool-diameter or [manufacturing] tool_diameter_mm")
+    return Job(tool_diameter_mm=tool, depth_mm=spec.manufacturing.thickness_mm, tool_number=args.tool_number,
+               spindle_rpm=args.rpm, feed_mm_min=args.feed, plunge_feed_mm_min=args.plunge_feed,
+               step_down_mm=args.step_down, safe_z_mm=args.safe_z, roughing_allowance_mm=args.allowance,
+               roughing_passes=0 if args.compensation else args.roughing_passes, direction=args.direction,
+               coolant=args.coolant, units=args.units, tolerance_mm=tol, design_name=spec.name)
+
+
+def _tol(spec, value):
+    from .offset.discretize import validate_tol
+
+    try:
+        return validate_tol(spec.manufacturing.tolerance_mm if value is None else value)
+    except ValueError as exc:
+        raise UsageError(f"--tol {value}: {exc}") from None
+
+
+@register("gcode", "contour-milling G-code (LinuxCNC, Fanuc, GRBL) of the cam periphery")
+def cmd_gcode(args: argparse.Namespace) -> int:
+    from .design.assemble import check_design, geometry_from_spec
+    from .gcode import dumps
+    from .gcode.cam import cam_program
+
+    spec = _load(args.file)
+    tol = _tol(spec, args.tol)
+    job = _job(spec, args, tol)
+    post = args.post or spec.outputs.gcode or "linuxcnc"
+    report = check_design(spec)
+    if report.verdict == "unacceptable" and not args.force:
+        print(f"camfab gcode: {spec.name} is unacceptable ({_worst(report)}): nothing written "
+              "(use --force to write anyway)", file=sys.stderr)
+        return EXIT_CHECKS
+    geom = geometry_from_spec(spec)
+    out = Path(args.output)
+    texts = []
+    for i, contact in enumerate(geom.profiles):
+        cp = cam_program(contact, job, tol=tol, compensation=args.compensation)
+        name = out if len(geom.profiles) == 1 else out.with_name(f"{out.stem}_cam{i + 1}{out.suffix}")
+        texts.append((name, dumps(cp.program, post), cp))
+    lift = None
+    if args.lift_table:
+        lift = _lift_table(spec, args.lift_step)
+    for name, text, cp in texts:
+        atomic_write(name, text)
+        print(f"wrote {name}: {post}, {cp.entities} contour entities, max deviation {cp.deviation_mm:.3g} mm "
+              f"(tol {tol:g} mm)")
+    if lift is not None:
+        atomic_write(args.lift_table, lift)
+        print(f"wrote {args.lift_table}")
+    return EXIT_OK
+
+
+cmd_gcode.add_arguments = _gcode_args
+
+
+def _worst(report) -> str:
+    errs = [f.code for f in report.findings if f.severity == "error"]
+    return ", ".join(sorted(set(errs))) or report.verdict
+
+
+def _lift_table(spec, step: float) -> str:
+    from .gcode import lift_angles, lift_table_csv
+
+    prog = spec.program()
+    if _x_scale(prog) == 1.0:
+        raise UsageError("a lift table needs a rotating cam")
+    ang = lift_angles(step)
+    return lift_table_csv(ang, prog(np.radians(ang)))
+
+
+def _verify_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("program", help="G-code file to verify")
+    p.add_argument("--design", required=True, help="the design the program should cut")
+    p.add_argument("--tool-diameter", type=float, default=None, metavar="MM",
+                   help="end mill diameter (default: [manufacturing] tool_diameter_mm)")
+    p.add_argument("--tol", type=float, default=None, help="tolerance, mm (default: the design's)")
+    p.add_argument("--safe-z", type=float, default=25.0)
+    p.add_argument("--profile", type=int, default=1, help="which profile of a conjugate pair (1 or 2)")
+    p.add_argument("--json", action="store_true")
+
+
+@register("verify", "back-plot a G-code program and check it against the exact design")
+def cmd_verify(args: argparse.Namespace) -> int:
+    from .design.assemble import geometry_from_spec
+    from .gcode import GcodeError, parse, verify
+    from .gcode.cam import signed_distance
+    from .offset.cutter import offset_curve, profile_curve
+
+    spec = _load(args.design)
+    tol = _tol(spec, args.tol)
+    tool = args.tool_diameter if args.tool_diameter is not None else spec.manufacturing.tool_diameter_mm
+    if tool is None:
+        raise UsageError("no tool: give --tool-diameter or [manufacturing] tool_diameter_mm")
+    geom = geometry_from_spec(spec)
+    if not 1 <= args.profile <= len(geom.profiles):
+        raise UsageError(f"--profile {args.profile}: the design has {len(geom.profiles)} profile(s)")
+    contact = geom.profiles[args.profile - 1]
+    try:
+        text = Path(args.program).read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise UsageError(f"{args.program}: not a text G-code file") from None
+    try:
+        moves = parse(text)
+    except GcodeError as exc:
+        raise UsageError(f"{args.program}: {exc}") from None
+    rep = verify(moves, exact_curve_distance=signed_distance(offset_curve(contact, tool / 2), tol=tol),
+                 part_distance=signed_distance(profile_curve(contact), tol=tol), tool_radius=tool / 2, tol=tol,
+                 safe_z=args.safe_z, top_z=0.0)
+    data = rep.to_dict()
+    if args.json:
+        print(json.dumps(data, indent=2))
+    else:
+        dev = data.get("max_deviation_mm")
+        print(f"{args.program}: {'OK' if rep.ok else 'FAILED'}; max deviation "
+              f"{'-' if dev is None else f'{dev:.3g}'} mm (tol {tol:g}); gouge: {'yes' if rep.gouge else 'no'}")
+        for pr in data.get("problems", []):
+            print(f"  [{pr.get('code')}] line {pr.get('line')}: {pr.get('message')}")
+    return EXIT_OK if rep.ok else EXIT_CHECKS
+
+
+cmd_verify.add_arguments = _verify_args
+
+
 # ---------------------------------------------------------------------------
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="camfab", description="Cam design, checks and manufacturing files.")

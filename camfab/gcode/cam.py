@@ -1,0 +1,92 @@
+"""Cam profiles → milling programs, and the exact distance functions the verifier needs.
+
+Takes geometry (a profile :class:`~camfab.design.profile.Contact`) and a
+:class:`~camfab.gcode.toolpath.Job`; never a design file.  The finishing
+contour is the exact tool-centre offset arc-fitted within ``tol``; roughing
+contours are exact offsets by the allowance plus the step-over.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from ..offset.cutter import offset_curve, profile_curve, tool_centre_path
+from ..offset.discretize import ArcDiscretisation, ParametricCurve, arcs, polyline
+from .toolpath import Job, Program, Segment, contour_toolpath
+
+__all__ = ["segments_from_arcs", "cam_program", "CamProgram", "signed_distance"]
+
+
+def segments_from_arcs(fit: ArcDiscretisation) -> list[Segment]:
+    """G-code contour segments (lines and arcs) of an arc discretisation."""
+    out = []
+    for s, e, c, sw in zip(fit.starts, fit.ends, fit.centres, fit.sweeps):
+        if sw == 0:
+            out.append(Segment(tuple(s), tuple(e)))
+        else:
+            out.append(Segment(tuple(s), tuple(e), tuple(c), bool(sw < 0)))
+    return out
+
+
+@dataclass(frozen=True)
+class CamProgram:
+    """A milling program of one cam profile and what was measured while building it."""
+
+    program: Program
+    deviation_mm: float  # arc chain vs exact tool-centre curve
+    shapely_deviation_mm: float
+    entities: int
+
+
+#: share of the tolerance given to the arc fit; the rest absorbs the rounding of the written
+#: coordinates and arc centres (the posts write at least tol/10 resolution)
+FIT_SHARE = 0.8
+
+
+def cam_program(contact, job: Job, *, tol: float, compensation: str | None = None) -> CamProgram:
+    """The contour-milling program of one profile (periphery, outside)."""
+    r = job.tool_radius_mm
+    tol_fit = max(tol * FIT_SHARE, 1e-6)
+    path = tool_centre_path(contact, r, tol=tol_fit)
+    job = _with_deviation(job, path.max_deviation)
+    if compensation:
+        part = arcs(profile_curve(contact), tol=tol_fit)
+        prog = contour_toolpath(segments_from_arcs(part), job, compensation=compensation)
+        return CamProgram(prog, part.max_deviation, path.shapely_deviation, part.n_entities)
+    rough = []
+    for k in range(job.roughing_passes, 0, -1):  # outermost first
+        d = r + job.roughing_allowance_mm + (k - 1) * job.stepover
+        rough.append(segments_from_arcs(arcs(offset_curve(contact, d), tol=max(tol, 1e-3))))
+    prog = contour_toolpath(segments_from_arcs(path.arcs), job, roughing_contours=rough)
+    return CamProgram(prog, path.max_deviation, path.shapely_deviation, path.arcs.n_entities)
+
+
+def _with_deviation(job: Job, dev: float) -> Job:
+    from dataclasses import replace
+
+    return replace(job, achieved_deviation_mm=dev)
+
+
+def signed_distance(curve: ParametricCurve, *, tol: float) -> Callable[[np.ndarray], np.ndarray]:
+    """``f(points (n, 2)) -> (n,)``: signed distance to a closed exact curve, positive outside.
+
+    Uses a polyline within ``tol/50`` of the curve (so distances are exact to
+    ``tol/50``) and shapely's vectorised distance and containment.
+    """
+    import shapely
+    from shapely.geometry import Polygon
+
+    pts = polyline(curve, tol=max(tol / 50, 1e-6)).points
+    poly = Polygon(pts)
+    ring = poly.exterior
+    shapely.prepare(poly)
+
+    def f(p: np.ndarray) -> np.ndarray:
+        p = np.asarray(p, dtype=float)
+        d = shapely.distance(ring, shapely.points(p))
+        inside = shapely.contains_xy(poly, p[:, 0], p[:, 1])
+        return np.where(inside, -d, d)
+
+    return f
