@@ -8,7 +8,8 @@ Flavours
     R12-safe LINE and ARC entities (DXF R12 file), for old CAM software.
 
 Layers: ``PROFILE``, ``PITCH_CURVE``, ``BASE_CIRCLE``, ``PRIME_CIRCLE``, ``BORE``,
-``TOOL_PATH``, ``CENTRE_MARKS``.  Units are recorded as ``$INSUNITS = 4`` (mm)
+``TOOL_PATH``, ``CENTRE_MARKS``; the second cam of a conjugate pair is on ``PROFILE_2``
+and ``PITCH_CURVE_2``.  Units are recorded as ``$INSUNITS = 4`` (mm)
 and the tolerance and achieved deviation as custom header properties
 ``CAMFAB_TOL_MM`` / ``CAMFAB_DEVIATION_MM``.  Output is byte-identical for the
 same input (ezdxf's fixed-metadata mode, no timestamps).
@@ -28,8 +29,8 @@ from .plate import BulgeLoop
 __all__ = ["DxfContent", "LAYERS", "FLAVOURS", "dumps", "build_document"]
 
 #: layer name -> ACI colour
-LAYERS = {"PROFILE": 7, "PITCH_CURVE": 2, "BASE_CIRCLE": 3, "PRIME_CIRCLE": 1, "BORE": 5,
-          "TOOL_PATH": 6, "CENTRE_MARKS": 8}
+LAYERS = {"PROFILE": 7, "PROFILE_2": 4, "PITCH_CURVE": 2, "PITCH_CURVE_2": 2, "BASE_CIRCLE": 3,
+          "PRIME_CIRCLE": 1, "BORE": 5, "TOOL_PATH": 6, "CENTRE_MARKS": 8}
 FLAVOURS = ("lwpolyline", "r12")
 
 
@@ -91,10 +92,10 @@ def build_document(content: DxfContent, *, flavour: str = "lwpolyline"):
     for name, colour in LAYERS.items():
         doc.layers.add(name, color=colour)
     msp = doc.modelspace()
-    for loop in content.profiles:
-        _add_loop(msp, loop, "PROFILE", flavour)
-    for loop in content.pitch_curves:
-        _add_loop(msp, loop, "PITCH_CURVE", flavour)
+    for i, loop in enumerate(content.profiles):
+        _add_loop(msp, loop, "PROFILE" if i == 0 else f"PROFILE_{i + 1}", flavour)
+    for i, loop in enumerate(content.pitch_curves):
+        _add_loop(msp, loop, "PITCH_CURVE" if i == 0 else f"PITCH_CURVE_{i + 1}", flavour)
     for loop in content.tool_paths:
         _add_loop(msp, loop, "TOOL_PATH", flavour)
     if content.bore is not None:

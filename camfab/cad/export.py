@@ -121,6 +121,12 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
             text = step.dumps(loop, plate, name=f"{spec.name}{_suffix(i, n)}")
             out.append(Artifact(f"{spec.name}{_suffix(i, n)}.step", text.encode("utf-8"), "step",
                                 len(loop.points), dev))
+        if n > 1:
+            say("STEP pair on the shaft")
+            text = step.stack_dumps(shapes.profiles, plate, name=f"{spec.name}_pair")
+            out.append(Artifact(f"{spec.name}_pair.step", text.encode("utf-8"), "step",
+                                sum(len(lp.points) for lp in shapes.profiles), max(shapes.profile_deviation),
+                                "both cams positioned along the shaft"))
     return out
 
 

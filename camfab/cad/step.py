@@ -12,7 +12,7 @@ from pathlib import Path
 from ..errors import MissingDependencyError
 from .plate import BulgeLoop, PlateSpec
 
-__all__ = ["plate_solid", "dumps"]
+__all__ = ["plate_solid", "dumps", "stack_dumps"]
 
 
 def _cq():
@@ -50,8 +50,19 @@ def plate_solid(outline: BulgeLoop, plate: PlateSpec):
 
 def dumps(outline: BulgeLoop, plate: PlateSpec, *, name: str = "cam") -> str:
     """STEP (AP214) text of the plate, in millimetres, byte-identical for the same input."""
+    return _export(plate_solid(outline, plate), name)
+
+
+def stack_dumps(outlines, plate: PlateSpec, *, gap_mm: float = 2.0, name: str = "cam") -> str:
+    """Several plates on one shaft (a conjugate pair): plate i at z = i·(thickness + hub + gap)."""
     cq = _cq()
-    solid = plate_solid(outline, plate)
+    pitch = plate.thickness_mm + (plate.hub_length_mm or 0.0) + gap_mm
+    solids = [plate_solid(o, plate).val().translate(cq.Vector(0, 0, i * pitch)) for i, o in enumerate(outlines)]
+    return _export(cq.Workplane("XY").add(cq.Compound.makeCompound(solids)), name)
+
+
+def _export(solid, name: str) -> str:
+    cq = _cq()
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / f"{name}.step"
         cq.exporters.export(solid, str(path), "STEP")

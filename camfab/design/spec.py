@@ -47,7 +47,7 @@ _CAM_KEYS = ("kind", "rotation", "direction", "speed_rpm", "omega_rad_s", "speed
 _FOLLOWER_FLOATS = ("base_radius_mm", "roller_radius_mm", "offset_mm", "pivot_distance_mm",
                     "arm_length_mm", "face_offset_mm", "follower_distance_mm",
                     "second_roller_radius_mm", "follower_angle_deg", "cam_length_mm",
-                    "base_height_mm", "width_mm")
+                    "base_height_mm", "width_mm", "rise_deg")
 _FOLLOWER_KEYS = ("type", "motion", *_FOLLOWER_FLOATS)
 _SEGMENT_KEYS = ("law", "lift", "angle_deg", "length_mm", "shape")
 _MFG_KEYS = ("thickness_mm", "bore_mm", "keyway", "hub_diameter_mm", "hub_length_mm",
@@ -92,6 +92,7 @@ class FollowerSpec:
     cam_length_mm: float | None = None
     base_height_mm: float | None = None
     width_mm: float | None = None
+    rise_deg: float | None = None
 
     @property
     def lift_unit(self) -> str:
@@ -354,8 +355,27 @@ def _follower(v: _Validator, t: Mapping[str, Any], cam: CamSpec) -> FollowerSpec
         if ftype == "flat" or motion == "oscillating":
             v.add("follower.type", ftype, "a translating cam drives a translating roller follower",
                   'use type = "roller", motion = "translating"')
+    elif cam.kind in ("constant_width", "constant_diameter"):
+        want = "flat" if cam.kind == "constant_width" else "roller"
+        if ftype != want or motion != "translating":
+            v.add("follower.type", ftype, f"a {cam.kind.replace('_', '-')} cam has a double translating {want} "
+                  "follower", f'use type = "{want}", motion = "translating"')
+        need = ("base_radius_mm",) + (("roller_radius_mm",) if want == "roller" else ())
+        if "width_mm" in t and "follower_distance_mm" in t:
+            v.add("follower.follower_distance_mm", t["follower_distance_mm"],
+                  "give the constant width once", "keep width_mm and remove follower_distance_mm")
+        elif vals["width_mm"] is None:
+            vals["width_mm"] = vals["follower_distance_mm"]
+        if vals["width_mm"] is None and "width_mm" not in t and "follower_distance_mm" not in t:
+            v.add("follower.width_mm", None, f"is required for a {cam.kind} cam",
+                  "add width_mm = <mm> (the constant width, > 2·base_radius_mm)")
     else:
         need = _REQUIRED[(ftype, motion)]
+        if cam.kind == "conjugate":
+            if ftype == "knife":
+                v.add("follower.type", ftype, "conjugate cams have roller or flat followers",
+                      'use type = "roller" or "flat"')
+            need = need + (("follower_distance_mm",) if motion == "translating" else ("follower_angle_deg",))
     for key in need:
         if key not in t and not (key == "roller_radius_mm" and ftype == "knife"):
             v.add(f"follower.{key}", None, f"is required for a {motion} {ftype} follower",
@@ -460,6 +480,21 @@ def _outputs(v: _Validator, t: Mapping[str, Any]) -> OutputsSpec:
     return OutputsSpec(gcode=post, **flags)
 
 
+def _symmetric_law(spec: DesignSpec):
+    """The fixed constant-width/diameter law: SHM rise, dwell, SHM return, dwell; h = width − 2·Rb."""
+    from .program import MotionProgram
+
+    f = spec.follower
+    h = (f.width_mm or 0.0) - (f.base_radius_mm or 0.0) * 2
+    r = f.rise_deg or 120.0
+    if h <= 0 or not 0 < r <= 180:
+        raise SpecError(Problem("follower.width_mm", f.width_mm,
+                                f"the width must exceed the base diameter {2 * (f.base_radius_mm or 0):g} mm and "
+                                "rise_deg lie in (0, 180]", "increase width_mm or fix rise_deg"), spec.source)
+    dwell = [("dwell", 0.0, 180.0 - r)] if r < 180.0 else []
+    return MotionProgram.from_segments([("simple_harmonic", h, r), *dwell, ("simple_harmonic", -h, r), *dwell])
+
+
 def _build_motion(spec: DesignSpec):
     from .program import SegmentInput, TWO_PI, build_program
 
@@ -469,7 +504,9 @@ def _build_motion(spec: DesignSpec):
         base = Path(spec.base_dir) if spec.base_dir else None
         return load_motion_table(spec.motion_table, base_dir=base).program()
     if spec.motion is None:
-        raise SpecError(Problem("motion", None, f"no motion law for a {spec.cam.kind} cam yet",
+        if spec.cam.kind in ("constant_width", "constant_diameter"):
+            return _symmetric_law(spec)
+        raise SpecError(Problem("motion", None, f"no motion law for a {spec.cam.kind} cam",
                                 "add [[motion]] segments"), spec.source)
     if spec.is_translating_cam:
         length = spec.follower.cam_length_mm or sum(s.span or 0.0 for s in spec.motion)

@@ -154,3 +154,47 @@ def test_cli_export_tool_too_big_is_refused(tmp_path, capsys):
 def test_cli_export_bad_tol(tmp_path, tol):
     assert main(["export", "ejemplo9rt", "--dxf", "--tol", tol, "-o", str(tmp_path / "o")]) == 2
     assert not (tmp_path / "o").exists()
+
+
+CONJ = base_design(cam={"kind": "conjugate"},
+                   follower={"type": "flat", "motion": "translating", "base_radius_mm": 45.0,
+                             "follower_distance_mm": 225.0},
+                   motion=[{"law": "double_harmonic", "lift": 100.0, "angle_deg": 180.0},
+                           {"law": "double_harmonic", "lift": -100.0, "angle_deg": 180.0}],
+                   manufacturing={"thickness_mm": 12.0, "bore_mm": 20.0, "keyway": True})
+CWIDTH = base_design(cam={"kind": "constant_width"},
+                     follower={"type": "flat", "motion": "translating", "base_radius_mm": 40.0, "width_mm": 100.0})
+del CWIDTH["motion"]
+
+
+@pytest.mark.parametrize("data", [CONJ, CWIDTH], ids=["conjugate_8DA", "constant_width"])
+@pytest.mark.parametrize("tol", [1e-2, 1e-3, 1e-4])
+def test_desmodromic_dxf_within_tol(data, tol):
+    spec = design_from_dict(data)
+    geom = geometry_from_spec(spec)
+    (art,) = build_artifacts(spec, geom, ["dxf"], tol=tol)
+    doc = ezdxf.read(io.StringIO(art.data.decode()))
+    assert not doc.audit().has_errors
+    for i, contact in enumerate(geom.profiles):
+        layer = "PROFILE" if i == 0 else f"PROFILE_{i + 1}"
+        (pl,) = doc.modelspace().query(f"LWPOLYLINE[layer=='{layer}']")
+        rows = np.array(list(pl.get_points("xyb")))
+        assert measure_deviation(rows, profile_curve(contact)).max <= tol
+
+
+@pytest.mark.slow
+def test_conjugate_step_pair(tmp_path):
+    cq = pytest.importorskip("cadquery")
+    spec = design_from_dict(CONJ)
+    geom = geometry_from_spec(spec)
+    arts = build_artifacts(spec, geom, ["step"], tol=1e-4)
+    assert [a.filename for a in arts] == ["T_cam1.step", "T_cam2.step", "T_pair.step"]
+    (tmp_path / "p.step").write_bytes(arts[-1].data)
+    pair = cq.importers.importStep(str(tmp_path / "p.step")).val()
+    assert pair.isValid() and len(pair.Solids()) == 2
+    bb = pair.BoundingBox()
+    assert bb.zmax == pytest.approx(12.0 + 2.0 + 12.0)
+    vol = sum(s.Volume() for s in pair.Solids())
+    loops = cam_shapes(geom, tol=1e-4, with_pitch=False).profiles
+    plate = PlateSpec(12.0, 20.0, True)
+    assert vol == pytest.approx(sum(plate_volume(lp, plate) for lp in loops), rel=1e-9)

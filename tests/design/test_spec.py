@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
 from camfab.design.spec import design_from_dict, load_design
@@ -154,3 +155,42 @@ def test_spec_is_immutable(design_dict):
     spec = design_from_dict(design_dict)
     with pytest.raises(AttributeError):
         spec.name = "other"  # type: ignore[misc]
+
+
+@pytest.mark.parametrize("cam, follower, field", [
+    ({"kind": "conjugate"}, {"type": "flat", "motion": "translating", "base_radius_mm": 45.0},
+     "follower.follower_distance_mm"),
+    ({"kind": "conjugate"}, {"type": "roller", "motion": "oscillating", "base_radius_mm": 45.0,
+                             "roller_radius_mm": 5.0, "pivot_distance_mm": 100.0, "arm_length_mm": 80.0},
+     "follower.follower_angle_deg"),
+    ({"kind": "constant_width"}, {"type": "flat", "motion": "translating", "base_radius_mm": 40.0},
+     "follower.width_mm"),
+    ({"kind": "constant_width"}, {"type": "roller", "motion": "translating", "base_radius_mm": 40.0,
+                                  "roller_radius_mm": 5.0, "width_mm": 100.0}, "follower.type"),
+    ({"kind": "constant_diameter"}, {"type": "roller", "motion": "oscillating", "base_radius_mm": 40.0,
+                                     "roller_radius_mm": 5.0, "width_mm": 100.0, "pivot_distance_mm": 90.0,
+                                     "arm_length_mm": 70.0}, "follower.type"),
+])
+def test_desmodromic_required_fields(cam, follower, field):
+    err = _problems(base_design(cam=cam, follower=follower))
+    assert any(p.path == field for p in err.problems), str(err)
+
+
+def test_constant_width_builds_its_own_law():
+    d = base_design(cam={"kind": "constant_width"},
+                    follower={"type": "flat", "motion": "translating", "base_radius_mm": 40.0, "width_mm": 100.0,
+                              "rise_deg": 150.0})
+    del d["motion"]
+    prog = design_from_dict(d).program()
+    x = np.linspace(0, np.pi, 721)
+    np.testing.assert_allclose(prog(x) + prog(x + np.pi), 20.0, atol=1e-12)
+    assert [round(math.degrees(s.span), 9) for s in prog.segments] == [150.0, 30.0, 150.0, 30.0]
+    d["follower"]["follower_distance_mm"] = 100.0
+    assert any(p.path == "follower.follower_distance_mm" for p in _problems(d).problems)
+
+
+def test_constant_width_too_narrow():
+    d = base_design(cam={"kind": "constant_width"},
+                    follower={"type": "flat", "motion": "translating", "base_radius_mm": 40.0, "width_mm": 70.0})
+    del d["motion"]
+    assert "follower.width_mm" in str(_problems(d))
