@@ -445,6 +445,89 @@ def cmd_verify(args: argparse.Namespace) -> int:
 cmd_verify.add_arguments = _verify_args
 
 
+_ARTIFACTS = ("dxf", "step", "stl", "gcode", "lift_table", "xlsx", "report", "drawing")
+
+
+def _outputs_override(text: str | None) -> dict:
+    """``--outputs dxf,report`` → every artifact switched on or off explicitly."""
+    if text is None:
+        return {}
+    wanted = [w.strip() for w in text.split(",") if w.strip()]
+    bad = [w for w in wanted if w not in _ARTIFACTS]
+    if bad:
+        raise UsageError(f"--outputs: '{bad[0]}' is not a valid option, must be one of: {', '.join(_ARTIFACTS)}")
+    over = {a: (a in wanted) for a in _ARTIFACTS}
+    over["gcode"] = "linuxcnc" if "gcode" in wanted else None
+    return over
+
+
+def _run_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("file", nargs="?", default=None,
+                   help="design file (TOML or xlsx) or example name; default: the built-in example ejemplo9rt")
+    p.add_argument("-o", "--output", required=True, metavar="DIR")
+    p.add_argument("--outputs", metavar="LIST", help="comma list overriding [outputs]: " + ",".join(_ARTIFACTS))
+    p.add_argument("--tol", type=float, default=None, help="export tolerance, mm (default: the design's)")
+    p.add_argument("--force", action="store_true", help="write shop artifacts even for an unacceptable design")
+
+
+@register("run", "the main job: every artifact the design's [outputs] asks for")
+def cmd_run(args: argparse.Namespace) -> int:
+    from .jobs import request_from_outputs, run_design
+    from .package import _load as load_any
+
+    path = resolve_design_path(args.file or "ejemplo9rt")
+    spec = load_any(path)
+    over = _outputs_override(args.outputs)
+    req = request_from_outputs(spec, tol=args.tol, force=args.force or None, **over)
+    if req.tol is not None:
+        _tol(spec, req.tol)
+    res = run_design(spec, args.output, req, progress=lambda m: print(f"  ... {m}", file=sys.stderr))
+    print(f"{spec.name}: verdict {res.verdict}; tolerance {res.tol:g} mm; {len(res.files)} file(s) in {args.output}")
+    for name, p in res.files.items():
+        dev = res.deviations.get(name)
+        print(f"  {name:<36}" + ("" if dev is None else f" max deviation {dev:.3g} mm"))
+    if res.withheld:
+        print(f"  withheld (verdict unacceptable, use --force): {', '.join(res.withheld)}")
+    return EXIT_CHECKS if res.verdict == "unacceptable" else EXIT_OK
+
+
+cmd_run.add_arguments = _run_args
+
+
+def _package_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("paths", nargs="+", metavar="PATH", help="design files or folders (searched recursively)")
+    p.add_argument("-o", "--output", required=True, metavar="DIR")
+    p.add_argument("--jobs", type=int, default=1, help="designs built in parallel (processes)")
+    p.add_argument("--outputs", metavar="LIST", help="comma list overriding every design's [outputs]")
+    p.add_argument("--force", action="store_true", help="write shop artifacts even for unacceptable designs")
+
+
+@register("package", "many designs in parallel: per-cam folders, index.html, manifest.json, incremental")
+def cmd_package(args: argparse.Namespace) -> int:
+    from .package import exit_status, package
+
+    if args.jobs < 1:
+        raise UsageError(f"--jobs {args.jobs}: must be at least 1")
+    missing = [p for p in args.paths if not Path(p).exists()]
+    if missing:
+        raise UsageError(f"no such file or folder: {missing[0]}")
+    over = _outputs_override(args.outputs)
+    if args.force:
+        over["force"] = True
+    manifest = package(args.paths, args.output, jobs=args.jobs, overrides=over,
+                       progress=lambda m: print(m, file=sys.stderr))
+    cams = manifest["cams"]
+    rebuilt = sum(1 for c in cams if c.get("rebuilt"))
+    bad = [c for c in cams if c.get("status") == "error"]
+    print(f"{len(cams)} design(s), {rebuilt} rebuilt, {len(bad)} failed; index: {Path(args.output) / 'index.html'}")
+    for c in bad:
+        print(f"  {c['source']}: {c['error']}", file=sys.stderr)
+    return exit_status(manifest)
+
+
+cmd_package.add_arguments = _package_args
+
+
 # ---------------------------------------------------------------------------
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="camfab", description="Cam design, checks and manufacturing files.")

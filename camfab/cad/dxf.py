@@ -54,7 +54,7 @@ def _ezdxf():
     try:
         import ezdxf
     except ImportError as exc:  # pragma: no cover
-        raise MissingDependencyError("DXF export needs the 'cad' extra: pip install camfab[cad]") from exc
+        raise MissingDependencyError("DXF export needs ezdxf: pip install ezdxf") from exc
     return ezdxf
 
 

@@ -23,7 +23,7 @@ def plate_mesh(outline: BulgeLoop, plate: PlateSpec, *, tol: float):
     try:
         import trimesh
     except ImportError as exc:  # pragma: no cover - exercised only without the extra
-        raise MissingDependencyError("STL export needs the 'cad' extra: pip install camfab[cad]") from exc
+        raise MissingDependencyError("STL export needs trimesh and mapbox_earcut: pip install trimesh mapbox_earcut") from exc
     if plate.hub_diameter_mm and plate.hub_length_mm:
         raise GeometryError("STL export of a plate with a hub is not supported yet; "
                             "remove manufacturing.hub_diameter_mm for the STL or use STEP")

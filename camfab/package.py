@@ -1,0 +1,233 @@
+"""Drawing packages: many designs in parallel, a manifest, an index, incremental rebuilds.
+
+``package(paths, out)`` finds the designs (``*.toml`` and ``*.xlsx`` files, folders
+searched recursively), runs each design's job (:mod:`camfab.jobs`) in its own
+folder ``out/<name>/`` on a process pool, and writes ``out/manifest.json`` (each
+file's sha256 and size, measured deviation, tolerance, verdict, stage timings)
+and ``out/index.html``.
+
+Incremental: each cam's *input key* hashes its design file, the files it
+references (knot tables), the camfab version, the shipped templates and the
+job options.  A cam whose key is unchanged and whose files are all present with
+their recorded hashes is not rebuilt.  A design that fails is recorded with its
+error (in the manifest, the index and the exit status) without stopping the
+others.
+"""
+from __future__ import annotations
+
+import hashlib
+import html
+import json
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+from typing import Callable, Iterable
+
+from . import __version__
+from .io import atomic_write
+from .jobs import JobRequest
+
+__all__ = ["discover", "input_key", "package", "exit_status", "MANIFEST", "INDEX"]
+
+MANIFEST = "manifest.json"
+INDEX = "index.html"
+_TEMPLATES = Path(__file__).parent / "templates"
+
+
+def discover(paths: Iterable[str | Path]) -> list[Path]:
+    """Design files named directly or found (recursively) in folders, sorted, de-duplicated."""
+    found: list[Path] = []
+    for p in map(Path, paths):
+        if p.is_dir():
+            found += sorted(q for q in p.rglob("*") if q.suffix in (".toml", ".xlsx") and q.is_file())
+        else:
+            found.append(p)
+    seen, out = set(), []
+    for p in found:
+        r = p.resolve()
+        if r not in seen:
+            seen.add(r)
+            out.append(p)
+    return out
+
+
+def _sha(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+def _templates_hash() -> str:
+    h = hashlib.sha256()
+    for f in sorted(_TEMPLATES.rglob("*")):
+        if f.is_file() and "examples" not in f.parts:
+            h.update(str(f.relative_to(_TEMPLATES)).encode())
+            h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+def input_key(path: Path, options: dict, templates: str) -> str:
+    """Hash of everything a cam's outputs depend on (see the module docstring)."""
+    h = hashlib.sha256()
+    data = path.read_bytes()
+    h.update(data)
+    for ref in _referenced_files(path, data):
+        h.update(ref.name.encode())
+        h.update(ref.read_bytes() if ref.exists() else b"<missing>")
+    h.update(__version__.encode())
+    h.update(templates.encode())
+    h.update(json.dumps(options, sort_keys=True, default=str).encode())
+    return h.hexdigest()
+
+
+def _referenced_files(path: Path, data: bytes) -> list[Path]:
+    if path.suffix != ".toml":
+        return []
+    import tomllib
+
+    try:
+        table = tomllib.loads(data.decode("utf-8")).get("motion_table", {})
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError):
+        return []
+    f = table.get("file") if isinstance(table, dict) else None
+    return [path.parent / f] if isinstance(f, str) else []
+
+
+def _load(path: Path):
+    if path.suffix == ".xlsx":
+        from .design.xlsx_design import load_design_xlsx
+
+        return load_design_xlsx(path)
+    from .design.spec import load_design
+
+    return load_design(path)
+
+
+def _build(args: tuple) -> dict:
+    """Worker: build one design into its folder; never raises (errors go into the entry)."""
+    path, out, overrides, key = args
+    from .errors import CamfabError
+    from .jobs import request_from_outputs, run_design
+
+    t0 = time.perf_counter()
+    entry = {"source": str(path), "key": key, "rebuilt": True}
+    try:
+        spec = _load(Path(path))
+        entry["name"] = spec.name
+        folder = Path(out) / _folder_name(spec.name)
+        req = request_from_outputs(spec, **overrides)
+        res = run_design(spec, folder, req)
+        entry.update(status="unacceptable" if res.verdict == "unacceptable" else "ok", verdict=res.verdict,
+                     tolerance_mm=res.tol, withheld=res.withheld, timings=res.timings,
+                     folder=str(folder.relative_to(out)),
+                     files=[_file_entry(p, Path(out), res.deviations.get(n)) for n, p in sorted(res.files.items())])
+    except (CamfabError, OSError, ValueError) as exc:
+        entry.update(status="error", verdict=None, error=str(exc), files=[],
+                     error_type=type(exc).__name__)
+        entry.setdefault("name", Path(path).stem)
+    entry["seconds"] = time.perf_counter() - t0
+    return entry
+
+
+def _folder_name(name: str) -> str:
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) or "cam"
+
+
+def _file_entry(p: Path, out: Path, dev) -> dict:
+    data = p.read_bytes()
+    return {"path": str(p.relative_to(out)), "sha256": _sha(data), "bytes": len(data), "deviation_mm": dev}
+
+
+def _still_valid(entry: dict, out: Path) -> bool:
+    if entry.get("status") == "error" or not entry.get("files"):
+        return False
+    for f in entry["files"]:
+        p = out / f["path"]
+        if not p.is_file() or _sha(p.read_bytes()) != f["sha256"]:
+            return False
+    return True
+
+
+def package(paths: Iterable[str | Path], out: str | Path, *, jobs: int = 1, overrides: dict | None = None,
+            progress: Callable[[str], None] | None = None) -> dict:
+    """Build every design; returns the manifest (also written to ``out/manifest.json``)."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    say = progress or (lambda m: None)
+    overrides = overrides or {}
+    designs = discover(paths)
+    old = _old_entries(out)
+    templates = _templates_hash()
+    opts = JobRequest(**{k: v for k, v in overrides.items()}).key() if overrides else {}
+    todo, entries = [], {}
+    for p in designs:
+        key = input_key(p, opts, templates) if p.is_file() else "missing"
+        prev = old.get(str(p))
+        if prev and prev.get("key") == key and _still_valid(prev, out):
+            entries[str(p)] = {**prev, "rebuilt": False}
+            say(f"[up to date] {prev.get('name', p.stem)}")
+        else:
+            todo.append((str(p), str(out), overrides, key))
+    t0 = time.perf_counter()
+    done = 0
+    for entry in _map(_build, todo, jobs):
+        done += 1
+        entries[entry["source"]] = entry
+        tail = entry.get("verdict") or f"ERROR: {entry.get('error', '').splitlines()[0]}"
+        say(f"[{done}/{len(todo)}] {entry['name']}: {tail} ({entry['seconds']:.2f} s)")
+    manifest = {"camfab_version": __version__, "jobs": jobs, "wall_seconds": time.perf_counter() - t0,
+                "cams": [entries[str(p)] for p in designs]}
+    _dedupe_folders(manifest)
+    atomic_write(out / MANIFEST, json.dumps(manifest, indent=2) + "\n")
+    atomic_write(out / INDEX, _index_html(manifest))
+    return manifest
+
+
+def _map(fn, items: list, jobs: int):
+    if jobs <= 1 or len(items) <= 1:
+        yield from map(fn, items)
+        return
+    with ProcessPoolExecutor(max_workers=min(jobs, len(items), os.cpu_count() or 1)) as pool:
+        yield from pool.map(fn, items)
+
+
+def _old_entries(out: Path) -> dict:
+    try:
+        data = json.loads((out / MANIFEST).read_text(encoding="utf-8"))
+        return {e["source"]: e for e in data.get("cams", []) if "source" in e}
+    except (OSError, ValueError, KeyError, TypeError):
+        return {}
+
+
+def _dedupe_folders(manifest: dict) -> None:
+    seen: dict[str, str] = {}
+    for e in manifest["cams"]:
+        f = e.get("folder")
+        if f is None:
+            continue
+        if f in seen:
+            e["status"] = "error"
+            e["error"] = (f"design name '{e.get('name')}' is also used by {seen[f]}: both write to {f}/; "
+                          "give the designs different names")
+        seen[f] = e["source"]
+
+
+def exit_status(manifest: dict) -> int:
+    """2 if any design is invalid, else 1 if any is unacceptable, else 0."""
+    st = [e.get("status") for e in manifest["cams"]]
+    return 2 if "error" in st else 1 if "unacceptable" in st else 0
+
+
+def _index_html(manifest: dict) -> str:
+    from jinja2 import Environment, select_autoescape
+
+    env = Environment(autoescape=select_autoescape(default=True))
+    tpl = env.from_string((_TEMPLATES / "package" / "index.html.j2").read_text(encoding="utf-8"))
+    rows = []
+    for e in manifest["cams"]:
+        files = {Path(f["path"]).name: f["path"] for f in e.get("files", [])}
+        rows.append({"name": e.get("name"), "source": e.get("source"), "status": e.get("status"),
+                     "verdict": e.get("verdict"), "error": e.get("error"),
+                     "report": files.get("report.html"), "files": sorted(files.values()),
+                     "withheld": e.get("withheld", [])})
+    return tpl.render(rows=rows, version=manifest["camfab_version"], escape=html.escape)
+
