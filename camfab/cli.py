@@ -248,6 +248,8 @@ def _export_args(p: argparse.ArgumentParser) -> None:
                    help="max distance of every entity from the exact profile, mm (default: the design's, 0.001)")
     p.add_argument("--dxf-flavour", choices=("lwpolyline", "r12"), default="lwpolyline",
                    help="LWPOLYLINE with bulges (default) or R12 LINE/ARC entities")
+    p.add_argument("--tool-path", action="store_true",
+                   help="add the tool-centre path of [manufacturing] tool_diameter_mm to the DXF (TOOL_PATH layer)")
     p.add_argument("--force", action="store_true", help="export even if the design's verdict is unacceptable")
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="output folder")
 
@@ -276,7 +278,7 @@ def cmd_export(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return EXIT_CHECKS
     geom = geometry_from_spec(spec)
-    arts = build_artifacts(spec, geom, formats, tol=tol, dxf_flavour=args.dxf_flavour,
+    arts = build_artifacts(spec, geom, formats, tol=tol, dxf_flavour=args.dxf_flavour, tool_paths=args.tool_path,
                            progress=lambda m: print(f"  ... {m}", file=sys.stderr))
     paths = write_artifacts(arts, args.output)
     print(f"{spec.name}: verdict {report.verdict}, tolerance {tol:g} mm")

@@ -109,7 +109,8 @@ def run_design(spec, outdir: str | Path, req: JobRequest, *,
     if cad:
         from .cad.export import build_artifacts
 
-        for a in timed("cad", build_artifacts, spec, geom, cad, tol=tol, dxf_flavour=req.dxf_flavour):
+        for a in timed("cad", build_artifacts, spec, geom, cad, tol=tol, dxf_flavour=req.dxf_flavour,
+                       tool_paths=bool(req.gcode)):
             files[a.filename] = a.data
             res.deviations[a.filename] = a.deviation_mm
     if req.drawing:

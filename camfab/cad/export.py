@@ -82,7 +82,7 @@ def _suffix(i: int, n: int) -> str:
 
 
 def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_flavour: str = "lwpolyline",
-                    progress: Callable[[str], None] | None = None) -> list[Artifact]:
+                    tool_paths: bool = False, progress: Callable[[str], None] | None = None) -> list[Artifact]:
     """Build the requested artifacts in memory.
 
     Parameters
@@ -92,6 +92,8 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
     formats : iterable of {"dxf", "step", "stl"}
     tol : float
         Maximum distance (mm) between every written entity and the exact profile.
+    tool_paths : bool
+        Add the tool-centre paths (``[manufacturing] tool_diameter_mm``) on the DXF's TOOL_PATH layer.
     """
     say = progress or (lambda msg: None)
     formats = [f for f in FORMATS if f in set(formats)]
@@ -102,7 +104,7 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
     n = len(shapes.profiles)
     if "dxf" in formats:
         say("DXF")
-        out.append(_dxf(spec, geometry, shapes, plate, tol, dxf_flavour))
+        out.append(_dxf(spec, geometry, shapes, plate, tol, dxf_flavour, tool_paths))
     if "stl" in formats:
         from . import stl
 
@@ -130,11 +132,12 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
     return out
 
 
-def _dxf(spec, geometry, shapes: CamShapes, plate: PlateSpec, tol: float, flavour: str) -> Artifact:
+def _dxf(spec, geometry, shapes: CamShapes, plate: PlateSpec, tol: float, flavour: str,
+         tool_paths: bool) -> Artifact:
     f = spec.follower
     tools = ()
     tool_d = spec.manufacturing.tool_diameter_mm
-    if tool_d:
+    if tool_paths and tool_d:
         tools = tuple(_loop(tool_centre_path(c, tool_d / 2, tol=tol).arcs) for c in geometry.profiles)
     rr = f.roller_radius_mm or 0.0
     content = dxf_mod.DxfContent(

@@ -73,6 +73,15 @@ class Segment:
     s0: float
     coeffs: tuple[float, ...] | None = None
     title: str = ""
+    _dcoeffs: tuple = field(default=(), repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        if self.coeffs is not None:  # derivative coefficients, computed once
+            c = np.asarray(self.coeffs, dtype=float)
+            ders = [c]
+            for _ in range(5):
+                ders.append(np.polynomial.polynomial.polyder(ders[-1]) if ders[-1].size > 1 else np.zeros(1))
+            object.__setattr__(self, "_dcoeffs", tuple(ders))
 
     @property
     def end(self) -> float:
@@ -86,8 +95,7 @@ class Segment:
     def du(self, u: np.ndarray, nu: int) -> np.ndarray:
         """``nu``-th derivative of S with respect to ``u`` (absolute units)."""
         if self.coeffs is not None:
-            c = np.polynomial.polynomial.polyder(self.coeffs, nu) if nu else self.coeffs
-            return np.polynomial.polynomial.polyval(u, c)
+            return np.polynomial.polynomial.polyval(u, self._dcoeffs[nu])
         out = self.lift * LAWS[self.law](u, nu)
         return out + self.s0 if nu == 0 else out
 
@@ -243,10 +251,12 @@ class MotionProgram:
         xr = np.mod(xa, self.period)
         idx = self.segment_index(xr)
         out = np.empty((len(orders), xr.size))
-        for k, seg in enumerate(self.segments):
-            sel = np.flatnonzero(idx == k)
-            if sel.size == 0:
-                continue
+        # group the samples by segment (stable counting sort) and visit only the segments hit
+        order = np.argsort(idx.astype(np.int16), kind="stable")
+        bounds = np.searchsorted(idx[order], np.arange(len(self.segments) + 1))
+        for k in np.flatnonzero(bounds[1:] > bounds[:-1]):
+            seg = self.segments[k]
+            sel = order[bounds[k]:bounds[k + 1]]
             u = (xr[sel] - seg.start) / seg.span
             for row, nu in enumerate(orders):
                 out[row, sel] = seg.values(u, nu)

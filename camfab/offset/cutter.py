@@ -27,6 +27,9 @@ __all__ = ["profile_curve", "pitch_curve", "offset_curve", "concave_limit", "Too
 #: shapely buffer resolution (segments per quarter circle) and join style, always explicit
 QUAD_SEGS = 64
 JOIN_STYLE = "round"
+#: the shapely cross-check works on a polyline of the profile; below this tolerance (mm) it checks
+#: at this resolution (the exact offset itself is still fitted to the requested tolerance)
+SHAPELY_CHECK_MIN_MM = 1e-5
 
 
 def _deg(contact, x):
@@ -159,13 +162,14 @@ def tool_centre_path(contact, tool_radius: float, *, tol: float = DEFAULT_EXPORT
     _refuse_if_too_big(contact, tool_radius, label)
     exact = offset_curve(contact, tool_radius)
     fit = arcs(exact, tol=tol)
-    base = polyline(profile_curve(contact), tol=tol / 4)
+    check_tol = max(tol, SHAPELY_CHECK_MIN_MM)
+    base = polyline(profile_curve(contact), tol=check_tol / 4)
     buffered = shapely_offset(base.points[:-1], tool_radius)
     ring = np.asarray(buffered.exterior.coords)
     dev = float(measure_deviation(ring, exact).max)
-    if dev > tol:
-        raise GeometryError(f"{label}the shapely offset differs from the exact offset by {dev:.3g} mm (> tol "
-                            f"{tol:g} mm); the offset is ill-conditioned at this tool radius")
+    if dev > check_tol:
+        raise GeometryError(f"{label}the shapely offset differs from the exact offset by {dev:.3g} mm (> "
+                            f"{check_tol:g} mm); the offset is ill-conditioned at this tool radius")
     return ToolCentrePath(exact, fit, tool_radius, dev, tol)
 
 

@@ -144,7 +144,7 @@ def test_cli_export_tool_too_big_is_refused(tmp_path, capsys):
     d.write_text((EXAMPLES / "ejemplo9rt.toml").read_text().replace("tool_diameter_mm = 6.0",
                                                                       "tool_diameter_mm = 100.0"))
     out = tmp_path / "out"
-    assert main(["export", str(d), "--dxf", "-o", str(out)]) == 2
+    assert main(["export", str(d), "--dxf", "--tool-path", "-o", str(out)]) == 2
     err = capsys.readouterr().err
     assert "largest cutter" in err and "47.5" in err and "°" in err
     assert not out.exists()
