@@ -475,10 +475,8 @@ def _run_args(p: argparse.ArgumentParser) -> None:
 @register("run", "the main job: every artifact the design's [outputs] asks for")
 def cmd_run(args: argparse.Namespace) -> int:
     from .jobs import request_from_outputs, run_design
-    from .package import _load as load_any
 
-    path = resolve_design_path(args.file or "ejemplo9rt")
-    spec = load_any(path)
+    spec = _load(args.file or "ejemplo9rt")
     over = _outputs_override(args.outputs)
     req = request_from_outputs(spec, tol=args.tol, force=args.force or None, **over)
     if req.tol is not None:

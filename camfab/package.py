@@ -93,10 +93,6 @@ def _referenced_files(path: Path, data: bytes) -> list[Path]:
 
 
 def _load(path: Path):
-    if path.suffix == ".xlsx":
-        from .design.xlsx_design import load_design_xlsx
-
-        return load_design_xlsx(path)
     from .design.spec import load_design
 
     return load_design(path)

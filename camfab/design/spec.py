@@ -178,7 +178,8 @@ class DesignSpec:
 
 # ---------------------------------------------------------------------------
 def load_design(path: str | Path) -> DesignSpec:
-    """Read and validate a TOML design file.
+    """Read and validate a design file: TOML, or an xlsx workbook (``*.xlsx``, see
+    :mod:`camfab.design.xlsx_design`).
 
     Raises
     ------
@@ -186,6 +187,10 @@ def load_design(path: str | Path) -> DesignSpec:
         On unreadable or invalid files; every problem found is listed.
     """
     p = Path(path)
+    if p.suffix.lower() == ".xlsx":
+        from .xlsx_design import load_design_xlsx
+
+        return load_design_xlsx(p)
     try:
         text = p.read_text(encoding="utf-8")
     except FileNotFoundError:

@@ -1,0 +1,454 @@
+"""Manufacturing drawing sheet (DXF): the cam plate dimensioned on an A4/A3 frame with a title block.
+
+The sheet is drawn in **paper millimetres** in model space: the cam is placed
+at a standard scale (ISO 5455: 10:1 … 1:100) with its centre in the middle of
+the view area, and every DIMENSION carries ``dimlfac = 1/scale`` so CAD shows
+true sizes.  The frame, title block, notes column and lift-table sizes come
+from ``templates/drawing/title_block.toml`` (data, loaded through
+:mod:`importlib.resources`).
+
+Layout (landscape)
+------------------
+* frame with a 20 mm filing margin; title block in the bottom-right corner;
+* a notes column on the left (material, thickness, bore/keyway, tolerance,
+  units and scale, rotation sense, zero-angle reference, follower, verdict);
+* the lift table on the right above the title block, split into side-by-side
+  column groups when it is taller than the space;
+* the cam view between them: profile(s) (arc-fitted bulge loops, layer
+  ``PROFILE``), bore and keyway (``BORE``), base circle and — for rollers —
+  prime circle (thin phantom/centre lines), centre lines and centre mark, a
+  0° mark on +Y, a rotation arrow, and DIMENSION entities: base-circle
+  diameter, DMAX radius, bore diameter and, with a keyway, its width and the
+  ``d + t2`` depth.
+
+Paper and scale
+---------------
+``paper="auto"`` tries A4 then A3 and keeps the sheet giving the larger
+scale, counting any enlargement beyond 1:1 as 1:1 (so a cam that fits A4 at
+1:1 stays on A4, and a large cam moves to A3 rather than shrinking further);
+ties go to A4.  On the chosen paper the largest standard scale at which the
+cam (plus a dimension clearance) fits the view is used.
+
+The output is deterministic (ezdxf's fixed-metadata mode, as in
+:mod:`camfab.cad.dxf`).  The scale and the cam-centre position are recorded
+as header custom properties ``CAMFAB_SCALE`` and ``CAMFAB_CENTRE`` so the
+true-size geometry can be recovered: ``true = (paper − centre) / scale``.
+"""
+from __future__ import annotations
+
+import functools
+import io
+import math
+import tomllib
+from dataclasses import dataclass
+from importlib import resources
+from typing import Any
+
+import numpy as np
+
+from ..errors import ExportError, GeometryError
+from .dxf import _EZDXF_STAMP, _ezdxf
+from .plate import BulgeLoop, bore_loop, keyway_size
+
+__all__ = ["PAPERS", "LAYERS", "SheetLayout", "load_template", "sheet_layout", "parse_scale", "drawing_sheet",
+           "build_drawing", "title_fields", "notes_text"]
+
+PAPERS = ("A4", "A3")
+#: layer -> (ACI colour, linetype, lineweight in 1/100 mm)
+LAYERS = {
+    "FRAME": (7, "Continuous", 70), "TITLE_BLOCK": (7, "Continuous", 35), "PROFILE": (7, "Continuous", 50),
+    "BORE": (7, "Continuous", 50), "BASE_CIRCLE": (3, "PHANTOM", 18), "PRIME_CIRCLE": (1, "CENTER", 18),
+    "CENTRE_LINES": (8, "CENTER", 18), "CENTRE_MARKS": (8, "Continuous", 18), "DIMENSIONS": (4, "Continuous", 18),
+    "LIFT_TABLE": (7, "Continuous", 25), "NOTES": (7, "Continuous", 25), "ANNOTATION": (6, "Continuous", 25),
+}
+
+
+@functools.lru_cache(maxsize=1)
+def load_template() -> dict[str, Any]:
+    """The title-block template (``camfab/templates/drawing/title_block.toml``) as a dict."""
+    text = resources.files("camfab").joinpath("templates", "drawing", "title_block.toml").read_text("utf-8")
+    return tomllib.loads(text)
+
+
+def parse_scale(label: str) -> float:
+    """``"1:2"`` → 0.5, ``"2:1"`` → 2.0 (drawing length per true length)."""
+    a, b = label.split(":")
+    return float(a) / float(b)
+
+
+@dataclass(frozen=True)
+class SheetLayout:
+    """Where everything goes on the sheet (paper mm, origin at the sheet's lower-left corner).
+
+    Boxes are ``(x0, y0, x1, y1)``.  ``fits`` is False when even the smallest
+    scale does not fit the view (the cam is then drawn at that scale anyway).
+    """
+
+    paper: str
+    size: tuple[float, float]
+    scale: float
+    scale_label: str
+    centre: tuple[float, float]
+    frame: tuple[float, float, float, float]
+    title: tuple[float, float, float, float]
+    table: tuple[float, float, float, float]
+    table_groups: int
+    table_rows: int
+    notes: tuple[float, float, float, float]
+    view: tuple[float, float, float, float]
+    fits: bool
+
+
+def _layout_on(paper: str, extent_mm: float, n_rows: int, tpl: dict[str, Any]) -> SheetLayout:
+    w, h = tpl["paper"][paper]["width_mm"], tpl["paper"][paper]["height_mm"]
+    fr, gap = tpl["frame"], tpl["frame"]["gap_mm"]
+    fx0, fy0, fx1, fy1 = fr["left_mm"], fr["bottom_mm"], w - fr["right_mm"], h - fr["top_mm"]
+    tb = tpl["title_block"]
+    title = (fx1 - tb["width_mm"], fy0, fx1, fy0 + tb["height_mm"])
+    lt = tpl["lift_table"]
+    rh, colw = lt["row_height_mm"], sum(lt["column_widths_mm"])
+    avail = fy1 - title[3] - gap
+    per_group = max(1, int(math.floor(avail / rh - 2.5)))
+    groups = max(1, math.ceil(n_rows / per_group))
+    rows = math.ceil(n_rows / groups)
+    table = (fx1 - groups * colw, fy1 - (rows + 2.5) * rh, fx1, fy1)
+    notes = (fx0, fy0, fx0 + tpl["notes"]["width_mm"], fy1)
+    view = (notes[2] + gap, title[3] + gap, table[0] - gap, fy1)
+    room = min(view[2] - view[0], view[3] - view[1]) / 2 - tpl["view"]["clearance_mm"]
+    labels = tpl["view"]["scales"]
+    fits = [s for s in labels if extent_mm * parse_scale(s) <= room]
+    label = fits[0] if fits else labels[-1]
+    centre = ((view[0] + view[2]) / 2, (view[1] + view[3]) / 2)
+    return SheetLayout(paper, (w, h), parse_scale(label), label, centre, (fx0, fy0, fx1, fy1), title, table,
+                       groups, rows, notes, view, bool(fits))
+
+
+def sheet_layout(extent_mm: float, n_rows: int, paper: str = "auto") -> SheetLayout:
+    """Choose paper and scale for a cam of outer radius ``extent_mm`` and a lift table of ``n_rows`` rows.
+
+    Parameters
+    ----------
+    extent_mm : float
+        Largest distance of the cam outline from its centre (true mm).
+    n_rows : int
+        Data rows of the lift table.
+    paper : {"auto", "A4", "A3"}
+
+    Raises
+    ------
+    ValueError
+        An unknown paper name.
+    """
+    if paper != "auto" and paper not in PAPERS:
+        raise ValueError(f"'{paper}' is not a valid paper, must be one of: auto, {', '.join(PAPERS)}")
+    tpl = load_template()
+    if paper != "auto":
+        return _layout_on(paper, extent_mm, n_rows, tpl)
+    options = [_layout_on(p, extent_mm, n_rows, tpl) for p in PAPERS]
+    return max(options, key=lambda lay: (lay.fits, min(lay.scale, 1.0), -PAPERS.index(lay.paper)))
+
+
+# ---------------------------------------------------------------------------
+def _text(msp, text: str, at, height: float, layer: str, align: str = "BOTTOM_LEFT", width: float | None = None):
+    from ezdxf.enums import TextEntityAlignment
+
+    tpl = load_template()
+    if width is not None and text:
+        height = max(1.0, min(height, width / (tpl["text"]["width_factor"] * len(text))))
+    t = msp.add_text(text, height=height, dxfattribs={"layer": layer})
+    t.set_placement((float(at[0]), float(at[1])), align=TextEntityAlignment[align])
+    return t
+
+
+def _rect(msp, box, layer: str) -> None:
+    x0, y0, x1, y1 = box
+    msp.add_lwpolyline([(x0, y0), (x1, y0), (x1, y1), (x0, y1)], close=True, dxfattribs={"layer": layer})
+
+
+def _place(loop: BulgeLoop, scale: float, centre) -> list[tuple[float, float, float, float, float]]:
+    pts = loop.points * scale + np.asarray(centre)
+    return [(float(x), float(y), 0.0, 0.0, float(b)) for (x, y), b in zip(pts, loop.bulges)]
+
+
+def _fmt(v: float, dec: int = 3) -> str:
+    s = f"{v:.{dec}f}"
+    return s[1:] if s.startswith("-") and float(s) == 0 else s
+
+
+def title_fields(spec, report, layout: SheetLayout) -> dict[str, str]:
+    """The values written into the title block, keyed by template field."""
+    from .. import __version__
+
+    return {"name": spec.name, "material": spec.manufacturing.material or "to be specified",
+            "scale": layout.scale_label, "units": "mm", "tolerance": f"±{spec.manufacturing.tolerance_mm:g} mm",
+            "verdict": report.verdict, "date": "", "drawn_by": f"camfab {__version__}", "paper": layout.paper,
+            "sheet": "1 / 1", "checked": ""}
+
+
+def notes_text(spec, geometry, report, shapes, layout: SheetLayout) -> list[str]:
+    """The numbered notes (one string per note)."""
+    m, f = spec.manufacturing, spec.follower
+    sense = "CLOCKWISE" if spec.cam.rotation == "cw" else "COUNTER-CLOCKWISE"
+    bore = "no bore"
+    if m.bore_mm > 0:
+        bore = f"bore Ø{m.bore_mm:g} mm"
+        if m.keyway:
+            b, t2 = keyway_size(m.bore_mm)
+            bore += f" with keyway DIN 6885-1 b = {b:g} mm, t2 = {t2:g} mm (d + t2 = {m.bore_mm + t2:g} mm) on +Y"
+    if f.type == "flat":
+        fol = f"{f.motion} flat-face follower"
+    else:
+        fol = f"{f.motion} {'knife-edge' if f.type == 'knife' else 'roller'} follower"
+        if f.type == "roller":
+            fol += f", roller Ø{2 * (f.roller_radius_mm or 0.0):g} mm"
+    if f.motion == "oscillating":
+        fol += f", pivot at {f.pivot_distance_mm:g} mm on +X"
+        if f.arm_length_mm:
+            fol += f", arm {f.arm_length_mm:g} mm"
+    elif f.type != "flat" and f.offset_mm:
+        fol += f", offset {f.offset_mm:g} mm"
+    radius_word = "roller-centre distance (pitch radius)" if f.type != "flat" else "face distance"
+    dev = max(shapes.profile_deviation) if shapes.profile_deviation else 0.0
+    errors = [x for x in report.findings if x.severity == "error"]
+    verdict = f"Check verdict: {report.verdict}"
+    if errors:
+        verdict += " — " + "; ".join(sorted({x.code for x in errors}))
+    elif report.verdict == "not_for_high_speed":
+        verdict += " — jerk discontinuity, not for high speeds"
+    return [
+        f"Material: {m.material or 'to be specified'}.",
+        f"Plate thickness {m.thickness_mm:g} mm; {bore}.",
+        f"Profile tolerance ±{m.tolerance_mm:g} mm; drawn arcs lie within {dev:.2g} mm of the exact profile.",
+        f"All dimensions in mm (true size); scale {layout.scale_label}.",
+        f"The cam rotates {sense} as drawn.",
+        "Zero-angle reference: at cam angle 0° the follower axis is +Y (up on this sheet, marked 0°); "
+        "the lift table gives the follower lift after the cam has turned by the angle in its sense of rotation.",
+        f"Follower: {fol}.",
+        f"Base radius R_b = {f.base_radius_mm:g} mm; largest radius DMAX = {geometry.max_radius:.3f} mm.",
+        f"Lift table: lift in {'degrees of arm rotation' if f.motion == 'oscillating' else 'mm'}; "
+        f"RADIUS = {radius_word} from the cam centre (mm).",
+        verdict + ".",
+    ]
+
+
+def _title_block(msp, layout: SheetLayout, fields: dict[str, str]) -> None:
+    tpl = load_template()
+    x0, y0, x1, y1 = layout.title
+    _rect(msp, layout.title, "TITLE_BLOCK")
+    th = tpl["text"]
+    for cell in tpl["title_block"]["cells"]:
+        if cell["field"] not in fields:
+            raise ExportError(f"title-block template field '{cell['field']}' is unknown; "
+                              f"use one of: {', '.join(fields)}")
+        cx, cy = x0 + cell["x_mm"], y0 + cell["y_mm"]
+        cw, ch = cell["width_mm"], cell["height_mm"]
+        _rect(msp, (cx, cy, cx + cw, cy + ch), "TITLE_BLOCK")
+        _text(msp, cell["label"], (cx + 1.0, cy + ch - 1.0), th["label_height_mm"], "TITLE_BLOCK", "TOP_LEFT")
+        value = fields[cell["field"]]
+        if value:
+            h = th["title_height_mm"] if cell.get("large") else th["value_height_mm"]
+            _text(msp, value, (cx + 1.5, cy + 1.5), h, "TITLE_BLOCK", "BOTTOM_LEFT", width=cw - 3.0)
+
+
+def _lift_table(msp, layout: SheetLayout, table, closed: bool) -> None:
+    tpl = load_template()["lift_table"]
+    rh, widths, h = tpl["row_height_mm"], tpl["column_widths_mm"], tpl["text_height_mm"]
+    x0, y0, x1, y1 = layout.table
+    _rect(msp, layout.table, "LIFT_TABLE")
+    step = float(table.angle[1] - table.angle[0]) if len(table.angle) > 1 else 360.0
+    unit = "°" if table.lift_unit == "deg" else "mm"
+    _text(msp, f"LIFT TABLE (step {step:g}{'°' if closed else ' mm'})", ((x0 + x1) / 2, y1 - 0.75 * rh),
+          h, "LIFT_TABLE", "MIDDLE_CENTER", width=x1 - x0 - 2)
+    msp.add_line((x0, y1 - 1.5 * rh), (x1, y1 - 1.5 * rh), dxfattribs={"layer": "LIFT_TABLE"})
+    heads = ("ANGLE °" if closed else "TRAVEL mm", f"LIFT {unit}", "RADIUS mm")
+    gw = sum(widths)
+    lift_dec = 4 if table.lift_unit == "deg" else 3
+    for g in range(layout.table_groups):
+        gx = x0 + g * gw
+        if g:
+            msp.add_line((gx, y0), (gx, y1 - 1.5 * rh), dxfattribs={"layer": "LIFT_TABLE"})
+        xs = np.cumsum([gx] + list(widths))
+        for k in range(1, 3):
+            msp.add_line((xs[k], y0), (xs[k], y1 - 1.5 * rh), dxfattribs={"layer": "LIFT_TABLE"})
+        ytop = y1 - 1.5 * rh
+        for k, text in enumerate(heads):
+            _text(msp, text, ((xs[k] + xs[k + 1]) / 2, ytop - rh / 2), h, "LIFT_TABLE", "MIDDLE_CENTER",
+                  width=widths[k] - 1)
+        msp.add_line((gx, ytop - rh), (gx + gw, ytop - rh), dxfattribs={"layer": "LIFT_TABLE"})
+        rows = range(g * layout.table_rows, min(len(table.angle), (g + 1) * layout.table_rows))
+        for j, i in enumerate(rows):
+            yc = ytop - rh * (j + 1.5)
+            vals = (f"{table.angle[i]:g}", _fmt(table.lift[i], lift_dec), _fmt(table.radius[i]))
+            for k, text in enumerate(vals):
+                _text(msp, text, ((xs[k] + xs[k + 1]) / 2, yc), h, "LIFT_TABLE", "MIDDLE_CENTER",
+                      width=widths[k] - 1)
+
+
+def _notes(msp, layout: SheetLayout, notes: list[str]) -> None:
+    tpl = load_template()["notes"]
+    x0, y0, x1, y1 = layout.notes
+    h = tpl["text_height_mm"]
+    _text(msp, "NOTES", (x0 + 2, y1 - 2), 3.5, "NOTES", "TOP_LEFT")
+    body = "\\P".join(f"{i}. {n}" for i, n in enumerate(notes, 1))
+    mt = msp.add_mtext(body, dxfattribs={"layer": "NOTES", "char_height": h, "width": x1 - x0 - 4,
+                                         "insert": (x0 + 2, y1 - 8), "attachment_point": 1})
+    mt.dxf.line_spacing_factor = 1.2
+
+
+def _dimstyle(doc, tpl) -> None:
+    d = tpl["dimensions"]
+    doc.dimstyles.new("CAMFAB", dxfattribs={
+        "dimtxt": d["text_height_mm"], "dimasz": d["arrow_size_mm"], "dimexe": 1.25, "dimexo": 0.625,
+        "dimgap": 0.625, "dimdec": d["decimals"], "dimtxsty": "Standard", "dimzin": 8, "dimdsep": ord("."),
+        "dimtad": 1, "dimtih": 0, "dimtoh": 0, "dimtofl": 1, "dimclrd": 4, "dimclre": 4, "dimclrt": 4})
+
+
+def _dimensions(msp, spec, geometry, layout: SheetLayout) -> None:
+    s, (cx, cy) = layout.scale, layout.centre
+    over = {"dimlfac": 1.0 / s}
+    attrs = {"layer": "DIMENSIONS"}
+    rb, rmax = spec.follower.base_radius_mm, geometry.max_radius
+    # base-circle diameter along 210°/30°, text outside the cam at lower left
+    d = msp.add_diameter_dim((cx, cy), radius=rb * s, angle=210.0, dimstyle="CAMFAB", override=dict(over),
+                             dxfattribs=attrs)
+    d.render()
+    ext = geometry.radius_extremes()
+    p = geometry.evaluate(np.array([ext.at_max])).point[0]
+    u = p / np.hypot(*p)
+    loc = np.array([cx, cy]) + u * (rmax * s + 8.0)
+    d = msp.add_radius_dim((cx, cy), radius=float(np.hypot(*p)) * s, location=tuple(loc),
+                           dimstyle="CAMFAB", override=dict(over), dxfattribs=attrs)
+    d.render()
+    m = spec.manufacturing
+    if m.bore_mm > 0:
+        r = m.bore_mm / 2
+        d = msp.add_diameter_dim((cx, cy), radius=r * s, angle=315.0,
+                                 location=(cx + (r * s + 6) * math.cos(math.radians(315)),
+                                           cy + (r * s + 6) * math.sin(math.radians(315))),
+                                 dimstyle="CAMFAB", override=dict(over), dxfattribs=attrs)
+        d.render()
+        if m.keyway:
+            b, t2 = keyway_size(m.bore_mm)
+            top = cy + (r + t2) * s
+            d = msp.add_linear_dim(base=(cx, top + 5.0), p1=(cx - b / 2 * s, top), p2=(cx + b / 2 * s, top),
+                                   dimstyle="CAMFAB", override=dict(over), dxfattribs=attrs)
+            d.render()
+            xd = cx - (r * s + 5.0)
+            d = msp.add_linear_dim(base=(xd, cy), p1=(cx, cy - r * s), p2=(cx - b / 2 * s, top), angle=90.0,
+                                   dimstyle="CAMFAB", override=dict(over), dxfattribs=attrs)
+            d.render()
+
+
+def _view(msp, spec, geometry, shapes, layout: SheetLayout) -> None:
+    s, (cx, cy) = layout.scale, layout.centre
+    f, m = spec.follower, spec.manufacturing
+    for loop in shapes.profiles:
+        msp.add_lwpolyline(_place(loop, s, (cx, cy)), format="xyseb", close=True, dxfattribs={"layer": "PROFILE"})
+    if m.bore_mm > 0:
+        msp.add_lwpolyline(_place(bore_loop(m.bore_mm, m.keyway), s, (cx, cy)), format="xyseb", close=True,
+                           dxfattribs={"layer": "BORE"})
+    msp.add_circle((cx, cy), f.base_radius_mm * s, dxfattribs={"layer": "BASE_CIRCLE"})
+    if f.type == "roller" and f.roller_radius_mm:
+        msp.add_circle((cx, cy), (f.base_radius_mm + f.roller_radius_mm) * s, dxfattribs={"layer": "PRIME_CIRCLE"})
+    rmax = max([float(np.max(np.hypot(*lp.points.T))) for lp in shapes.profiles] + [geometry.max_radius])
+    reach = rmax * s + 4.0
+    msp.add_line((cx - reach, cy), (cx + reach, cy), dxfattribs={"layer": "CENTRE_LINES"})
+    msp.add_line((cx, cy - reach), (cx, cy + reach), dxfattribs={"layer": "CENTRE_LINES"})
+    mark = 2.0
+    msp.add_line((cx - mark, cy), (cx + mark, cy), dxfattribs={"layer": "CENTRE_MARKS"})
+    msp.add_line((cx, cy - mark), (cx, cy + mark), dxfattribs={"layer": "CENTRE_MARKS"})
+    _text(msp, "0°", (cx + 1.0, cy + reach), 2.5, "ANNOTATION", "BOTTOM_LEFT")
+    # rotation arrow: an arc at 40°…70° with an arrowhead in the sense of rotation
+    ra = rmax * s + 6.0
+    msp.add_arc((cx, cy), ra, 40.0, 70.0, dxfattribs={"layer": "ANNOTATION"})
+    cw = spec.cam.rotation == "cw"
+    tip_deg = 40.0 if cw else 70.0
+    t = math.radians(tip_deg)
+    tip = np.array([cx + ra * math.cos(t), cy + ra * math.sin(t)])
+    fwd = np.array([math.sin(t), -math.cos(t)]) * (1 if cw else -1)
+    side = np.array([-fwd[1], fwd[0]])
+    back = tip - 3.0 * fwd
+    msp.add_solid([tuple(tip), tuple(back + 1.0 * side), tuple(back - 1.0 * side)],
+                  dxfattribs={"layer": "ANNOTATION"})
+    _text(msp, "CW" if cw else "CCW", (cx + (ra + 2) * math.cos(math.radians(55)),
+                                       cy + (ra + 2) * math.sin(math.radians(55))), 2.5, "ANNOTATION")
+
+
+def build_drawing(spec, geometry, report, shapes, *, paper: str = "auto", lift_step_deg: float = 10.0):
+    """The ezdxf document of :func:`drawing_sheet` and its :class:`SheetLayout`."""
+    from ..report.xlsx import lift_table
+
+    if not geometry.closed:
+        raise GeometryError("a drawing sheet needs a disc cam; translating (wedge) cams are not supported yet")
+    ezdxf = _ezdxf()
+    tpl = load_template()
+    table = lift_table(spec, geometry, lift_step_deg)
+    extent = max([float(np.max(np.hypot(*lp.points.T))) for lp in shapes.profiles] + [geometry.max_radius])
+    layout = sheet_layout(extent, len(table.angle), paper)
+    doc = ezdxf.new("R2010", setup=["linetypes"], units=4)
+    doc.header["$INSUNITS"] = 4
+    doc.header["$MEASUREMENT"] = 1
+    doc.header["$LTSCALE"] = 1.0
+    doc.header["$LWDISPLAY"] = 1
+    doc.header["$EXTMIN"] = (0.0, 0.0, 0.0)
+    doc.header["$EXTMAX"] = (layout.size[0], layout.size[1], 0.0)
+    doc.header["$LIMMAX"] = layout.size
+    doc.header.custom_vars.append("CAMFAB_NAME", spec.name)
+    doc.header.custom_vars.append("CAMFAB_PAPER", layout.paper)
+    doc.header.custom_vars.append("CAMFAB_SCALE", f"{layout.scale!r}")
+    doc.header.custom_vars.append("CAMFAB_CENTRE", f"{layout.centre[0]!r},{layout.centre[1]!r}")
+    doc.header.custom_vars.append("CAMFAB_TOL_MM", f"{shapes.tol:g}")
+    for name, (colour, ltype, lw) in LAYERS.items():
+        doc.layers.add(name, color=colour, linetype=ltype, lineweight=lw)
+    _dimstyle(doc, tpl)
+    msp = doc.modelspace()
+    _rect(msp, (0.0, 0.0, *layout.size), "FRAME")
+    _rect(msp, layout.frame, "FRAME")
+    _title_block(msp, layout, title_fields(spec, report, layout))
+    _lift_table(msp, layout, table, geometry.closed)
+    _notes(msp, layout, notes_text(spec, geometry, report, shapes, layout))
+    _view(msp, spec, geometry, shapes, layout)
+    _dimensions(msp, spec, geometry, layout)
+    return doc, layout
+
+
+def drawing_sheet(spec, geometry, report, shapes, *, paper: str = "auto", lift_step_deg: float = 10.0) -> str:
+    """A dimensioned manufacturing drawing of the cam plate as DXF text (deterministic).
+
+    Parameters
+    ----------
+    spec : DesignSpec
+    geometry : CamGeometry
+        A disc cam (closed profiles).
+    report : Report
+        From :func:`camfab.design.assemble.check_design` (its verdict goes into the title block).
+    shapes : CamShapes
+        From :func:`camfab.cad.export.cam_shapes`; its arc-fitted ``profiles`` are drawn.
+    paper : {"auto", "A4", "A3"}
+    lift_step_deg : float
+        Step of the lift table (degrees, must divide 360).
+
+    Returns
+    -------
+    str
+        DXF R2010 text, millimetre units, byte-identical for the same input.
+
+    Raises
+    ------
+    GeometryError
+        A translating (wedge) cam.
+    ValueError
+        An unknown paper.
+    SpecError
+        A lift step that does not divide 360.
+    """
+    ezdxf = _ezdxf()
+    doc, _ = build_drawing(spec, geometry, report, shapes, paper=paper, lift_step_deg=lift_step_deg)
+    old = ezdxf.options.write_fixed_meta_data_for_testing
+    ezdxf.options.write_fixed_meta_data_for_testing = True
+    try:
+        buf = io.StringIO()
+        doc.write(buf)
+    finally:
+        ezdxf.options.write_fixed_meta_data_for_testing = old
+    return _EZDXF_STAMP.sub("@ 2000-01-01T00:00:00+00:00", buf.getvalue())

@@ -1,0 +1,448 @@
+"""Spreadsheet export (openpyxl): the CAM-DAS "Exportar-Excel" layout, checks and a lift table.
+
+Sheet ``CAM-DAS`` follows the map of ``spec/camdas-reference.md`` §1.11 cell
+for cell:
+
+==========  =================================================================
+Cells       Content
+==========  =================================================================
+A1          cam / follower type ("Rotating disc cam (clockwise) with ...")
+A2          title (the design name)
+A3          conclusion: the verdict sentence and the verdict code
+A4:A8       geometry and speed as text ("Base radius R_b = 35 mm"); A8 is
+            always the speed (ω, or v for a translating cam).  B4:B8 hold the
+            same values as numbers and C4:C8 their units (machine-readable
+            extras in cells CAM-DAS leaves empty)
+row 9       column headings with units
+A10:A...    cam angle in degrees, 0 to 360 inclusive at ``step_deg``
+            (travel in mm, 0 to the cam length, for a translating cam)
+B, C, D, E  S, V, A, J in time units at the design speed: mm, mm/s, mm/s²,
+            mm/s³ — degrees (°, °/s, …) for oscillating followers
+F           radius of curvature of the profile, mm (+ convex, − concave;
+            empty where it is infinite, at an inflection)
+G           rollers and knife edges: pressure angle, degrees (signed)
+G, H        flat translating face: left / right distance of the contact
+            point from the stem axis, mm (each ≥ 0, the other side 0)
+G           flat oscillating face: distance along the face from the
+            right-angle vertex (from the pivot's foot when the face offset
+            is 0), mm
+I, J        profile, polar: radius (mm), polar angle (degrees, 0 … 360)
+L, M        profile, Cartesian: x, y (mm, cam frame)
+O, P        pitch curve (roller centre), polar: radius, angle — rollers
+R, S        pitch curve, Cartesian: x, y — rollers
+==========  =================================================================
+
+The 361-vs-362-rows note of §1.11 is resolved as follows: the map's
+``A10:A371`` is the block CAM-DAS reserved, but the program stored 361
+points (0° … 360°, both ends included), so at the CAM-DAS step of 1° the data
+fill rows 10 … 370 and row 371 stays empty; row 9 holds the headings.  No row
+is invented to reach 371.  At another step the block is ``360/step + 1`` rows.
+
+Cam frame and angles follow ``design.md`` §3 (follower along +Y at 0°).  A
+translating cam has no polar coordinates (columns I, J, O, P stay empty).  A
+cam with several profiles (conjugate cams) gets one ``CAM-DAS`` sheet per
+profile (``CAM-DAS 2`` …).
+
+Sheet ``Checks``: the verdict, the CAM-DAS "Conclusiones" table (concept,
+maximum, minimum, comments), summary values and every finding with its
+angle range.  Sheet ``Lift table``: cam angle, follower lift and the
+follower radius (roller centre or face distance from the cam centre) at
+``lift_step_deg``, 0 up to (not including) 360°.
+
+The bytes are deterministic: the workbook properties carry a fixed date and
+the zip entries a fixed timestamp.
+"""
+from __future__ import annotations
+
+import datetime
+import io
+import math
+import re
+import zipfile
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import Problem, SpecError
+
+__all__ = ["CAMDAS_COLUMNS", "FIXED_DATE", "LiftTable", "camdas_workbook", "camdas_columns", "conclusions",
+           "fixed_zip", "geometry_rows", "lift_table", "sample_params", "type_text", "verdict_sentence"]
+
+#: the date written into the workbook properties (deterministic output)
+FIXED_DATE = datetime.datetime(2000, 1, 1, 0, 0, 0)
+#: column letter -> quantity, as in the CAM-DAS map (G/H depend on the follower)
+CAMDAS_COLUMNS = {"A": "angle", "B": "S", "C": "V", "D": "A", "E": "J", "F": "radius of curvature",
+                  "G": "pressure angle | left distance | distance along the face", "H": "right distance",
+                  "I": "profile r", "J": "profile polar angle", "L": "profile x", "M": "profile y",
+                  "O": "pitch r", "P": "pitch polar angle", "R": "pitch x", "S": "pitch y"}
+FIRST_DATA_ROW = 10
+_VERDICT_TEXT = {
+    "acceptable": "Acceptable cam",
+    "not_for_high_speed": "Jerk (or allowed acceleration) discontinuity. Cam not suitable for high speeds",
+    "unacceptable": "Unacceptable cam",
+}
+
+
+def verdict_sentence(report) -> str:
+    """The A3 conclusion: a CAM-DAS-style sentence followed by the verdict code in brackets."""
+    v = report.verdict
+    text = _VERDICT_TEXT[v]
+    if v == "unacceptable":
+        why = sorted({f.code.lower().replace("_", " ") for f in report.findings if f.severity == "error"})
+        text += ": " + ", ".join(why)
+    return f"{text} [{v}]"
+
+
+def sample_params(geometry, step: float) -> np.ndarray:
+    """Sample parameters (radians, or mm for a translating cam) from 0 to the period inclusive.
+
+    ``step`` is in degrees; it must divide 360.  A translating cam is cut into
+    the same number of equal intervals (``360/step``) over its length.
+    """
+    n = _intervals(step, "step_deg")
+    k = np.arange(n + 1, dtype=float)
+    if geometry.closed:
+        return np.radians(k * (360.0 / n))
+    return k * (geometry.period / n)
+
+
+def _intervals(step: Any, field: str) -> int:
+    if isinstance(step, bool) or not isinstance(step, (int, float)) or not math.isfinite(step) or step <= 0:
+        raise SpecError(Problem(field, step, "must be a positive number of degrees", "e.g. 1 or 0.5"))
+    n = 360.0 / step
+    if abs(n - round(n)) > 1e-9 * max(1.0, n):
+        raise SpecError(Problem(field, step, "must divide 360", "e.g. 0.25, 0.5, 1, 2, 5, 10"))
+    return int(round(n))
+
+
+# ---------------------------------------------------------------------------
+# texts
+def _unit(spec) -> str:
+    return spec.follower.lift_unit
+
+
+def type_text(spec) -> str:
+    """The A1 cam/follower type string."""
+    f, cam = spec.follower, spec.cam
+    ftype = {"roller": "roller", "flat": "flat-face", "knife": "knife-edge"}[f.type]
+    if spec.is_translating_cam:
+        return f"Translating cam (slides {cam.direction}) with {ftype} follower, translating motion"
+    sense = "clockwise" if cam.rotation == "cw" else "counter-clockwise"
+    return f"Rotating {cam.kind} cam ({sense}) with {ftype} follower, {f.motion} motion"
+
+
+def geometry_rows(spec, geometry) -> list[tuple[str, float | None, str]]:
+    """Rows A4:A8: up to four geometry values, then the speed (label, value, unit)."""
+    f = spec.follower
+    rows: list[tuple[str, float | None, str]] = []
+    if spec.is_translating_cam:
+        rows += [("Roller radius R_r", f.roller_radius_mm, "mm"), ("Base height h", f.base_height_mm or 0.0, "mm"),
+                 ("Cam length L", geometry.period, "mm")]
+    else:
+        rows.append(("Base radius R_b", f.base_radius_mm, "mm"))
+        if f.type == "roller":
+            rows.append(("Roller radius R_r", f.roller_radius_mm, "mm"))
+        if f.motion == "translating":
+            if f.type == "flat":
+                rows.append(("Face offset", f.face_offset_mm or 0.0, "mm"))
+            else:
+                rows.append(("Offset e", f.offset_mm or 0.0, "mm"))
+                rows.append(("Prime radius R_p", f.base_radius_mm + (f.roller_radius_mm or 0.0), "mm"))
+        else:
+            rows.append(("Pivot distance PivCen", f.pivot_distance_mm, "mm"))
+            if f.type == "flat":
+                rows.append(("Face offset (Excentricidad)", f.face_offset_mm or 0.0, "mm"))
+            else:
+                rows.append(("Arm length", f.arm_length_mm, "mm"))
+            if len(rows) < 4:
+                rows.append(("Initial arm angle", geometry.initial_arm_angle_deg, "deg"))
+    rows = rows[:4] + [("", None, "")] * (4 - len(rows[:4]))
+    if spec.is_translating_cam:
+        rows.append(("Cam speed v", spec.speed, "mm/s"))
+    else:
+        rows.append(("Angular speed ω", spec.speed, "rad/s"))
+    return rows
+
+
+# ---------------------------------------------------------------------------
+# the CAM-DAS table
+def _polar(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    r = np.hypot(p[:, 0], p[:, 1])
+    th = np.degrees(np.arctan2(p[:, 1], p[:, 0])) % 360.0
+    return r, np.where(th >= 360.0, 0.0, th)
+
+
+def camdas_columns(spec, geometry, *, step_deg: float = 1.0, profile: int = 0) -> tuple[dict[str, str],
+                                                                                         dict[str, np.ndarray]]:
+    """Headings (row 9) and data columns of one CAM-DAS sheet, keyed by column letter.
+
+    Returns
+    -------
+    headings : dict of str
+    columns : dict of (n,) float arrays
+        NaN marks an empty cell.
+    """
+    c = geometry.profiles[profile]
+    x = sample_params(geometry, step_deg)
+    u = _unit(spec)
+    w = spec.speed
+    S = c.motion.evaluate(x, (0, 1, 2, 3))
+    smp = c.evaluate(x)
+    xu = "deg" if geometry.closed else "mm"
+    head = {"A": f"Cam angle ({xu})" if geometry.closed else "Cam travel (mm)", "B": f"S ({u})",
+            "C": f"V ({u}/s)", "D": f"A ({u}/s2)", "E": f"J ({u}/s3)", "F": "Radius of curvature (mm)"}
+    cols: dict[str, np.ndarray] = {"A": geometry.to_user(x), "B": S[0], "C": S[1] * w, "D": S[2] * w**2,
+                                   "E": S[3] * w**3, "F": np.where(np.isfinite(smp.rho), smp.rho, np.nan)}
+    if c.kind == "roller":
+        head["G"] = "Pressure angle (deg)"
+        cols["G"] = np.degrees(smp.pressure_angle)
+    elif getattr(c, "xi0", None) is None:
+        head["G"], head["H"] = "Left contact distance (mm)", "Right contact distance (mm)"
+        cols["G"], cols["H"] = np.maximum(-smp.face_position, 0.0), np.maximum(smp.face_position, 0.0)
+    else:
+        head["G"] = "Contact distance along the face (mm)"
+        cols["G"] = smp.face_position
+    if geometry.closed:
+        head["I"], head["J"] = "Profile radius (mm)", "Profile polar angle (deg)"
+        cols["I"], cols["J"] = _polar(smp.point)
+    head["L"], head["M"] = "Profile x (mm)", "Profile y (mm)"
+    cols["L"], cols["M"] = smp.point[:, 0], smp.point[:, 1]
+    if c.kind == "roller" and smp.pitch is not None:
+        if geometry.closed:
+            head["O"], head["P"] = "Pitch radius (mm)", "Pitch polar angle (deg)"
+            cols["O"], cols["P"] = _polar(smp.pitch)
+        head["R"], head["S"] = "Pitch x (mm)", "Pitch y (mm)"
+        cols["R"], cols["S"] = smp.pitch[:, 0], smp.pitch[:, 1]
+    return head, cols
+
+
+# ---------------------------------------------------------------------------
+# the lift table
+@dataclass(frozen=True)
+class LiftTable:
+    """Follower lift against cam angle.
+
+    Attributes
+    ----------
+    angle : (n,) float
+        Cam angle in degrees (travel in mm for a translating cam), 0 up to, not including, the period.
+    lift : (n,) float
+        Follower lift S (mm, or degrees for oscillating followers).
+    radius : (n,) float
+        Distance from the cam centre to the follower's reference: the roller
+        centre (pitch radius) for rollers and knife edges, the face for flat
+        faces (mm).  For a translating cam: the roller-centre height.
+    lift_unit : str
+    radius_label : str
+    """
+
+    angle: np.ndarray
+    lift: np.ndarray
+    radius: np.ndarray
+    lift_unit: str
+    radius_label: str
+
+
+def lift_table(spec, geometry, step_deg: float = 10.0, *, profile: int = 0) -> LiftTable:
+    """The lift table of profile ``profile`` at ``step_deg`` (must divide 360)."""
+    c = geometry.profiles[profile]
+    x = sample_params(geometry, step_deg)[:-1]
+    smp = c.evaluate(x)
+    lift = c.motion.evaluate(x, (0,))[0]
+    if not geometry.closed:
+        radius, label = smp.pitch[:, 1], "Roller centre height (mm)"
+    elif c.kind == "roller":
+        radius, label = np.hypot(smp.pitch[:, 0], smp.pitch[:, 1]), "Pitch radius (mm)"
+    else:
+        radius, label = np.einsum("ij,ij->i", smp.point, smp.normal), "Face distance (mm)"
+    return LiftTable(geometry.to_user(x), lift, radius, _unit(spec), label)
+
+
+# ---------------------------------------------------------------------------
+# the workbook
+def camdas_workbook(spec, geometry, report, *, step_deg: float = 1.0, lift_step_deg: float = 10.0) -> bytes:
+    """The xlsx workbook: ``CAM-DAS`` sheet(s), ``Checks`` and ``Lift table`` (see the module notes).
+
+    Parameters
+    ----------
+    spec : DesignSpec
+    geometry : CamGeometry
+    report : Report
+        From :func:`camfab.design.assemble.check_design`.
+    step_deg : float
+        Angle step of the CAM-DAS sheet (CAM-DAS used 1°); must divide 360.
+    lift_step_deg : float
+        Angle step of the lift-table sheet; must divide 360.
+
+    Returns
+    -------
+    bytes
+        The xlsx file, byte-identical for the same input.
+
+    Raises
+    ------
+    SpecError
+        A step that is not a positive divisor of 360.
+    """
+    from openpyxl import Workbook
+
+    _intervals(step_deg, "step_deg")
+    _intervals(lift_step_deg, "lift_step_deg")
+    wb = Workbook()
+    wb.remove(wb.active)
+    for k in range(len(geometry.profiles)):
+        _camdas_sheet(wb.create_sheet("CAM-DAS" if k == 0 else f"CAM-DAS {k + 1}"), spec, geometry, report,
+                      step_deg, k)
+    _checks_sheet(wb.create_sheet("Checks"), spec, report)
+    _lift_sheet(wb.create_sheet("Lift table"), lift_table(spec, geometry, lift_step_deg), geometry)
+    wb.properties.creator = "camfab"
+    wb.properties.title = spec.name
+    wb.properties.created = FIXED_DATE
+    wb.properties.modified = FIXED_DATE
+    return _save(wb)
+
+
+def _save(wb) -> bytes:
+    buf = io.BytesIO()
+    wb.save(buf)
+    return fixed_zip(buf.getvalue())
+
+
+_MODIFIED = re.compile(rb"(<dcterms:modified[^>]*>)[^<]*(</dcterms:modified>)")
+
+
+def fixed_zip(raw: bytes) -> bytes:
+    """Re-pack an xlsx with fixed entry timestamps and a fixed ``modified`` property (equal content, equal bytes)."""
+    out = io.BytesIO()
+    with zipfile.ZipFile(io.BytesIO(raw)) as src, zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as dst:
+        for info in src.infolist():
+            zi = zipfile.ZipInfo(info.filename, date_time=(1980, 1, 1, 0, 0, 0))
+            zi.compress_type = zipfile.ZIP_DEFLATED
+            zi.external_attr = 0o600 << 16
+            data = src.read(info.filename)
+            if info.filename == "docProps/core.xml":  # openpyxl stamps the save time into <modified>
+                data = _MODIFIED.sub(rb"\g<1>" + FIXED_DATE.strftime("%Y-%m-%dT%H:%M:%SZ").encode() + rb"\2", data)
+            dst.writestr(zi, data)
+    return out.getvalue()
+
+
+def _cell(v: float) -> float | None:
+    return None if not math.isfinite(v) else float(v)
+
+
+def _camdas_sheet(ws, spec, geometry, report, step_deg: float, profile: int) -> None:
+    from openpyxl.styles import Font
+
+    ws["A1"] = type_text(spec) + (f" — profile {profile + 1}" if profile else "")
+    ws["A2"] = spec.name
+    ws["A3"] = verdict_sentence(report)
+    for i, (label, value, unit) in enumerate(geometry_rows(spec, geometry)):
+        if not label:
+            continue
+        ws.cell(4 + i, 1, f"{label} = {value:.10g} {unit}" if value is not None else f"{label}: n/a")
+        ws.cell(4 + i, 2, value)
+        ws.cell(4 + i, 3, unit)
+    head, cols = camdas_columns(spec, geometry, step_deg=step_deg, profile=profile)
+    bold = Font(bold=True)
+    for letter, text in head.items():
+        ws[f"{letter}9"] = text
+        ws[f"{letter}9"].font = bold
+    n = len(cols["A"])
+    for letter, values in cols.items():
+        col = ws[letter + "1"].column
+        for i in range(n):
+            ws.cell(FIRST_DATA_ROW + i, col, _cell(values[i]))
+    ws.freeze_panes = "B10"
+
+
+def _fmt(v) -> Any:
+    return None if v is None or (isinstance(v, float) and not math.isfinite(v)) else v
+
+
+def _continuity(report, code: str) -> str:
+    return "Discontinuous" if report.by_code(code) else "Continuous"
+
+
+def conclusions(spec, report) -> list[tuple[str, Any, Any, str]]:
+    """The CAM-DAS "Conclusiones" rows: (concept, maximum, minimum, comments)."""
+    u = _unit(spec)
+    rows: list[tuple[str, Any, Any, str]] = []
+    peaks = report.motion.peaks if report.motion is not None else {}
+    names = (("S", "Displacement", u, None), ("V", "Velocity", f"{u}/s", "VELOCITY_DISCONTINUITY"),
+             ("A", "Acceleration", f"{u}/s2", "ACCELERATION_DISCONTINUITY"),
+             ("J", "Jerk", f"{u}/s3", "JERK_DISCONTINUITY"))
+    for key, word, unit, code in names:
+        p = peaks.get(key, {})
+        rows.append((f"{word} ({unit})", p.get("max"), p.get("min"),
+                     "Continuous" if code is None else _continuity(report, code)))
+    s = report.summary
+    roc = s.get("radius_of_curvature_mm") or {}
+    bad = [f for f in report.findings if f.code in ("UNDERCUT", "CUSP")]
+    rows.append(("Radius of curvature (mm)" if roc.get("max") is not None else "Convex radius of curvature (mm)",
+                 roc.get("max"), roc.get("min_convex"),
+                 "; ".join(f.message for f in bad) if bad else "The profile is free of cusps and undercuts"))
+    pa = s.get("pressure_angle_deg")
+    if pa:
+        over = report.by_code("PRESSURE_ANGLE_EXCEEDED")
+        rows.append(("Pressure angle (deg)", pa.get("max"), pa.get("min"),
+                     f"Pressure angle > {pa.get('limit'):g} deg, high pressure angle" if over else "Acceptable"))
+    fl = s.get("face_length_mm")
+    if fl:
+        note = "The maximum is the minimum face length needed to keep contact"
+        if fl.get("left") is not None:
+            rows.append(("Left contact distance (mm)", fl.get("left"), 0.0, note))
+            rows.append(("Right contact distance (mm)", fl.get("right"), 0.0, note))
+        else:
+            rows.append(("Contact distance along the face (mm)", fl.get("max"), fl.get("min"), note))
+    return rows
+
+
+def _checks_sheet(ws, spec, report) -> None:
+    from openpyxl.styles import Font
+
+    bold = Font(bold=True)
+    ws["A1"], ws["B1"] = "Verdict", report.verdict
+    ws["A2"], ws["B2"] = "Conclusion", verdict_sentence(report)
+    ws["A1"].font = ws["A2"].font = bold
+    row = 4
+    for col, text in enumerate(("Concept", "Maximum", "Minimum", "Comments"), 1):
+        ws.cell(row, col, text).font = bold
+    for concept, mx, mn, note in conclusions(spec, report):
+        row += 1
+        for col, v in enumerate((concept, _fmt(mx), _fmt(mn), note), 1):
+            ws.cell(row, col, v)
+    row += 2
+    ws.cell(row, 1, "Summary").font = bold
+    s = report.summary
+    for label, key, unit in (("Base radius (min distance)", "base_radius_mm", "mm"),
+                             ("Max radius (DMAX)", "max_radius_mm", "mm"), ("Profile area", "area_mm2", "mm2"),
+                             ("Initial arm angle", "initial_arm_angle_deg", "deg")):
+        if s.get(key) is not None:
+            row += 1
+            ws.cell(row, 1, label), ws.cell(row, 2, _fmt(s[key])), ws.cell(row, 3, unit)
+    row += 2
+    ws.cell(row, 1, "Findings").font = bold
+    row += 1
+    x = "deg" if report.x_unit == "deg" else "mm"
+    for col, text in enumerate(("Code", "Severity", f"From ({x})", f"To ({x})", "Value", "Limit", "Message"), 1):
+        ws.cell(row, col, text).font = bold
+    if not report.findings:
+        ws.cell(row + 1, 1, "none")
+    for f in report.findings:
+        row += 1
+        for col, v in enumerate((f.code, f.severity, f.from_deg, f.to_deg, f.value, f.limit, f.message), 1):
+            ws.cell(row, col, _fmt(float(v)) if isinstance(v, (float, np.floating)) else v)
+
+
+def _lift_sheet(ws, table: LiftTable, geometry) -> None:
+    from openpyxl.styles import Font
+
+    bold = Font(bold=True)
+    heads = ("Cam angle (deg)" if geometry.closed else "Cam travel (mm)", f"Lift S ({table.lift_unit})",
+             table.radius_label)
+    for col, text in enumerate(heads, 1):
+        ws.cell(1, col, text).font = bold
+    for i, (a, s, r) in enumerate(zip(table.angle, table.lift, table.radius)):
+        ws.cell(2 + i, 1, float(a)), ws.cell(2 + i, 2, float(s)), ws.cell(2 + i, 3, float(r))
+    ws.freeze_panes = "A2"
