@@ -8,7 +8,6 @@ heavy dependencies are imported inside the commands that need them.
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 import math
 import sys
@@ -101,15 +100,10 @@ cmd_motion.add_arguments = _motion_args
 
 
 def knot_findings(spec) -> list:
-    """KNOT_INCONSISTENT warnings of a knot-table design (none for segment programs)."""
-    if spec.motion_table is None:
-        return []
-    from .design.knots import load_motion_table
-    from .design.motion_report import Finding
+    """KNOT_INCONSISTENT warnings (see :func:`camfab.design.assemble.knot_findings`)."""
+    from .design.assemble import knot_findings as findings
 
-    base = Path(spec.base_dir) if spec.base_dir else None
-    return [Finding(w.code, "warning", w.from_deg, w.to_deg, w.implied_peak, w.knot_max, w.message)
-            for w in load_motion_table(spec.motion_table, base_dir=base).warnings()]
+    return findings(spec)
 
 
 def _x_scale(prog) -> float:
@@ -175,9 +169,6 @@ def cmd_check(args: argparse.Namespace) -> int:
     spec = _load(args.file)
     tool = spec.manufacturing.tool_diameter_mm
     report = check_design(spec, tool_radius_mm=tool / 2 if tool else None)
-    knots = knot_findings(spec)
-    if knots:
-        report = dataclasses.replace(report, findings=tuple(report.findings) + tuple(knots))
     if args.json:
         print(json.dumps(report.to_dict(), indent=2))
     else:
@@ -459,7 +450,7 @@ def _outputs_override(text: str | None) -> dict:
     if bad:
         raise UsageError(f"--outputs: '{bad[0]}' is not a valid option, must be one of: {', '.join(_ARTIFACTS)}")
     over = {a: (a in wanted) for a in _ARTIFACTS}
-    over["gcode"] = "linuxcnc" if "gcode" in wanted else None
+    over["gcode"] = "linuxcnc" if "gcode" in wanted else False  # False: off (None means "keep the design's")
     return over
 
 
@@ -526,6 +517,17 @@ def cmd_package(args: argparse.Namespace) -> int:
 
 
 cmd_package.add_arguments = _package_args
+
+
+def _register_report_commands() -> None:
+    """``compare`` and ``report`` live in camfab.report (jinja2/matplotlib are imported only when they run)."""
+    from .report.commands import cmd_compare, cmd_report
+
+    register("compare", "overlaid S-V-A-J, curvature and pressure-angle plots and a side-by-side table")(cmd_compare)
+    register("report", "HTML report with plots and an animation of the mechanism")(cmd_report)
+
+
+_register_report_commands()
 
 
 # ---------------------------------------------------------------------------

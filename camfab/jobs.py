@@ -62,11 +62,17 @@ class RunResult:
 
 
 def request_from_outputs(spec, **over) -> JobRequest:
-    """The job a design's ``[outputs]`` section asks for, with overrides."""
+    """The job a design's ``[outputs]`` section asks for, with overrides.
+
+    An override of ``None`` keeps the design's value; ``gcode=False`` switches G-code off.
+    """
     o = spec.outputs
     req = JobRequest(dxf=o.dxf, step=o.step, stl=o.stl, gcode=o.gcode, lift_table=o.lift_table, xlsx=o.xlsx,
                      report=o.report, drawing=o.drawing)
-    return replace(req, **{k: v for k, v in over.items() if v is not None})
+    over = {k: v for k, v in over.items() if v is not None}
+    if over.get("gcode") is False:
+        over["gcode"] = None
+    return replace(req, **over)
 
 
 class _Timer:
@@ -131,8 +137,10 @@ def run_design(spec, outdir: str | Path, req: JobRequest, *,
 
         files[f"{spec.name}.xlsx"] = timed("xlsx", camdas_workbook, spec, geom, report, step_deg=req.xlsx_step_deg)
     if req.report:
+        from .report.commands import require_report_dependencies
         from .report.html import render_report
 
+        require_report_dependencies()
         files.update(timed("report", render_report, spec, geom, report))
     out = Path(outdir)
     for name, data in sorted(files.items()):

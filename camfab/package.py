@@ -18,6 +18,7 @@ from __future__ import annotations
 import hashlib
 import html
 import json
+import multiprocessing
 import os
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -182,7 +183,9 @@ def _map(fn, items: list, jobs: int):
     if jobs <= 1 or len(items) <= 1:
         yield from map(fn, items)
         return
-    with ProcessPoolExecutor(max_workers=min(jobs, len(items), os.cpu_count() or 1)) as pool:
+    # "spawn": a forked worker can deadlock on locks held by threads of the parent (OCCT, browsers)
+    ctx = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=min(jobs, len(items), os.cpu_count() or 1), mp_context=ctx) as pool:
         yield from pool.map(fn, items)
 
 

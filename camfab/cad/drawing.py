@@ -37,7 +37,6 @@ true-size geometry can be recovered: ``true = (paper − centre) / scale``.
 from __future__ import annotations
 
 import functools
-import io
 import math
 import tomllib
 from dataclasses import dataclass
@@ -47,7 +46,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ExportError, GeometryError
-from .dxf import _EZDXF_STAMP, _ezdxf
+from .dxf import _ezdxf, write_deterministic
 from .plate import BulgeLoop, bore_loop, keyway_size
 
 __all__ = ["PAPERS", "LAYERS", "SheetLayout", "load_template", "sheet_layout", "parse_scale", "drawing_sheet",
@@ -442,13 +441,5 @@ def drawing_sheet(spec, geometry, report, shapes, *, paper: str = "auto", lift_s
     SpecError
         A lift step that does not divide 360.
     """
-    ezdxf = _ezdxf()
     doc, _ = build_drawing(spec, geometry, report, shapes, paper=paper, lift_step_deg=lift_step_deg)
-    old = ezdxf.options.write_fixed_meta_data_for_testing
-    ezdxf.options.write_fixed_meta_data_for_testing = True
-    try:
-        buf = io.StringIO()
-        doc.write(buf)
-    finally:
-        ezdxf.options.write_fixed_meta_data_for_testing = old
-    return _EZDXF_STAMP.sub("@ 2000-01-01T00:00:00+00:00", buf.getvalue())
+    return write_deterministic(doc)

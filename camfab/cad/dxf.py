@@ -112,8 +112,16 @@ def build_document(content: DxfContent, *, flavour: str = "lwpolyline"):
 
 def dumps(content: DxfContent, *, flavour: str = "lwpolyline") -> str:
     """DXF text, byte-identical for the same ``content``."""
+    return write_deterministic(build_document(content, flavour=flavour))
+
+
+def write_deterministic(doc) -> str:
+    """Write an ezdxf document as text that depends only on its content.
+
+    ezdxf stamps the write time into its metadata and emits the CLASSES section in
+    hash-seed order (it differs between processes); both are normalised here.
+    """
     ezdxf = _ezdxf()
-    doc = build_document(content, flavour=flavour)
     old = ezdxf.options.write_fixed_meta_data_for_testing
     ezdxf.options.write_fixed_meta_data_for_testing = True
     try:
@@ -121,8 +129,17 @@ def dumps(content: DxfContent, *, flavour: str = "lwpolyline") -> str:
         doc.write(buf)
     finally:
         ezdxf.options.write_fixed_meta_data_for_testing = old
-    # ezdxf stamps the write time into its own metadata marker; pin it for reproducible files
-    return _EZDXF_STAMP.sub("@ 2000-01-01T00:00:00+00:00", buf.getvalue())
+    text = _EZDXF_STAMP.sub("@ 2000-01-01T00:00:00+00:00", buf.getvalue())
+    return _sorted_classes(text)
 
 
 _EZDXF_STAMP = re.compile(r"@ \d{4}-\d\d-\d\dT\d\d:\d\d:\d\d(?:\.\d+)?\+00:00")
+_CLASSES = re.compile(r"(  0\nSECTION\n  2\nCLASSES\n)(.*?)(  0\nENDSEC\n)", re.S)
+
+
+def _sorted_classes(text: str) -> str:
+    def sort(m: re.Match) -> str:
+        blocks = ["  0\nCLASS\n" + b for b in m.group(2).split("  0\nCLASS\n") if b]
+        return m.group(1) + "".join(sorted(blocks)) + m.group(3)
+
+    return _CLASSES.sub(sort, text, count=1)

@@ -5,8 +5,11 @@ CLI and the exporters never repeat the mapping.
 """
 from __future__ import annotations
 
+import dataclasses
+
 from ..errors import Problem, SpecError
 from .checks import Report, check
+from .motion_report import Finding
 from .mechanisms import OscillatingFlat, OscillatingRoller, TranslatingCamRoller, TranslatingFlat, TranslatingRoller
 from .profile import CamGeometry
 from .desmodromic import (ConjugateOscillatingFlat, ConjugateOscillatingRoller, ConjugateTranslatingFlat,
@@ -16,7 +19,7 @@ from .spec import DesignSpec
 DESMODROMIC = (ConjugateTranslatingFlat, ConjugateTranslatingRoller, ConjugateOscillatingFlat,
                ConjugateOscillatingRoller, ConstantWidthCam, ConstantDiameterCam)
 
-__all__ = ["mechanism_from_spec", "geometry_from_spec", "check_design"]
+__all__ = ["mechanism_from_spec", "geometry_from_spec", "check_design", "knot_findings"]
 
 
 def mechanism_from_spec(spec: DesignSpec):
@@ -67,9 +70,27 @@ def geometry_from_spec(spec: DesignSpec) -> CamGeometry:
 
 
 def check_design(spec: DesignSpec, *, tool_radius_mm: float | None = None) -> Report:
-    """Geometry + checks + verdict for a design (the ``camfab check`` report)."""
+    """Geometry + checks + verdict for a design (the ``camfab check`` report), knot-table
+    consistency warnings included."""
     geom = geometry_from_spec(spec)
-    return check(geom, pressure_angle_limit_deg=spec.pressure_angle_limit_deg,
-                 allow_acceleration_jump=spec.cam.kind in ("constant_width", "constant_diameter"),
-                 tool_radius_mm=tool_radius_mm, face_margin_mm=spec.face_margin_mm,
-                 name=spec.name, speed=spec.speed)
+    report = check(geom, pressure_angle_limit_deg=spec.pressure_angle_limit_deg,
+                   allow_acceleration_jump=spec.cam.kind in ("constant_width", "constant_diameter"),
+                   tool_radius_mm=tool_radius_mm, face_margin_mm=spec.face_margin_mm,
+                   name=spec.name, speed=spec.speed)
+    knots = knot_findings(spec)
+    if knots:
+        report = dataclasses.replace(report, findings=tuple(report.findings) + tuple(knots))
+    return report
+
+
+def knot_findings(spec: DesignSpec) -> list[Finding]:
+    """KNOT_INCONSISTENT warnings of a knot-table design (none for segment programs)."""
+    if spec.motion_table is None:
+        return []
+    from pathlib import Path
+
+    from .knots import load_motion_table
+
+    base = Path(spec.base_dir) if spec.base_dir else None
+    return [Finding(w.code, "warning", w.from_deg, w.to_deg, w.implied_peak, w.knot_max, w.message)
+            for w in load_motion_table(spec.motion_table, base_dir=base).warnings()]

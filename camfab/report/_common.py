@@ -1,0 +1,222 @@
+"""Helpers shared by the plots, the animation and the HTML pages.
+
+Nothing here imports matplotlib or jinja2: these are the numbers and words of
+the report (sampling grids, angle ranges, the CAM-DAS conclusions rows).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+__all__ = ["Axis", "axis_of", "sample_grid", "finding_spans", "fmt", "fmt_at", "range_text",
+           "conclusions_rows", "VERDICT_TEXT", "VERDICT_CLASS", "mechanism_text", "key_values",
+           "CURVATURE_CODES"]
+
+#: verdict → headline (same words as ``camfab check``)
+VERDICT_TEXT = {"acceptable": "Cam OK (acceptable)",
+                "not_for_high_speed": "Not suitable for high speeds",
+                "unacceptable": "Cam KO (unacceptable)"}
+#: verdict → CSS class / colour family
+VERDICT_CLASS = {"acceptable": "ok", "not_for_high_speed": "warn", "unacceptable": "bad"}
+#: finding codes shaded on the radius-of-curvature plot
+CURVATURE_CODES = ("UNDERCUT", "CUSP", "CONCAVE_RADIUS_BELOW_ROLLER")
+
+
+@dataclass(frozen=True)
+class Axis:
+    """The independent variable of a design in user units.
+
+    Attributes
+    ----------
+    period : float
+        Program period in internal units (2π rad, or the cam length in mm).
+    scale : float
+        User units per internal unit (180/π for disc cams, 1 for translating cams).
+    unit : str
+        "°" or "mm" (for labels).
+    label : str
+        Axis label ("cam angle (°)" or "cam travel (mm)").
+    """
+
+    period: float
+    scale: float
+    unit: str
+    label: str
+
+    @property
+    def user_period(self) -> float:
+        """The period in user units (360° or the cam length in mm)."""
+        return self.period * self.scale
+
+    @property
+    def closed(self) -> bool:
+        return self.unit == "°"
+
+
+def axis_of(prog) -> Axis:
+    """:class:`Axis` of a motion program (disc cam: degrees; translating cam: mm)."""
+    per = float(prog.period)
+    if abs(per - 2 * math.pi) < 1e-12:
+        return Axis(per, 180.0 / math.pi, "°", "cam angle (°)")
+    return Axis(per, 1.0, "mm", "cam travel (mm)")
+
+
+def sample_grid(period: float, breakpoints, n: int = 1441) -> np.ndarray:
+    """Sampling parameters (internal units) for plots: ``n`` even steps over one period
+    plus both one-sided limits at every breakpoint, so jumps plot as vertical lines and
+    no sample straddles a kink.
+
+    Parameters
+    ----------
+    period : float
+    breakpoints : (m,) float
+        Where a formula changes (0 and ``period`` may be included).
+    n : int
+
+    Returns
+    -------
+    (k,) float, increasing, in [0, period)
+        The last value is a hair below ``period`` (the left limit of the last segment).
+    """
+    eps = 1e-9 * period
+    b = np.asarray(breakpoints, dtype=float)
+    b = b[(b > 0) & (b < period)]
+    x = np.concatenate([np.linspace(0.0, period, n)[:-1], b - eps, b, [period - eps]])
+    return np.unique(x)
+
+
+def finding_spans(findings, codes, axis: Axis) -> list[tuple[float, float]]:
+    """``[(from, to), ...]`` in user units of the findings with the given codes; a range
+    that wraps through the period end is split in two; a point has from == to."""
+    out = []
+    for f in findings:
+        if f.code not in codes or f.from_deg is None:
+            continue
+        a, b = float(f.from_deg), float(f.to_deg if f.to_deg is not None else f.from_deg)
+        if a > b and axis.closed:
+            out += [(a, axis.user_period), (0.0, b)]
+        else:
+            out.append((a, b))
+    return out
+
+
+def fmt(v, digits: int = 2) -> str:
+    """A table number: fixed ``digits`` decimals, or 5 significant digits when huge; "--" for None."""
+    if v is None:
+        return "--"
+    v = float(v)
+    if not math.isfinite(v):
+        return "∞" if v > 0 else ("−∞" if v < 0 else "--")
+    return f"{v:.{digits}f}" if abs(v) < 1e7 else f"{v:.5g}"
+
+
+def fmt_at(v, unit: str = "°") -> str:
+    """A position: ``123.4°`` or ``12.3 mm``; "" for None."""
+    if v is None:
+        return ""
+    return f"{float(v):.1f}{unit}" if unit == "°" else f"{float(v):.2f} {unit}"
+
+
+def range_text(f, unit: str = "°") -> str:
+    """Where a finding applies, in words ("at 50.0°", "from 10.0° to 20.0°", "from 350.0° through 0° to 10.0°")."""
+    if f.from_deg is None:
+        return "whole cycle"
+    a, b = float(f.from_deg), float(f.to_deg if f.to_deg is not None else f.from_deg)
+    if abs(a - b) < 1e-9:
+        return f"at {fmt_at(a, unit)}"
+    if a > b and unit == "°":
+        return f"from {fmt_at(a, unit)} through 0° to {fmt_at(b, unit)}"
+    return f"from {fmt_at(a, unit)} to {fmt_at(b, unit)}"
+
+
+def mechanism_text(spec) -> str:
+    """One line describing the mechanism ("disc cam (cw), translating roller follower")."""
+    c, f = spec.cam, spec.follower
+    kind = c.kind.replace("_", "-")
+    sense = f"slides {c.direction}" if c.kind == "translating" else c.rotation
+    ftype = "knife-edge" if f.type == "knife" else ("flat-face" if f.type == "flat" else "roller")
+    double = "double " if c.kind in ("conjugate", "constant_width", "constant_diameter") else ""
+    return f"{kind} cam ({sense}), {double}{f.motion} {ftype} follower"
+
+
+def _cell(value, at=None, unit="°") -> dict[str, Any]:
+    return {"text": fmt(value), "value": None if value is None else float(value),
+            "at": fmt_at(at, unit) if value is not None else "", "at_value": None if at is None else float(at)}
+
+
+def conclusions_rows(spec, report) -> list[dict[str, Any]]:
+    """The CAM-DAS conclusions table (as ``camfab check`` prints it), one dict per row.
+
+    Each row has ``concept``, ``max`` and ``min`` cells (``text``, ``value`` – the exact
+    report number –, ``at``, ``at_value``), ``comment`` and ``status`` ("ok", "warn", "bad").
+    """
+    d = report.to_dict()
+    lu = spec.follower.lift_unit
+    xu = "°" if report.x_unit == "deg" else "mm"
+    codes = report.codes()
+    jumps = {"V": "VELOCITY_DISCONTINUITY", "A": "ACCELERATION_DISCONTINUITY", "J": "JERK_DISCONTINUITY"}
+    names = {"S": f"Displacement ({lu})", "V": f"Velocity ({lu}/s)", "A": f"Acceleration ({lu}/s²)",
+             "J": f"Jerk ({lu}/s³)"}
+    rows = []
+    for q, p in (d.get("peaks") or {}).items():
+        jump = q in jumps and jumps[q] in codes
+        sev = {f.severity for f in report.findings if q in jumps and f.code == jumps[q]}
+        rows.append({"concept": names[q], "max": _cell(p["max"], p["at_max_deg"], xu),
+                     "min": _cell(p["min"], p["at_min_deg"], xu),
+                     "comment": "Discontinuous" if jump else "Continuous",
+                     "status": ("bad" if "error" in sev else "warn") if jump else "ok"})
+    roc = d.get("radius_of_curvature_mm") or {}
+    if roc:
+        bad = codes & {"UNDERCUT", "CUSP"}
+        rows.append({"concept": "Convex radius of curvature (mm)", "max": _cell(None),
+                     "min": _cell(roc.get("min_convex"), roc.get("at_deg"), xu),
+                     "comment": "Undercut or cusp: see the findings" if bad
+                     else "The profile is free of cusps and undercuts", "status": "bad" if bad else "ok"})
+        if roc.get("min_concave") is not None:
+            tight = "CONCAVE_RADIUS_BELOW_ROLLER" in codes
+            rows.append({"concept": "Concave radius of curvature (mm)", "max": _cell(None),
+                         "min": _cell(roc["min_concave"], roc.get("at_min_concave_deg"), xu),
+                         "comment": "Tighter than the cutter: see the findings" if tight
+                         else "Smallest concave radius (the cutter must be smaller)",
+                         "status": "warn" if tight else "ok"})
+    pa = d.get("pressure_angle_deg")
+    if pa:
+        ok = "PRESSURE_ANGLE_EXCEEDED" not in codes
+        rows.append({"concept": "Pressure angle (°)", "max": _cell(pa["max"], pa["at_max_deg"], xu),
+                     "min": _cell(pa["min"], pa["at_min_deg"], xu),
+                     "comment": (f"Acceptable (limit ±{pa.get('limit', 0):g}°)" if ok
+                                 else f"High pressure angle (> {pa.get('limit', 0):g}°)"),
+                     "status": "ok" if ok else "bad"})
+    face = d.get("face_length_mm")
+    if face:
+        if face.get("left") is not None:
+            rows.append({"concept": "Face length left / right (mm)", "max": _cell(face["left"]),
+                         "min": _cell(face["right"]),
+                         "comment": "Minimum face length on each side of the stem to keep contact",
+                         "status": "ok"})
+        else:
+            rows.append({"concept": "Contact along the face (mm)", "max": _cell(face["max"]),
+                         "min": _cell(face["min"]), "comment": "Distance of the contact from the face vertex",
+                         "status": "ok"})
+    return rows
+
+
+def key_values(report) -> list[tuple[str, str, float | None]]:
+    """Dimensions of the cam: ``[(label, text, exact value), ...]`` (rows that do not apply are left out)."""
+    d = report.to_dict()
+    out = []
+    rb, rmax = d.get("base_radius_mm"), d.get("max_radius_mm")
+    if rb is not None:
+        out.append(("Minimum radius Rmin (mm)", fmt(rb, 3), rb))
+        out.append(("DMIN = 2·Rmin (mm)", fmt(2 * rb, 3), 2 * rb))
+    if rmax is not None:
+        out.append(("Maximum radius Rmax (mm)", fmt(rmax, 3), rmax))
+        out.append(("DMAX = 2·Rmax (mm)", fmt(2 * rmax, 3), 2 * rmax))
+    if d.get("area_mm2") is not None:
+        out.append(("Profile area (mm²)", fmt(d["area_mm2"], 2), d["area_mm2"]))
+    if d.get("initial_arm_angle_deg") is not None:
+        out.append(("Initial arm angle ξ₀ (°)", fmt(d["initial_arm_angle_deg"], 3), d["initial_arm_angle_deg"]))
+    return out

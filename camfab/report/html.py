@@ -1,0 +1,222 @@
+"""The HTML report of one design: plots, conclusions, findings, inputs and an animation.
+
+:func:`render_report` returns the files of a report directory as
+``{relative path: bytes}`` — ``report.html`` plus ``plots/<name>.png`` and
+``plots/<name>.svg`` — and writes nothing (see :func:`write_files`).  The page is
+rendered from the jinja2 templates shipped in ``camfab/templates/report/``
+(loaded with :mod:`importlib.resources`); it needs no network: the stylesheet and
+the animation script are inlined, the plots are relative ``<img>`` links (or
+``data:`` URIs with ``standalone=True``).  The output is deterministic: no
+timestamps, rounded animation frames, byte-stable plots.
+"""
+from __future__ import annotations
+
+import base64
+import dataclasses
+import json
+import math
+from importlib import resources
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+
+from ._common import (VERDICT_CLASS, VERDICT_TEXT, axis_of, conclusions_rows, fmt, key_values, mechanism_text,
+                      range_text)
+
+__all__ = ["render_report", "write_files", "template_environment", "report_context", "PLOT_TEXT"]
+
+#: file stem → (title, caption) of every report plot
+PLOT_TEXT = {
+    "svaj": ("Motion diagrams S, V, A, J",
+             "Displacement, velocity, acceleration and jerk at the design speed; dotted lines are segment "
+             "junctions, dots the exact extremes."),
+    "profile": ("Cam profile",
+                "Cam frame (the follower sits at +Y at 0°); contact points every 30°, labelled every 90°; "
+                "DMIN/DMAX are the smallest and largest diameters of the profile."),
+    "curvature": ("Radius of curvature",
+                  "Signed: positive is convex. A roller needs the convex pitch radius to exceed the roller radius "
+                  "(else undercut); red bands mark undercuts, cusps and stretches too tight for the cutter."),
+    "pressure_angle": ("Pressure angle",
+                       "Angle between the line of action and the follower's motion; red beyond the limit."),
+    "face_position": ("Flat-face contact position",
+                      "Where the cam touches the face; the green band is the face length needed."),
+}
+_SEVERITY_ORDER = {"error": 0, "warning": 1, "info": 2}
+
+
+def _read_asset(name: str) -> str:
+    return resources.files("camfab").joinpath("templates", "report", name).read_text(encoding="utf-8")
+
+
+def template_environment():
+    """The jinja2 environment of the report templates (autoescaping on, loaded from the package)."""
+    import jinja2
+
+    def load(name: str):
+        try:
+            return _read_asset(name)
+        except FileNotFoundError:
+            return None
+
+    return jinja2.Environment(loader=jinja2.FunctionLoader(load), autoescape=True, trim_blocks=False,
+                              keep_trailing_newline=True, undefined=jinja2.StrictUndefined)
+
+
+def script_json(data: Any) -> str:
+    """JSON safe to put inside ``<script type="application/json">``."""
+    text = json.dumps(data, separators=(",", ":"), ensure_ascii=False, allow_nan=False)
+    return text.replace("&", "\\u0026").replace("<", "\\u003c").replace(">", "\\u003e")
+
+
+def common_context(source: str | None) -> dict[str, Any]:
+    """Keys every page template needs: version, css, source name."""
+    from markupsafe import Markup
+
+    from .. import __version__
+
+    return {"version": __version__, "css": Markup(_read_asset("report.css")),
+            "source": Path(source).name if source else None}
+
+
+def plot_files(figures: Mapping[str, Any], *, standalone: bool = False) -> tuple[dict[str, bytes], list[dict]]:
+    """Render figures to ``plots/<name>.png|svg`` and describe them for the templates."""
+    from .plots import figure_bytes
+
+    files: dict[str, bytes] = {}
+    plots = []
+    for name, fig in figures.items():
+        png, svg = figure_bytes(fig, "png"), figure_bytes(fig, "svg")
+        files[f"plots/{name}.png"], files[f"plots/{name}.svg"] = png, svg
+        w, h = (fig.get_size_inches() * 110).round().astype(int)
+        title, caption = PLOT_TEXT.get(name, (name.replace("_", " ").capitalize(), ""))
+        src = ("data:image/svg+xml;base64," + base64.b64encode(svg).decode("ascii")) if standalone \
+            else f"plots/{name}.svg"
+        plots.append({"name": name, "title": title, "caption": caption, "src": src, "png": f"plots/{name}.png",
+                      "svg": f"plots/{name}.svg", "width": int(w), "height": int(h)})
+    return files, plots
+
+
+def _highlights(spec, report) -> list[str]:
+    """The worst values in words (for the verdict box)."""
+    d = report.to_dict()
+    xu = "°" if report.x_unit == "deg" else " mm"
+    out = []
+    lu = spec.follower.lift_unit
+    units = {"V": f"{lu}/s", "A": f"{lu}/s²", "J": f"{lu}/s³"}
+    for q, word in (("V", "velocity"), ("A", "acceleration"), ("J", "jerk")):
+        p = (d.get("peaks") or {}).get(q)
+        if p:
+            big, at = (p["max"], p["at_max_deg"]) if abs(p["max"]) >= abs(p["min"]) else (p["min"], p["at_min_deg"])
+            out.append(f"Largest {word} {fmt(big)} {units[q]} at {at:.1f}{xu}")
+    pa = d.get("pressure_angle_deg")
+    if pa:
+        big, at = (pa["max"], pa["at_max_deg"]) if abs(pa["max"]) >= abs(pa["min"]) else (pa["min"], pa["at_min_deg"])
+        out.append(f"Largest pressure angle {fmt(big)}° at {at:.1f}{xu} (limit ±{pa['limit']:g}°)")
+    roc = d.get("radius_of_curvature_mm") or {}
+    if roc.get("min_convex") is not None:
+        out.append(f"Smallest convex radius of curvature {fmt(roc['min_convex'])} mm at {roc['at_deg']:.1f}{xu}")
+    face = d.get("face_length_mm")
+    if face and face.get("left") is not None:
+        out.append(f"Face length needed {fmt(face['left'])} mm left and {fmt(face['right'])} mm right of the stem")
+    return out
+
+
+def _inputs(spec) -> list[dict[str, Any]]:
+    c, f, m = spec.cam, spec.follower, spec.manufacturing
+    if spec.is_translating_cam:
+        speed = f"{spec.speed:g} mm/s"
+    else:
+        speed = f"{c.omega_rad_s:.6g} rad/s ({c.omega_rad_s * 30 / math.pi:.6g} rpm)"
+    cam = [("kind", c.kind), ("direction" if spec.is_translating_cam else "rotation",
+                              c.direction if spec.is_translating_cam else c.rotation),
+           ("speed", speed + ("" if c.speed_given else " (default)"))]
+    fol = [("type", f.type), ("motion", f.motion)]
+    for key in (fl.name for fl in dataclasses.fields(f)):
+        v = getattr(f, key)
+        if key not in ("type", "motion") and v is not None:
+            fol.append((key, f"{v:g}"))
+    mfg = [(k, (f"{v:g}" if isinstance(v, float) else str(v))) for k in (fl.name for fl in dataclasses.fields(m))
+           if (v := getattr(m, k)) not in (None, "")]
+    checks = [("pressure_angle_limit_deg", f"{spec.pressure_angle_limit_deg:g}" if spec.pressure_angle_limit_deg
+               else "default (30° translating, 35° oscillating)"), ("face_margin_mm", f"{spec.face_margin_mm:g}")]
+    groups = [{"title": "Cam", "rows": cam}, {"title": "Follower", "rows": fol},
+              {"title": "Manufacturing", "rows": mfg}, {"title": "Checks", "rows": checks}]
+    if spec.motion_table is not None:
+        groups.append({"title": "Knot table", "rows": [(k, json.dumps(v) if isinstance(v, dict) else str(v))
+                                                       for k, v in spec.motion_table.items() if k != "rows"]})
+    return groups
+
+
+def _segments(prog) -> list[dict[str, str]]:
+    ax = axis_of(prog)
+    starts = np.array([s.start for s in prog.segments])
+    ends = np.array([s.start + s.span for s in prog.segments])
+    eps = 1e-12 * prog.period
+    s0 = prog.evaluate(starts + eps, (0,))[0]
+    s1 = prog.evaluate(ends - eps, (0,))[0]
+    return [{"index": i + 1, "title": s.title or s.law, "lift": f"{s1[i] - s0[i]:+.4f}",
+             "start": f"{starts[i] * ax.scale:.4f}", "end": f"{ends[i] * ax.scale:.4f}",
+             "s0": f"{s0[i]:.4f}", "s1": f"{s1[i]:.4f}"} for i, s in enumerate(prog.segments)]
+
+
+def report_context(spec, geometry, report, plots: list[dict], anim: dict) -> dict[str, Any]:
+    """Everything ``report.html.j2`` renders (plain data; see the template)."""
+    from markupsafe import Markup
+
+    xu = "°" if report.x_unit == "deg" else "mm"
+    findings = sorted(report.findings, key=lambda f: _SEVERITY_ORDER.get(f.severity, 3))
+    counts = {k: sum(f.severity == k for f in report.findings) for k in ("error", "warning", "info")}
+    ctx = common_context(spec.source)
+    ctx.update({
+        "name": spec.name, "description": spec.description, "mechanism": mechanism_text(spec),
+        "verdict": report.verdict, "verdict_text": VERDICT_TEXT[report.verdict],
+        "verdict_class": VERDICT_CLASS[report.verdict], "counts": counts, "highlights": _highlights(spec, report),
+        "rows": conclusions_rows(spec, report), "key_values": key_values(report),
+        "findings": [{"code": f.code, "severity": f.severity, "where": range_text(f, xu), "message": f.message}
+                     for f in findings],
+        "plots": plots, "plots_by_name": {p["name"]: p for p in plots}, "inputs": _inputs(spec),
+        "segments": _segments(spec.program()), "lift_unit": spec.follower.lift_unit, "x_unit": xu,
+        "closed": geometry.closed, "anim_json": Markup(script_json(anim)),
+        "anim_js": Markup(_read_asset("animation.js")),
+    })
+    return ctx
+
+
+def render_report(spec, geometry, report, *, standalone: bool = False, frames: int = 360) -> dict[str, bytes]:
+    """The files of a design's HTML report.
+
+    Parameters
+    ----------
+    spec : DesignSpec
+    geometry : CamGeometry
+        From :func:`camfab.design.assemble.geometry_from_spec`.
+    report : Report
+        From :func:`camfab.design.assemble.check_design` (knot-table warnings may be added).
+    standalone : bool
+        Embed the SVG plots as ``data:`` URIs so ``report.html`` alone is complete
+        (the ``plots/`` files are returned either way).
+    frames : int
+        Animation frames per cycle.
+
+    Returns
+    -------
+    dict[str, bytes]
+        ``{"report.html": ..., "plots/svaj.png": ..., "plots/svaj.svg": ..., ...}``.
+    """
+    from .animation import animation_data
+    from .plots import report_figures
+
+    files, plots = plot_files(report_figures(spec, geometry, report), standalone=standalone)
+    anim = animation_data(spec, geometry, report, frames=frames)
+    html = template_environment().get_template("report.html.j2").render(
+        report_context(spec, geometry, report, plots, anim))
+    return {"report.html": html.encode("utf-8"), **files}
+
+
+def write_files(files: Mapping[str, bytes], out_dir: str | Path) -> list[Path]:
+    """Write ``{relative path: bytes}`` under ``out_dir`` (atomic writes); returns the paths in order."""
+    from ..io import atomic_write
+
+    out = Path(out_dir)
+    return [atomic_write(out / rel, data) for rel, data in files.items()]

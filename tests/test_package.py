@@ -1,0 +1,141 @@
+"""`camfab run` and `camfab package`: artifacts, manifest hashes, incremental rebuilds, failures, stage skipping."""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from camfab.cli import main
+from tests.conftest import EXAMPLES
+
+FAST = "dxf,lift_table,xlsx"
+
+
+def _sha(p: Path) -> str:
+    return hashlib.sha256(p.read_bytes()).hexdigest()
+
+
+def _manifest(out: Path) -> dict:
+    return json.loads((out / "manifest.json").read_text())
+
+
+def _check_manifest(out: Path, manifest: dict) -> None:
+    for cam in manifest["cams"]:
+        for f in cam["files"]:
+            p = out / f["path"]
+            assert p.is_file(), p
+            assert _sha(p) == f["sha256"] and p.stat().st_size == f["bytes"]
+
+
+@pytest.fixture
+def designs(tmp_path):
+    src = tmp_path / "designs"
+    src.mkdir()
+    for name in ("ejemplo9rt", "ejemplo1rt", "ejemplo10ex"):
+        shutil.copy(EXAMPLES / f"{name}.toml", src)
+    return src
+
+
+def test_package_incremental(designs, tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["package", str(designs), "-o", str(out), "--outputs", FAST]) == 0
+    m1 = _manifest(out)
+    assert len(m1["cams"]) == 3 and all(c["rebuilt"] for c in m1["cams"])
+    _check_manifest(out, m1)
+    index = (out / "index.html").read_text()
+    assert all(c["name"] in index for c in m1["cams"])
+    # second run: nothing rebuilt, same hashes
+    assert main(["package", str(designs), "-o", str(out), "--outputs", FAST]) == 0
+    m2 = _manifest(out)
+    assert not any(c["rebuilt"] for c in m2["cams"])
+    assert [c["files"] for c in m2["cams"]] == [c["files"] for c in m1["cams"]]
+    # touch one design (a real change): only that cam is rebuilt
+    f = designs / "ejemplo1rt.toml"
+    f.write_text(f.read_text().replace("roller_radius_mm = 5.0", "roller_radius_mm = 6.0"))
+    assert main(["package", str(designs), "-o", str(out), "--outputs", FAST]) == 0
+    m3 = _manifest(out)
+    assert {c["name"]: c["rebuilt"] for c in m3["cams"]} == {"Ejemplo1RT": True, "Ejemplo9RT": False,
+                                                              "Ejemplo10EX": False}
+    _check_manifest(out, m3)
+    # a deleted artifact is rebuilt
+    (out / m3["cams"][0]["files"][0]["path"]).unlink()
+    assert main(["package", str(designs), "-o", str(out), "--outputs", FAST]) == 0
+    assert _manifest(out)["cams"][0]["rebuilt"]
+    # other options are another input: a different output set rebuilds everything
+    assert main(["package", str(designs), "-o", str(out), "--outputs", "dxf"]) == 0
+    assert all(c["rebuilt"] for c in _manifest(out)["cams"])
+
+
+def test_package_with_a_broken_design(designs, tmp_path, capsys):
+    (designs / "broken.toml").write_text('name = "Broken"\n[follower]\ntype = "roller"\nbase_radius_mm = -3\n')
+    out = tmp_path / "out"
+    assert main(["package", str(designs), "-o", str(out), "--outputs", "dxf", "--jobs", "2"]) == 2
+    m = _manifest(out)
+    status = {Path(c["source"]).name: c["status"] for c in m["cams"]}
+    assert status.pop("broken.toml") == "error"
+    assert set(status.values()) == {"ok"}
+    broken = next(c for c in m["cams"] if c["source"].endswith("broken.toml"))
+    assert "follower.base_radius_mm" in broken["error"]
+    assert "follower.base_radius_mm" in (out / "index.html").read_text()
+    assert "broken.toml" in capsys.readouterr().err
+
+
+def test_parallel_equals_serial(designs, tmp_path):
+    a, b = tmp_path / "a", tmp_path / "b"
+    assert main(["package", str(designs), "-o", str(a), "--outputs", FAST, "--jobs", "1"]) == 0
+    assert main(["package", str(designs), "-o", str(b), "--outputs", FAST, "--jobs", "2"]) == 0
+    fa = [(f["path"], f["sha256"]) for c in _manifest(a)["cams"] for f in c["files"]]
+    fb = [(f["path"], f["sha256"]) for c in _manifest(b)["cams"] for f in c["files"]]
+    assert fa == fb
+
+
+def test_run_unacceptable_withholds_shop_files(tmp_path, capsys):
+    d = tmp_path / "bad.toml"
+    d.write_text((EXAMPLES / "ejemplo9rt.toml").read_text().replace("base_radius_mm = 35.0", "base_radius_mm = 12.0"))
+    out = tmp_path / "out"
+    assert main(["run", str(d), "-o", str(out), "--outputs", "dxf,gcode,xlsx"]) == 1
+    names = {p.name for p in out.iterdir()}
+    assert names == {"check.json", "Ejemplo9RT.xlsx"}
+    assert "withheld" in capsys.readouterr().out
+    assert main(["run", str(d), "-o", str(out), "--outputs", "dxf", "--force"]) == 1
+    assert (out / "Ejemplo9RT.dxf").exists()
+
+
+def test_run_default_example_and_bad_outputs(tmp_path, capsys):
+    assert main(["run", "-o", str(tmp_path / "o"), "--outputs", "dxf"]) == 0
+    assert (tmp_path / "o" / "Ejemplo9RT.dxf").exists()
+    assert main(["run", "-o", str(tmp_path / "p"), "--outputs", "dxf,pdf"]) == 2
+    assert "'pdf' is not a valid option" in capsys.readouterr().err
+    assert not (tmp_path / "p").exists()
+
+
+def test_no_cadquery_or_offsets_without_step_and_gcode(tmp_path):
+    code = ("import sys, camfab.offset.cutter as c\n"
+            "calls = []\n"
+            "orig = c.tool_centre_path\n"
+            "c.tool_centre_path = lambda *a, **k: calls.append(1) or orig(*a, **k)\n"
+            "from camfab.cli import main\n"
+            f"rc = main(['run', 'ejemplo9rt', '-o', r'{tmp_path / 'o'}', '--outputs', 'dxf,stl,xlsx'])\n"
+            "print(rc, 'cadquery' in sys.modules, 'OCP' in sys.modules, len(calls))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                         env={**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])})
+    assert out.stdout.splitlines()[-1].split() == ["0", "False", "False", "0"]
+
+
+@pytest.mark.slow
+def test_package_examples_library(tmp_path):
+    """Every example in the library runs through `camfab package` with its own [outputs]."""
+    out = tmp_path / "lib"
+    rc = main(["package", str(EXAMPLES), "-o", str(out), "--jobs", "2"])
+    m = _manifest(out)
+    assert rc == 0, [(c["name"], c.get("error")) for c in m["cams"] if c["status"] != "ok"]
+    assert {c["status"] for c in m["cams"]} == {"ok"}
+    _check_manifest(out, m)
+    assert main(["package", str(EXAMPLES), "-o", str(out), "--jobs", "2"]) == 0
+    assert not any(c["rebuilt"] for c in _manifest(out)["cams"])
