@@ -237,8 +237,8 @@ def _export_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--stl", action="store_true", help="write the STL mesh")
     p.add_argument("--tol", type=float, default=None,
                    help="max distance of every entity from the exact profile, mm (default: the design's, 0.001)")
-    p.add_argument("--dxf-flavour", choices=("lwpolyline", "r12"), default="lwpolyline",
-                   help="LWPOLYLINE with bulges (default) or R12 LINE/ARC entities")
+    p.add_argument("--dxf-flavour", choices=("lwpolyline", "r12", "spline"), default="lwpolyline",
+                   help="LWPOLYLINE with bulges (default), R12 LINE/ARC entities, or one exact rational SPLINE")
     p.add_argument("--tool-path", action="store_true",
                    help="add the tool-centre path of [manufacturing] tool_diameter_mm to the DXF (TOOL_PATH layer)")
     p.add_argument("--force", action="store_true", help="export even if the design's verdict is unacceptable")
@@ -304,6 +304,7 @@ def _gcode_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--safe-z", type=float, default=25.0, help="safe height for rapids, mm")
     p.add_argument("--compensation", choices=("G41", "G42"), default=None,
                    help="emit the part contour with cutter compensation instead of tool-centre coordinates")
+    p.add_argument("--lines-only", action="store_true", help="write the finishing contour as G1 lines (no G2/G3)")
     p.add_argument("--lift-table", metavar="CSV", help="also write the polar lift table for cam grinders")
     p.add_argument("--lift-step", type=float, default=1.0, help="lift-table step in degrees (divides 360)")
     p.add_argument("--force", action="store_true", help="write even if the design's verdict is unacceptable")
@@ -351,7 +352,7 @@ def cmd_gcode(args: argparse.Namespace) -> int:
     out = Path(args.output)
     texts = []
     for i, contact in enumerate(geom.profiles):
-        cp = cam_program(contact, job, tol=tol, compensation=args.compensation)
+        cp = cam_program(contact, job, tol=tol, compensation=args.compensation, arcs_allowed=not args.lines_only)
         name = out if len(geom.profiles) == 1 else out.with_name(f"{out.stem}_cam{i + 1}{out.suffix}")
         texts.append((name, dumps(cp.program, post), cp))
     lift = None

@@ -6,6 +6,10 @@ Flavours
     each loop is one closed LWPOLYLINE whose bulges carry the arcs exactly.
 ``r12``
     R12-safe LINE and ARC entities (DXF R12 file), for old CAM software.
+``spline``
+    each loop is one closed rational quadratic SPLINE (NURBS) that reproduces the
+    arcs exactly (arcs split at 90°, weight cos(θ/2) on the middle control point),
+    for CAD systems that want one smooth curve.
 
 Layers: ``PROFILE``, ``PITCH_CURVE``, ``BASE_CIRCLE``, ``PRIME_CIRCLE``, ``BORE``,
 ``TOOL_PATH``, ``CENTRE_MARKS``; the second cam of a conjugate pair is on ``PROFILE_2``
@@ -26,12 +30,12 @@ import numpy as np
 from ..errors import MissingDependencyError
 from .plate import BulgeLoop
 
-__all__ = ["DxfContent", "LAYERS", "FLAVOURS", "dumps", "build_document"]
+__all__ = ["DxfContent", "LAYERS", "FLAVOURS", "dumps", "build_document", "loop_nurbs", "write_deterministic"]
 
 #: layer name -> ACI colour
 LAYERS = {"PROFILE": 7, "PROFILE_2": 4, "PITCH_CURVE": 2, "PITCH_CURVE_2": 2, "BASE_CIRCLE": 3,
           "PRIME_CIRCLE": 1, "BORE": 5, "TOOL_PATH": 6, "CENTRE_MARKS": 8}
-FLAVOURS = ("lwpolyline", "r12")
+FLAVOURS = ("lwpolyline", "r12", "spline")
 
 
 @dataclass(frozen=True)
@@ -58,7 +62,44 @@ def _ezdxf():
     return ezdxf
 
 
+def loop_nurbs(loop: BulgeLoop) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Control points, weights and knots of a closed degree-2 rational B-spline equal to ``loop``.
+
+    Lines become a straight piece (middle control point halfway, weight 1); arcs are split into
+    pieces of at most 90° whose middle control point lies at the tangents' intersection with
+    weight cos(θ/2), the exact conic form of a circular arc.
+    """
+    ctrl, w = [], []
+    for p0, p1, b in loop.segments():
+        if abs(b) < 1e-15:
+            ctrl += [p0, (p0 + p1) / 2]
+            w += [1.0, 1.0]
+            continue
+        c = BulgeLoop._centre(p0, p1, b)
+        r = float(math.hypot(*(p0 - c)))
+        th = 4 * math.atan(b)
+        k = max(1, math.ceil(abs(th) / (math.pi / 2) - 1e-12))
+        a0 = math.atan2(p0[1] - c[1], p0[0] - c[0])
+        d = th / k
+        for i in range(k):
+            a = a0 + i * d
+            q0 = p0 if i == 0 else c + r * np.array([math.cos(a), math.sin(a)])
+            am = a + d / 2
+            ctrl += [q0, c + r / math.cos(d / 2) * np.array([math.cos(am), math.sin(am)])]
+            w += [1.0, math.cos(d / 2)]
+    m = len(ctrl) // 2
+    ctrl.append(loop.points[0])
+    w.append(1.0)
+    knots = [0.0, 0.0, 0.0] + [float(j) for j in range(1, m) for _ in (0, 1)] + [float(m)] * 3
+    return np.asarray(ctrl, dtype=float), np.asarray(w), np.asarray(knots)
+
+
 def _add_loop(msp, loop: BulgeLoop, layer: str, flavour: str) -> None:
+    if flavour == "spline":
+        ctrl, w, knots = loop_nurbs(loop)
+        msp.add_rational_spline([(float(x), float(y), 0.0) for x, y in ctrl], [float(v) for v in w], degree=2,
+                                knots=[float(v) for v in knots], dxfattribs={"layer": layer})
+        return
     if flavour == "lwpolyline":
         pts = [(float(x), float(y), 0.0, 0.0, float(b)) for (x, y), b in zip(loop.points, loop.bulges)]
         msp.add_lwpolyline(pts, format="xyseb", close=True, dxfattribs={"layer": layer})

@@ -16,7 +16,7 @@ from ..offset.cutter import offset_curve, profile_curve, tool_centre_path
 from ..offset.discretize import ArcDiscretisation, ParametricCurve, arcs, polyline
 from .toolpath import Job, Program, Segment, contour_toolpath
 
-__all__ = ["segments_from_arcs", "cam_program", "CamProgram", "signed_distance"]
+__all__ = ["segments_from_arcs", "segments_from_polyline", "cam_program", "CamProgram", "signed_distance"]
 
 
 def segments_from_arcs(fit: ArcDiscretisation) -> list[Segment]:
@@ -45,22 +45,42 @@ class CamProgram:
 FIT_SHARE = 0.8
 
 
-def cam_program(contact, job: Job, *, tol: float, compensation: str | None = None) -> CamProgram:
-    """The contour-milling program of one profile (periphery, outside)."""
+def segments_from_polyline(points: np.ndarray) -> list[Segment]:
+    """Line segments through consecutive points of a closed polyline (last point == first)."""
+    return [Segment(tuple(a), tuple(b)) for a, b in zip(points[:-1], points[1:])]
+
+
+def cam_program(contact, job: Job, *, tol: float, compensation: str | None = None,
+                arcs_allowed: bool = True) -> CamProgram:
+    """The contour-milling program of one profile (periphery, outside).
+
+    ``arcs_allowed=False`` writes the finishing contour as G1 lines only (a polyline within the
+    same tolerance), for controllers or shops that do not want G2/G3.
+    """
     r = job.tool_radius_mm
     tol_fit = max(tol * FIT_SHARE, 1e-6)
     path = tool_centre_path(contact, r, tol=tol_fit)
+    if not arcs_allowed and not compensation:
+        line = polyline(path.curve, tol=tol_fit)
+        job = _with_deviation(job, line.max_deviation)
+        prog = contour_toolpath(segments_from_polyline(line.points), job, roughing_contours=_rough(contact, job, tol))
+        return CamProgram(prog, line.max_deviation, path.shapely_deviation, line.n_entities)
     job = _with_deviation(job, path.max_deviation)
     if compensation:
         part = arcs(profile_curve(contact), tol=tol_fit)
         prog = contour_toolpath(segments_from_arcs(part), job, compensation=compensation)
         return CamProgram(prog, part.max_deviation, path.shapely_deviation, part.n_entities)
-    rough = []
-    for k in range(job.roughing_passes, 0, -1):  # outermost first
-        d = r + job.roughing_allowance_mm + (k - 1) * job.stepover
-        rough.append(segments_from_arcs(arcs(offset_curve(contact, d), tol=max(tol, 1e-3))))
-    prog = contour_toolpath(segments_from_arcs(path.arcs), job, roughing_contours=rough)
+    prog = contour_toolpath(segments_from_arcs(path.arcs), job, roughing_contours=_rough(contact, job, tol))
     return CamProgram(prog, path.max_deviation, path.shapely_deviation, path.arcs.n_entities)
+
+
+def _rough(contact, job: Job, tol: float) -> list[list[Segment]]:
+    """Roughing contours, outermost first: exact offsets by tool radius + allowance + k·step-over."""
+    out = []
+    for k in range(job.roughing_passes, 0, -1):
+        d = job.tool_radius_mm + job.roughing_allowance_mm + (k - 1) * job.stepover
+        out.append(segments_from_arcs(arcs(offset_curve(contact, d), tol=max(tol, 1e-3))))
+    return out
 
 
 def _with_deviation(job: Job, dev: float) -> Job:

@@ -27,9 +27,10 @@ __all__ = ["profile_curve", "pitch_curve", "offset_curve", "concave_limit", "Too
 #: shapely buffer resolution (segments per quarter circle) and join style, always explicit
 QUAD_SEGS = 64
 JOIN_STYLE = "round"
-#: the shapely cross-check works on a polyline of the profile; below this tolerance (mm) it checks
+#: the shapely cross-check buffers a polyline of the profile (GEOS simplifies its input slightly), so
+#: below this tolerance (mm) it checks
 #: at this resolution (the exact offset itself is still fitted to the requested tolerance)
-SHAPELY_CHECK_MIN_MM = 1e-5
+SHAPELY_CHECK_MIN_MM = 1e-4
 
 
 def _deg(contact, x):

@@ -198,3 +198,22 @@ def test_conjugate_step_pair(tmp_path):
     loops = cam_shapes(geom, tol=1e-4, with_pitch=False).profiles
     plate = PlateSpec(12.0, 20.0, True)
     assert vol == pytest.approx(sum(plate_volume(lp, plate) for lp in loops), rel=1e-9)
+
+
+@pytest.mark.parametrize("tol", [1e-2, 1e-3, 1e-4])
+def test_dxf_spline_flavour_is_exact_nurbs_of_the_arcs(tol):
+    spec = DESIGNS["ejemplo9rt"]()
+    geom = geometry_from_spec(spec)
+    (art,) = build_artifacts(spec, geom, ["dxf"], tol=tol, dxf_flavour="spline")
+    doc = ezdxf.read(io.StringIO(art.data.decode()))
+    assert not doc.audit().has_errors
+    (sp,) = doc.modelspace().query("SPLINE[layer=='PROFILE']")
+    bs = sp.construction_tool()
+    assert bs.degree == 2
+    t = np.linspace(0, bs.max_t, 40001)
+    pts = np.array([(p.x, p.y) for p in bs.points(t)])
+    # every spline point is on one of the fitted arcs (to round-off) and the whole is within tol
+    loop = cam_shapes(geom, tol=tol, with_pitch=False).profiles[0]
+    rows = np.column_stack([loop.points, loop.bulges])
+    assert Chain.from_bulges(rows).distance(pts)[0].max() < 1e-9
+    assert measure_deviation(pts, profile_curve(geom.profiles[0])).max <= tol

@@ -146,3 +146,17 @@ def test_cli_gcode_refuses_big_tool_and_unacceptable(tmp_path, capsys):
     d.write_text((EXAMPLES / "ejemplo9rt.toml").read_text().replace("base_radius_mm = 35.0", "base_radius_mm = 12.0"))
     assert main(["gcode", str(d), "-o", str(out)]) == 1
     assert "nothing written" in capsys.readouterr().err and not out.exists()
+
+
+def test_lines_only_program_verifies_and_has_no_arcs_in_the_finish(programs):
+    contact, _ = programs["ejemplo9rt"]
+    job = Job(tool_diameter_mm=2 * R_TOOL, depth_mm=10.0, tolerance_mm=TOL)
+    cp = cam_program(contact, job, tol=TOL, arcs_allowed=False)
+    text = dumps(cp.program, "linuxcnc")
+    lines = text.splitlines()
+    start = lines.index("(FINISH CONTOUR)")
+    end = next(i for i in range(start + 1, len(lines)) if lines[i].startswith("(") and "LEAD-OUT" in lines[i])
+    assert not any(re.search(r"\bG0?[23]\b", ln) for ln in lines[start + 1:end])
+    rep = _verify(text, contact)
+    assert rep.ok and rep.max_deviation_mm <= TOL
+    assert cp.entities > 300  # a polyline needs far more moves than the ~90 arcs

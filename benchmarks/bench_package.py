@@ -1,0 +1,82 @@
+"""Benchmark: `camfab package` of N generated cams, without and with STEP, on 1 and 2 processes.
+
+Generates N valid designs (translating and oscillating rollers, flat faces; 4-8 segments of
+dwell-compatible laws; random geometry scaled to pass the checks), then times
+``camfab package --outputs dxf,stl,gcode,lift_table,xlsx,report,drawing`` (and the same plus step) with
+--jobs 1 and --jobs 2, each into a fresh folder.  Reports wall time, peak resident memory (the parent and
+its worker processes) and the speed-up.
+
+Run:  python3 benchmarks/bench_package.py [--n 100] [--no-step]
+"""
+from __future__ import annotations
+
+import argparse
+import random
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+LAWS = ("cycloidal", "poly345", "poly4567", "modified_sine", "modified_trapezoid")
+OUTPUTS = "dxf,stl,gcode,lift_table,xlsx,report,drawing"
+
+
+def design(i: int, rng: random.Random) -> str:
+    kind = ("translating_roller", "oscillating_roller", "translating_flat")[i % 3]
+    n_moves = rng.choice((1, 2))
+    spans, rows = [], []
+    for k in range(n_moves):  # rise, dwell, return, dwell per move
+        h = rng.uniform(5, 15) if kind != "oscillating_roller" else rng.uniform(5, 12)
+        b = rng.uniform(60, 100) / n_moves
+        d = 180 / n_moves - b
+        rows += [(rng.choice(LAWS), h, b), ("dwell", 0, d), (rng.choice(LAWS), -h, b), ("dwell", 0, d)]
+    motion = "".join(f'[[motion]]\nlaw = "{law}"\nlift = {h:.3f}\nangle_deg = {b:.6f}\n' for law, h, b in rows)
+    if kind == "translating_roller":
+        fol = 'type = "roller"\nmotion = "translating"\nbase_radius_mm = 70.0\nroller_radius_mm = 8.0\n'
+    elif kind == "oscillating_roller":
+        fol = ('type = "roller"\nmotion = "oscillating"\nbase_radius_mm = 90.0\nroller_radius_mm = 10.0\n'
+               'pivot_distance_mm = 150.0\narm_length_mm = 100.0\n')
+    else:
+        fol = 'type = "flat"\nmotion = "translating"\nbase_radius_mm = 120.0\n'
+    return (f'name = "Bench{i:03d}"\n[cam]\nspeed_rpm = 60.0\n[follower]\n{fol}{motion}'
+            '[manufacturing]\nthickness_mm = 10.0\nbore_mm = 20.0\nkeyway = true\ntool_diameter_mm = 6.0\n'
+            'tolerance_mm = 0.001\n[checks]\npressure_angle_limit_deg = 40.0\n')
+
+
+def run(src: Path, out: Path, jobs: int, outputs: str) -> tuple[float, float, int]:
+    cmd = [sys.executable, "-m", "camfab", "package", str(src), "-o", str(out), "--jobs", str(jobs),
+           "--outputs", outputs, "--force"]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    t = time.perf_counter()
+    rc = subprocess.run(cmd, capture_output=True, text=True).returncode
+    wall = time.perf_counter() - t
+    peak = max(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss, before) / 1024
+    return wall, peak, rc
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--n", type=int, default=100)
+    ap.add_argument("--no-step", action="store_true")
+    a = ap.parse_args()
+    rng = random.Random(1)
+    with tempfile.TemporaryDirectory() as tmp:
+        src = Path(tmp) / "designs"
+        src.mkdir()
+        for i in range(a.n):
+            (src / f"bench{i:03d}.toml").write_text(design(i, rng))
+        print(f"{a.n} generated cams")
+        print(f"{'outputs':<34}{'jobs':>5}{'wall s':>9}{'s/cam':>8}{'peak MB':>9}{'speed-up':>10}{'rc':>4}")
+        sets = [("all but STEP", OUTPUTS)] + ([] if a.no_step else [("all with STEP", OUTPUTS + ",step")])
+        for label, outputs in sets:
+            base = None
+            for jobs in (1, 2):
+                wall, peak, rc = run(src, Path(tmp) / f"out_{label[:3]}_{jobs}", jobs, outputs)
+                base = base or wall
+                print(f"{label:<34}{jobs:>5}{wall:>9.1f}{wall / a.n:>8.2f}{peak:>9.0f}{base / wall:>9.2f}x{rc:>4}")
+
+
+if __name__ == "__main__":
+    main()
