@@ -120,6 +120,12 @@ def _build(args: tuple) -> dict:
     except (CamfabError, OSError, ValueError) as exc:
         entry.update(status="error", verdict=None, error=str(exc), files=[],
                      error_type=type(exc).__name__)
+    except Exception as exc:  # an internal failure on one design must not lose the others
+        import traceback
+
+        entry.update(status="error", verdict=None, files=[], error_type=type(exc).__name__,
+                     error=f"internal error ({type(exc).__name__}: {exc}); please report it with this design",
+                     traceback=traceback.format_exc())
         entry.setdefault("name", Path(path).stem)
     entry["seconds"] = time.perf_counter() - t0
     return entry
@@ -170,13 +176,19 @@ def package(paths: Iterable[str | Path], out: str | Path, *, jobs: int = 1, over
         done += 1
         entries[entry["source"]] = entry
         tail = entry.get("verdict") or f"ERROR: {entry.get('error', '').splitlines()[0]}"
-        say(f"[{done}/{len(todo)}] {entry['name']}: {tail} ({entry['seconds']:.2f} s)")
+        say(f"{_bar(done, len(todo))} {done}/{len(todo)} {entry['name']}: {tail} ({entry['seconds']:.2f} s)")
     manifest = {"camfab_version": __version__, "jobs": jobs, "wall_seconds": time.perf_counter() - t0,
                 "cams": [entries[str(p)] for p in designs]}
     _dedupe_folders(manifest)
     atomic_write(out / MANIFEST, json.dumps(manifest, indent=2) + "\n")
     atomic_write(out / INDEX, _index_html(manifest))
     return manifest
+
+
+def _bar(done: int, total: int, width: int = 20) -> str:
+    """A text progress bar ``[#####---------------]``."""
+    k = round(width * done / max(total, 1))
+    return "[" + "#" * k + "-" * (width - k) + "]"
 
 
 def _map(fn, items: list, jobs: int):

@@ -241,14 +241,37 @@ class DiscRollerContact(Contact):
     def evaluate(self, phi) -> ProfileSample:
         x, S = self._S(phi)
         C, C1, C2, v, arm = self._path(S)
-        sg = self.sense
-        T = sg * _J(C) + C1
-        A2 = -C + 2 * sg * _J(C1) + C2
-        out = _roller(C, T, A2, v, self.roller_radius, sg)
+        sg, rr = self.sense, self.roller_radius
+        # component arrays (contiguous) instead of (n, 2) column slices: this is the hot path
+        cx, cy = C[:, 0], C[:, 1]
+        tx, ty = C1[:, 0] - sg * cy, C1[:, 1] + sg * cx            # T = σ·J·C + C′
+        ax = C2[:, 0] - cx - 2 * sg * C1[:, 1]                      # A2 = −C + 2σ·J·C′ + C″
+        ay = C2[:, 1] - cy + 2 * sg * C1[:, 0]
+        speed = np.hypot(tx, ty)
+        ux, uy = tx / speed, ty / speed                             # unit tangent
+        kp = sg * (tx * ay - ty * ax) / speed**3                    # pitch-curve curvature
+        nx, ny = sg * uy, -sg * ux                                  # n = −σ·J·t
+        scale = 1.0 - rr * kp
+        with np.errstate(divide="ignore", invalid="ignore"):
+            k = kp / scale
+        vx, vy = v[:, 0], v[:, 1]
+        delta = np.arctan2(-sg * (vx * ny - vy * nx), vx * nx + vy * ny)
         c, s = np.cos(sg * x), np.sin(sg * x)
-        pitch, point, dpoint, n, t, kp, k, delta = out
-        return ProfileSample(x, _rot(point, c, s), _rot(dpoint, c, s), _rot(n, c, s), _rot(t, c, s),
-                             k, _inv(k), _rot(pitch, c, s), kp, _inv(kp), delta, None, arm)
+        rot = _rotator(c, s)
+        return ProfileSample(x, rot(cx - rr * nx, cy - rr * ny), rot(tx * scale, ty * scale), rot(nx, ny),
+                             rot(ux, uy), k, _inv(k), rot(cx, cy), kp, _inv(kp), delta, None, arm)
+
+
+def _rotator(c: np.ndarray, s: np.ndarray):
+    """``rot(x, y) -> (n, 2)``: components rotated by the angle whose cos/sin are c, s."""
+
+    def rot(x, y):
+        out = np.empty((c.size, 2))
+        out[:, 0] = x * c - y * s
+        out[:, 1] = x * s + y * c
+        return out
+
+    return rot
 
 
 def _inv(k: np.ndarray) -> np.ndarray:

@@ -37,6 +37,7 @@ from typing import Callable, Optional
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ..errors import GeometryError
 from ..tolerances import DEFAULT_EXPORT_TOL_MM, MAX_EXPORT_TOL_MM, MIN_EXPORT_TOL_MM
 
 __all__ = [
@@ -839,7 +840,7 @@ def _refine(curve: ParametricCurve, nodes: np.ndarray, target: float, kind: str,
         width = np.diff(nodes)
         if np.any(width[bad] < 1e-12 * curve.period):
             where = nodes[:-1][bad & (width < 1e-12 * curve.period)][0]
-            raise RuntimeError(f"cannot reach the tolerance near parameter {where:.9g}: "
+            raise GeometryError(f"cannot reach the tolerance near parameter {where:.9g}: "
                                "is the curve continuous there?")
         ratio = np.where(np.isfinite(dev), dev / target, 8.0)
         parts = np.where(bad, np.clip(np.ceil(1.05 * ratio ** (1.0 / power)), 2, 16), 1).astype(int)
@@ -849,7 +850,8 @@ def _refine(curve: ParametricCurve, nodes: np.ndarray, target: float, kind: str,
         j = np.arange(a.size) - group_start
         nodes = np.append(a + w * j / np.repeat(parts, parts), curve.period)
         dev = np.repeat(np.where(bad, np.nan, dev), parts)
-    raise RuntimeError("discretisation did not converge")
+    raise GeometryError("the discretisation did not converge: the curve may have a cusp or cross itself "
+                        "(an undercut profile cannot be exported)")
 
 
 def _equidistribute(curve: ParametricCurve, nodes: np.ndarray, dev: np.ndarray, target: float,
@@ -892,7 +894,8 @@ def _fit(curve: ParametricCurve, tol: float, kind: str, verify: Callable[[np.nda
             return nodes, measured
         target *= 0.7
         nodes, dev = _refine(curve, nodes, target, kind, dev)
-    raise RuntimeError(f"could not verify the tolerance {tol:g} mm (measured {measured:.3g} mm)")
+    raise GeometryError(f"could not verify the tolerance {tol:g} mm (measured {measured:.3g} mm): the curve "
+                        "may have a cusp or cross itself (an undercut profile cannot be exported)")
 
 
 # --------------------------------------------------------------------------------------

@@ -160,3 +160,32 @@ def test_lines_only_program_verifies_and_has_no_arcs_in_the_finish(programs):
     rep = _verify(text, contact)
     assert rep.ok and rep.max_deviation_mm <= TOL
     assert cp.entities > 300  # a polyline needs far more moves than the ~90 arcs
+
+
+def _millable_examples():
+    out = []
+    for p in sorted(EXAMPLES.glob("*.toml")):
+        spec = load_design(p)
+        if spec.cam.kind != "translating" and spec.manufacturing.tool_diameter_mm:
+            out.append(p.stem)
+    return out
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", _millable_examples())
+def test_every_example_design_verifies_with_every_post(name):
+    spec = load_design(EXAMPLES / f"{name}.toml")
+    geom = geometry_from_spec(spec)
+    tol = spec.manufacturing.tolerance_mm
+    tool = spec.manufacturing.tool_diameter_mm
+    job = Job(tool_diameter_mm=tool, depth_mm=spec.manufacturing.thickness_mm, tolerance_mm=tol,
+              design_name=spec.name)
+    for contact in geom.profiles:
+        cp = cam_program(contact, job, tol=tol)
+        part = signed_distance(profile_curve(contact), tol=tol)
+        centre = signed_distance(offset_curve(contact, tool / 2), tol=tol)
+        for post in ("linuxcnc", "fanuc", "grbl"):
+            rep = verify(parse(dumps(cp.program, post)), exact_curve_distance=centre, part_distance=part,
+                         tool_radius=tool / 2, tol=tol, safe_z=job.safe_z_mm)
+            assert rep.ok, (name, post, rep.to_dict()["problems"])
+            assert rep.max_deviation_mm <= tol and not rep.gouge
