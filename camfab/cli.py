@@ -554,13 +554,7 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_INPUT
     try:
         return COMMANDS[args.command](args)
-    except SpecError as exc:
-        print(f"camfab {args.command}: error: {exc}", file=sys.stderr)
-        return EXIT_INPUT
-    except UsageError as exc:
-        print(f"camfab {args.command}: error: {exc}", file=sys.stderr)
-        return EXIT_INPUT
-    except GeometryError as exc:
+    except (SpecError, UsageError, GeometryError) as exc:
         print(f"camfab {args.command}: error: {exc}", file=sys.stderr)
         return EXIT_INPUT
     except MissingDependencyError as exc:

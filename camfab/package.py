@@ -126,7 +126,7 @@ def _build(args: tuple) -> dict:
         entry.update(status="error", verdict=None, files=[], error_type=type(exc).__name__,
                      error=f"internal error ({type(exc).__name__}: {exc}); please report it with this design",
                      traceback=traceback.format_exc())
-        entry.setdefault("name", Path(path).stem)
+    entry.setdefault("name", Path(path).stem)
     entry["seconds"] = time.perf_counter() - t0
     return entry
 

@@ -30,6 +30,25 @@ def base_design(**over):
     return d
 
 
+def _designs():
+    from camfab.design.spec import design_from_dict, load_design
+
+    osc = base_design(follower={"type": "roller", "motion": "oscillating", "base_radius_mm": 40.0,
+                                "roller_radius_mm": 8.0, "pivot_distance_mm": 110.0, "arm_length_mm": 90.0},
+                      motion=[{"law": "dwell", "lift": 0.0, "angle_deg": 90.0},
+                              {"law": "poly4567", "lift": 15.0, "angle_deg": 90.0},
+                              {"law": "poly4567", "lift": -6.0, "angle_deg": 45.0},
+                              {"law": "poly4567", "lift": 6.0, "angle_deg": 45.0},
+                              {"law": "poly4567", "lift": -15.0, "angle_deg": 90.0}])
+    flat = base_design(follower={"type": "flat", "motion": "translating", "base_radius_mm": 100.0})
+    return {"ejemplo9rt": lambda: load_design(EXAMPLES / "ejemplo9rt.toml"),
+            "oscillating": lambda: design_from_dict(osc), "flat": lambda: design_from_dict(flat)}
+
+
+#: three designs covering a translating roller, an oscillating roller and a flat face (factories)
+DESIGNS = _designs()
+
+
 @pytest.fixture
 def design_dict():
     return base_design()

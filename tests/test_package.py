@@ -139,3 +139,21 @@ def test_package_examples_library(tmp_path):
     _check_manifest(out, m)
     assert main(["package", str(EXAMPLES), "-o", str(out), "--jobs", "2"]) == 0
     assert not any(c["rebuilt"] for c in _manifest(out)["cams"])
+
+
+def test_internal_error_on_one_design_does_not_lose_the_others(designs, tmp_path, monkeypatch):
+    import camfab.jobs
+
+    real = camfab.jobs.run_design
+
+    def flaky(spec, *a, **k):
+        if spec.name == "Ejemplo1RT":
+            raise RuntimeError("simulated bug")
+        return real(spec, *a, **k)
+
+    monkeypatch.setattr(camfab.jobs, "run_design", flaky)
+    out = tmp_path / "out"
+    assert main(["package", str(designs), "-o", str(out), "--outputs", "dxf", "--jobs", "1"]) == 2
+    cams = {c["name"]: c for c in _manifest(out)["cams"]}
+    assert cams["Ejemplo1RT"]["status"] == "error" and "simulated bug" in cams["Ejemplo1RT"]["error"]
+    assert cams["Ejemplo9RT"]["status"] == cams["Ejemplo10EX"]["status"] == "ok"

@@ -7,7 +7,6 @@ STEP, tool paths only when a cutter is given).
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Iterable

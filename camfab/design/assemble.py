@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 
-from ..errors import Problem, SpecError
+from ..errors import SpecError
 from .checks import Report, check
 from .motion_report import Finding
 from .mechanisms import OscillatingFlat, OscillatingRoller, TranslatingCamRoller, TranslatingFlat, TranslatingRoller

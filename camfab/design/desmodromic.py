@@ -240,7 +240,7 @@ def _margin(mech: _Desmodromic, program, h: float, q: float, rmin: float, explai
     c, rb2, exist = mech._second(program, h, q)
     if exist <= 0:
         return ("the second follower cannot be placed opposite the first (it would reach or cross the line "
-                "through the cam centre)") if explain else exist
+                "through the cam centre)") if explain else exist - 1.0  # strictly < 0: inadmissible
     out = [(rb2 - rmin, f"the second cam's base radius would be {rb2:.6g} mm"
             + (f", not above the bore radius {rmin:.6g} mm" if rmin else ", not > 0"))]
     edges = c.breakpoints

@@ -247,9 +247,9 @@ class DiscRollerContact(Contact):
         tx, ty = C1[:, 0] - sg * cy, C1[:, 1] + sg * cx            # T = σ·J·C + C′
         ax = C2[:, 0] - cx - 2 * sg * C1[:, 1]                      # A2 = −C + 2σ·J·C′ + C″
         ay = C2[:, 1] - cy + 2 * sg * C1[:, 0]
-        speed = np.hypot(tx, ty)
-        ux, uy = tx / speed, ty / speed                             # unit tangent
-        kp = sg * (tx * ay - ty * ax) / speed**3                    # pitch-curve curvature
+        inv = 1.0 / np.hypot(tx, ty)
+        ux, uy = tx * inv, ty * inv                                 # unit tangent
+        kp = sg * (tx * ay - ty * ax) * (inv * inv * inv)           # pitch-curve curvature
         nx, ny = sg * uy, -sg * ux                                  # n = −σ·J·t
         scale = 1.0 - rr * kp
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -266,10 +266,10 @@ def _rotator(c: np.ndarray, s: np.ndarray):
     """``rot(x, y) -> (n, 2)``: components rotated by the angle whose cos/sin are c, s."""
 
     def rot(x, y):
-        out = np.empty((c.size, 2))
-        out[:, 0] = x * c - y * s
-        out[:, 1] = x * s + y * c
-        return out
+        out = np.empty((2, c.size))  # filled row-wise (contiguous), returned as an (n, 2) view
+        np.subtract(x * c, y * s, out=out[0])
+        np.add(x * s, y * c, out=out[1])
+        return out.T
 
     return rot
 
@@ -345,14 +345,16 @@ class DiscFlatContact(Contact):
         w = sg + b1
         s = p1 / w
         rho = p + p2 / w**2 - p1 * b2 / w**3
-        n = _xy(np.cos(beta), np.sin(beta))
-        jn = _J(n)
-        P = p[:, None] * n + s[:, None] * jn
+        nx, ny = np.cos(beta), np.sin(beta)                 # face normal; J·n = (−ny, nx)
+        P = np.empty((x.size, 2))
+        P[:, 0] = p * nx - s * ny
+        P[:, 1] = p * ny + s * nx
         v, pos, arm = self._extras(P, s, S)
-        delta = _pressure(v, n, sg)
-        c, sn = np.cos(sg * x), np.sin(sg * x)
-        return ProfileSample(x, _rot(P, c, sn), _rot(jn * (w * rho)[:, None], c, sn), _rot(n, c, sn),
-                             _rot(sg * jn, c, sn), _inv(rho), rho, None, None, None, delta, pos, arm)
+        delta = np.arctan2(-sg * (v[:, 0] * ny - v[:, 1] * nx), v[:, 0] * nx + v[:, 1] * ny)
+        rot = _rotator(np.cos(sg * x), np.sin(sg * x))
+        wr = w * rho
+        return ProfileSample(x, rot(P[:, 0], P[:, 1]), rot(-ny * wr, nx * wr), rot(nx, ny),
+                             rot(-sg * ny, sg * nx), _inv(rho), rho, None, None, None, delta, pos, arm)
 
 
 class TranslatingFlatContact(DiscFlatContact):

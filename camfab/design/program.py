@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import Problem, SpecError
 from ..tolerances import ANGLE_SUM_TOL_DEG
-from .laws import GENERIC, HALF_PERIOD, LAWS, Law, get_law, law_names
+from .laws import GENERIC, HALF_PERIOD, LAWS, get_law, law_names
 
 __all__ = [
     "SegmentInput",

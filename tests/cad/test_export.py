@@ -11,24 +11,14 @@ from camfab.cad.export import build_artifacts, cam_shapes
 from camfab.cad.plate import PlateSpec, plate_volume
 from camfab.cli import main
 from camfab.design.assemble import geometry_from_spec
-from camfab.design.spec import design_from_dict, load_design
+from camfab.design.spec import design_from_dict
 from camfab.offset.cutter import profile_curve
 from camfab.offset.discretize import Chain, measure_deviation, polyline
-from tests.conftest import EXAMPLES, base_design
+from tests.conftest import DESIGNS, EXAMPLES, base_design
 
 ezdxf = pytest.importorskip("ezdxf")
 trimesh = pytest.importorskip("trimesh")
 
-OSC = base_design(follower={"type": "roller", "motion": "oscillating", "base_radius_mm": 40.0,
-                            "roller_radius_mm": 8.0, "pivot_distance_mm": 110.0, "arm_length_mm": 90.0},
-                  motion=[{"law": "dwell", "lift": 0.0, "angle_deg": 90.0},
-                          {"law": "poly4567", "lift": 15.0, "angle_deg": 90.0},
-                          {"law": "poly4567", "lift": -6.0, "angle_deg": 45.0},
-                          {"law": "poly4567", "lift": 6.0, "angle_deg": 45.0},
-                          {"law": "poly4567", "lift": -15.0, "angle_deg": 90.0}])
-FLAT = base_design(follower={"type": "flat", "motion": "translating", "base_radius_mm": 100.0})
-DESIGNS = {"ejemplo9rt": lambda: load_design(EXAMPLES / "ejemplo9rt.toml"),
-           "oscillating": lambda: design_from_dict(OSC), "flat": lambda: design_from_dict(FLAT)}
 
 
 def _by_angle(points):

@@ -9,22 +9,12 @@ import pytest
 
 from camfab.cli import main
 from camfab.design.assemble import geometry_from_spec
-from camfab.design.spec import design_from_dict, load_design
+from camfab.design.spec import load_design
 from camfab.gcode import Job, dumps, parse, verify
 from camfab.gcode.cam import cam_program, signed_distance
 from camfab.offset.cutter import offset_curve, profile_curve
-from tests.conftest import EXAMPLES, base_design
+from tests.conftest import DESIGNS, EXAMPLES
 
-OSC = base_design(follower={"type": "roller", "motion": "oscillating", "base_radius_mm": 40.0,
-                            "roller_radius_mm": 8.0, "pivot_distance_mm": 110.0, "arm_length_mm": 90.0},
-                  motion=[{"law": "dwell", "lift": 0.0, "angle_deg": 90.0},
-                          {"law": "poly4567", "lift": 15.0, "angle_deg": 90.0},
-                          {"law": "poly4567", "lift": -6.0, "angle_deg": 45.0},
-                          {"law": "poly4567", "lift": 6.0, "angle_deg": 45.0},
-                          {"law": "poly4567", "lift": -15.0, "angle_deg": 90.0}])
-FLAT = base_design(follower={"type": "flat", "motion": "translating", "base_radius_mm": 100.0})
-DESIGNS = {"ejemplo9rt": lambda: load_design(EXAMPLES / "ejemplo9rt.toml"),
-           "oscillating": lambda: design_from_dict(OSC), "flat": lambda: design_from_dict(FLAT)}
 TOL, R_TOOL = 1e-3, 3.0
 
 
@@ -101,7 +91,7 @@ def test_cutter_larger_than_concave_radius_gouges(programs):
     r = 50.0
     pts = offset_curve(contact, r).point(np.linspace(0, 2 * np.pi, 3601))
     body = [f"G1 X{x:.4f} Y{y:.4f}" for x, y in pts]
-    text = "\n".join(["G21 G90 G17", "S3000 M3", f"G0 Z25", f"G0 X{pts[0, 0]:.4f} Y{pts[0, 1]:.4f}",
+    text = "\n".join(["G21 G90 G17", "S3000 M3", "G0 Z25", f"G0 X{pts[0, 0]:.4f} Y{pts[0, 1]:.4f}",
                       "G1 Z-10 F200", "(FINISH CONTOUR)", "F600", *body, "G0 Z25", "M5", "M2"]) + "\n"
     # the offset by 50 mm folds over itself; measure the centre path against the part distance - r
     part = _distances(contact, R_TOOL)[0]
