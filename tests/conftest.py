@@ -2,9 +2,16 @@
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 
 import pytest
+from hypothesis import settings
+
+# CI runs property tests with a fixed seed sequence (reproducible runs); locally they explore freely.
+settings.register_profile("ci", derandomize=True, print_blob=True)
+if os.environ.get("CI"):
+    settings.load_profile("ci")
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "camfab" / "templates" / "examples"
 SHARED = Path(__file__).resolve().parents[2] / "shared"
