@@ -238,15 +238,21 @@ class DiscRollerContact(Contact):
     def _path(self, S: np.ndarray):  # pragma: no cover - abstract
         raise NotImplementedError
 
+    def _components(self, S):
+        """``(cx, cy, c1x, c1y, c2x, c2y, vx, vy, arm)`` of :meth:`_path` as separate arrays
+        (or scalars); subclasses override it with a direct, cheaper form."""
+        C, C1, C2, v, arm = self._path(S)
+        return C[:, 0], C[:, 1], C1[:, 0], C1[:, 1], C2[:, 0], C2[:, 1], v[:, 0], v[:, 1], arm
+
     def evaluate(self, phi) -> ProfileSample:
         x, S = self._S(phi)
-        C, C1, C2, v, arm = self._path(S)
+        cx, cy, c1x, c1y, c2x, c2y, vx, vy, arm = self._components(S)
         sg, rr = self.sense, self.roller_radius
-        # component arrays (contiguous) instead of (n, 2) column slices: this is the hot path
-        cx, cy = C[:, 0], C[:, 1]
-        tx, ty = C1[:, 0] - sg * cy, C1[:, 1] + sg * cx            # T = σ·J·C + C′
-        ax = C2[:, 0] - cx - 2 * sg * C1[:, 1]                      # A2 = −C + 2σ·J·C′ + C″
-        ay = C2[:, 1] - cy + 2 * sg * C1[:, 0]
+        # component arrays instead of (n, 2) column slices: this is the hot path
+        cx = cx + 0.0 * cy  # broadcast a scalar coordinate to the sample count
+        tx, ty = c1x - sg * cy, c1y + sg * cx                       # T = σ·J·C + C′
+        ax = c2x - cx - 2 * sg * c1y                                # A2 = −C + 2σ·J·C′ + C″
+        ay = c2y - cy + 2 * sg * c1x
         inv = 1.0 / np.hypot(tx, ty)
         ux, uy = tx * inv, ty * inv                                 # unit tangent
         kp = sg * (tx * ay - ty * ax) * (inv * inv * inv)           # pitch-curve curvature
@@ -254,7 +260,6 @@ class DiscRollerContact(Contact):
         scale = 1.0 - rr * kp
         with np.errstate(divide="ignore", invalid="ignore"):
             k = kp / scale
-        vx, vy = v[:, 0], v[:, 1]
         delta = np.arctan2(-sg * (vx * ny - vy * nx), vx * nx + vy * ny)
         c, s = np.cos(sg * x), np.sin(sg * x)
         rot = _rotator(c, s)
@@ -306,6 +311,10 @@ class TranslatingRollerContact(DiscRollerContact):
         z = np.zeros_like(s0)
         return (_xy(self.offset + z, self.axial_base + s0), _xy(z, s1), _xy(z, s2), _xy(z, 1.0 + z), None)
 
+    def _components(self, S):
+        s0, s1, s2 = S
+        return self.offset, self.axial_base + s0, 0.0, s1, 0.0, s2, 0.0, 1.0, None
+
 
 class OscillatingRollerContact(DiscRollerContact):
     """Oscillating roller: pivot (m, 0), C = (m − A cos ξ, A sin ξ), ξ = ξ₀ + S (S in degrees)."""
@@ -322,6 +331,13 @@ class OscillatingRollerContact(DiscRollerContact):
         C1 = _xy(a * x1 * sx, a * x1 * cx)
         C2 = _xy(a * (x2 * sx + x1**2 * cx), a * (x2 * cx - x1**2 * sx))
         return C, C1, C2, _xy(sx, cx), xi
+
+    def _components(self, S):
+        xi, x1, x2 = self.xi0 + _K * S[0], _K * S[1], _K * S[2]
+        sx, cx, a = np.sin(xi), np.cos(xi), self.a
+        ax1, ax1sq = a * x1, a * x1 * x1
+        return (self.m - a * cx, a * sx, ax1 * sx, ax1 * cx, a * x2 * sx + ax1sq * cx, a * x2 * cx - ax1sq * sx,
+                sx, cx, xi)
 
 
 class DiscFlatContact(Contact):
