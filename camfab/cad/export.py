@@ -13,7 +13,6 @@ from typing import Callable, Iterable
 
 import numpy as np
 
-from ..errors import GeometryError
 from ..io import atomic_write
 from ..offset.discretize import arcs, measure_deviation, validate_tol
 from ..offset.cutter import pitch_curve, profile_curve, tool_centre_path
@@ -57,9 +56,6 @@ def cam_shapes(geometry, *, tol: float, with_pitch: bool = True) -> CamShapes:
     tol = validate_tol(tol)
     profiles, devs, pitch, curves = [], [], [], []
     for c in geometry.profiles:
-        if not c.closed:
-            raise GeometryError("CAD export of translating (wedge) cams is not supported yet; "
-                                "use camfab check / motion for them")
         curve = profile_curve(c)
         fit = arcs(curve, tol=tol)
         profiles.append(_loop(fit))

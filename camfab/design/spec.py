@@ -219,7 +219,7 @@ def design_from_dict(data: Mapping[str, Any], *, source: str | None = None,
     cam = _cam(v, _table(v, data, "cam"))
     fol = _follower(v, _table(v, data, "follower"), cam)
     motion, table = _motion(v, data, cam)
-    mfg = _manufacturing(v, _table(v, data, "manufacturing"), fol)
+    mfg = _manufacturing(v, _table(v, data, "manufacturing"), fol, cam.kind == "translating")
     out = _outputs(v, _table(v, data, "outputs"))
     checks = _table(v, data, "checks")
     v.keys(checks, _CHECK_KEYS, "checks")
@@ -445,7 +445,8 @@ def _motion(v: _Validator, data: Mapping[str, Any], cam: CamSpec):
     return tuple(segs), None
 
 
-def _manufacturing(v: _Validator, t: Mapping[str, Any], fol: FollowerSpec) -> ManufacturingSpec:
+def _manufacturing(v: _Validator, t: Mapping[str, Any], fol: FollowerSpec,
+                   translating: bool = False) -> ManufacturingSpec:
     v.keys(t, _MFG_KEYS, "manufacturing")
     m = ManufacturingSpec(
         thickness_mm=v.number(t, "thickness_mm", "manufacturing", 10.0, lo=0.0, lo_open=True, hi=1e4),
@@ -462,6 +463,11 @@ def _manufacturing(v: _Validator, t: Mapping[str, Any], fol: FollowerSpec) -> Ma
     if rb is not None and m.bore_mm >= 2 * rb:
         v.add("manufacturing.bore_mm", m.bore_mm, f"the bore does not fit inside the base circle (diameter {2 * rb:g} mm)",
               "use a smaller bore or a larger base_radius_mm")
+    if translating:
+        for key in ("bore_mm", "hub_diameter_mm", "hub_length_mm"):
+            if getattr(m, key):
+                v.add(f"manufacturing.{key}", getattr(m, key), "a translating cam is a plate that slides; it has "
+                      "no shaft, bore or hub", f"remove {key} (mount the plate with your own holes in CAD)")
     if m.keyway and m.bore_mm == 0:
         v.add("manufacturing.keyway", True, "a keyway needs a bore", "set bore_mm or keyway = false")
     return m

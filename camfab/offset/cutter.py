@@ -20,6 +20,7 @@ import numpy as np
 from ..errors import GeometryError
 from ..tolerances import DEFAULT_EXPORT_TOL_MM
 from .discretize import ArcDiscretisation, ParametricCurve, arcs, measure_deviation, polyline, validate_tol
+from .outline import translating_outline
 
 __all__ = ["profile_curve", "pitch_curve", "offset_curve", "concave_limit", "ToolCentrePath",
            "tool_centre_path", "shapely_offset", "roller_envelope_deviation", "QUAD_SEGS", "JOIN_STYLE"]
@@ -38,13 +39,22 @@ def _deg(contact, x):
 
 
 def profile_curve(contact) -> ParametricCurve:
-    """The exact profile of one contact as a :class:`ParametricCurve`."""
+    """The exact profile of one contact as a closed :class:`ParametricCurve`.
+
+    For a translating (wedge) cam this is the whole plate outline: the profile
+    closed by the plate's ends and bottom edge (:mod:`camfab.offset.outline`).
+    """
+    if not contact.closed:
+        return translating_outline(contact)
     return ParametricCurve(lambda t: contact.evaluate(t).point, contact.breakpoints, contact.period,
                            lambda t: contact.evaluate(t).point_d1)
 
 
 def pitch_curve(contact) -> ParametricCurve | None:
-    """The exact pitch curve (roller-centre path), or None for flat faces."""
+    """The exact closed pitch curve (roller-centre path), or None for flat faces and for
+    translating cams (whose pitch curve is open)."""
+    if not contact.closed:
+        return None
     if contact.evaluate(np.array([0.0])).pitch is None:
         return None
     return ParametricCurve(lambda t: contact.evaluate(t).pitch, contact.breakpoints, contact.period)
@@ -54,8 +64,11 @@ def offset_curve(contact, distance: float) -> ParametricCurve:
     """``P + distance·n``: the exact offset of a profile (outward for distance > 0).
 
     Its derivative is ``P′·(1 + distance·κ)`` (κ > 0 convex), so it is given
-    analytically too.
+    analytically too.  For a translating cam it is the offset of the whole plate outline,
+    convex corners rounded by arcs of radius ``distance``.
     """
+    if not contact.closed:
+        return translating_outline(contact, distance)
 
     def point(t):
         s = contact.evaluate(t)
@@ -158,8 +171,6 @@ def tool_centre_path(contact, tool_radius: float, *, tol: float = DEFAULT_EXPORT
     tol = validate_tol(tol)
     if not (math.isfinite(tool_radius) and tool_radius > 0):
         raise GeometryError(f"tool radius must be > 0 mm, got {tool_radius!r}")
-    if not contact.closed:
-        raise GeometryError("tool paths for translating cams are not supported yet")
     _refuse_if_too_big(contact, tool_radius, label)
     exact = offset_curve(contact, tool_radius)
     fit = arcs(exact, tol=tol)
@@ -181,7 +192,7 @@ def roller_envelope_deviation(contact, *, tol: float = DEFAULT_EXPORT_TOL_MM) ->
     """
     pitch = pitch_curve(contact)
     if pitch is None or contact.roller_radius == 0:
-        raise GeometryError("the roller-envelope cross-check needs a roller follower")
+        raise GeometryError("the roller-envelope cross-check needs a roller follower on a disc cam")
     pts = polyline(pitch, tol=tol / 4).points[:-1]
     inner = shapely_offset(pts, -contact.roller_radius)
     return float(measure_deviation(np.asarray(inner.exterior.coords), profile_curve(contact)).max)

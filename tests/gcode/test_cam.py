@@ -156,7 +156,7 @@ def _millable_examples():
     out = []
     for p in sorted(EXAMPLES.glob("*.toml")):
         spec = load_design(p)
-        if spec.cam.kind != "translating" and spec.manufacturing.tool_diameter_mm:
+        if spec.manufacturing.tool_diameter_mm:
             out.append(p.stem)
     return out
 
