@@ -246,37 +246,67 @@ class DiscRollerContact(Contact):
 
     def evaluate(self, phi) -> ProfileSample:
         x, S = self._S(phi)
-        cx, cy, c1x, c1y, c2x, c2y, vx, vy, arm = self._components(S)
+        n = x.size
         sg, rr = self.sense, self.roller_radius
-        # component arrays instead of (n, 2) column slices: this is the hot path
-        cx = cx + 0.0 * cy  # broadcast a scalar coordinate to the sample count
-        tx, ty = c1x - sg * cy, c1y + sg * cx                       # T = σ·J·C + C′
-        ax = c2x - cx - 2 * sg * c1y                                # A2 = −C + 2σ·J·C′ + C″
-        ay = c2y - cy + 2 * sg * c1x
-        inv = 1.0 / np.hypot(tx, ty)
-        ux, uy = tx * inv, ty * inv                                 # unit tangent
-        kp = sg * (tx * ay - ty * ax) * (inv * inv * inv)           # pitch-curve curvature
-        nx, ny = sg * uy, -sg * ux                                  # n = −σ·J·t
-        scale = 1.0 - rr * kp
-        with np.errstate(divide="ignore", invalid="ignore"):
-            k = kp / scale
-        delta = np.arctan2(-sg * (vx * ny - vy * nx), vx * nx + vy * ny)
-        c, s = np.cos(sg * x), np.sin(sg * x)
-        rot = _rotator(c, s)
-        return ProfileSample(x, rot(cx - rr * nx, cy - rr * ny), rot(tx * scale, ty * scale), rot(nx, ny),
-                             rot(ux, uy), k, _inv(k), rot(cx, cy), kp, _inv(kp), delta, None, arm)
+        # outputs filled chunk by chunk: the long chain of elementwise temporaries then
+        # stays in cache (and off fresh pages), which is most of the cost at large n
+        out = _block(16, n)  # the last row is the arm angle, when there is one
+        pitch, point, point_d1, normal, tangent = out[0:2], out[2:4], out[4:6], out[6:8], out[8:10]
+        kp, k, rho_p, rho, delta = out[10:15]
+        arm = None
+        for a in range(0, max(n, 1), _CHUNK):
+            b = min(a + _CHUNK, n)
+            cx, cy, c1x, c1y, c2x, c2y, vx, vy, xi = self._components(S[:, a:b])
+            if xi is not None:
+                arm = out[15]
+                arm[a:b] = xi
+            # component arrays instead of (n, 2) column slices: this is the hot path
+            cx = cx + 0.0 * cy  # broadcast a scalar coordinate to the sample count
+            tx, ty = c1x - sg * cy, c1y + sg * cx                       # T = σ·J·C + C′
+            ax = c2x - cx - 2 * sg * c1y                                # A2 = −C + 2σ·J·C′ + C″
+            ay = c2y - cy + 2 * sg * c1x
+            inv = 1.0 / np.hypot(tx, ty)
+            ux, uy = tx * inv, ty * inv                                 # unit tangent
+            kpc = np.multiply(sg * (tx * ay - ty * ax), inv * inv * inv, out=kp[a:b])  # pitch curvature
+            nx, ny = sg * uy, -sg * ux                                  # n = −σ·J·t
+            scale = 1.0 - rr * kpc
+            with np.errstate(divide="ignore", invalid="ignore"):
+                kc = np.divide(kpc, scale, out=k[a:b])
+                np.divide(1.0, kc, out=rho[a:b])
+                np.divide(1.0, kpc, out=rho_p[a:b])
+            np.arctan2(-sg * (vx * ny - vy * nx), vx * nx + vy * ny, out=delta[a:b])
+            c, s = _cos_sin(sg * x[a:b])
+            _rot_into(point, a, b, cx - rr * nx, cy - rr * ny, c, s)
+            _rot_into(point_d1, a, b, tx * scale, ty * scale, c, s)
+            _rot_into(normal, a, b, nx, ny, c, s)
+            _rot_into(tangent, a, b, ux, uy, c, s)
+            _rot_into(pitch, a, b, cx, cy, c, s)
+        return ProfileSample(x, point.T, point_d1.T, normal.T, tangent.T, k, rho, pitch.T, kp, rho_p, delta, None,
+                             arm)
 
 
-def _rotator(c: np.ndarray, s: np.ndarray):
-    """``rot(x, y) -> (n, 2)``: components rotated by the angle whose cos/sin are c, s."""
+#: samples per chunk of the elementwise geometry (64 KiB per float64 temporary)
+_CHUNK = 8192
 
-    def rot(x, y):
-        out = np.empty((2, c.size))  # filled row-wise (contiguous), returned as an (n, 2) view
-        np.subtract(x * c, y * s, out=out[0])
-        np.add(x * s, y * c, out=out[1])
-        return out.T
 
-    return rot
+def _block(rows: int, n: int) -> np.ndarray:
+    """Uninitialised (rows, n) storage for the outputs of one evaluation.  One block instead
+    of many arrays: at large n fresh memory costs more than the arithmetic, and one large
+    allocation is faulted in far more cheaply (huge pages) than a dozen separate ones;
+    rows left unused are never touched and cost no memory."""
+    return np.empty((rows, n))
+
+
+def _cos_sin(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(cos x, sin x)`` through one complex exponential (a single sincos per sample)."""
+    e = np.exp(x * 1j)
+    return e.real, e.imag
+
+
+def _rot_into(out: np.ndarray, a: int, b: int, x, y, c: np.ndarray, s: np.ndarray) -> None:
+    """``out[:, a:b]`` (a (2, n) array) = components (x, y) rotated by the angle whose cos/sin are c, s."""
+    np.subtract(x * c, y * s, out=out[0, a:b])
+    np.add(x * s, y * c, out=out[1, a:b])
 
 
 def _inv(k: np.ndarray) -> np.ndarray:
@@ -334,7 +364,7 @@ class OscillatingRollerContact(DiscRollerContact):
 
     def _components(self, S):
         xi, x1, x2 = self.xi0 + _K * S[0], _K * S[1], _K * S[2]
-        sx, cx, a = np.sin(xi), np.cos(xi), self.a
+        (cx, sx), a = _cos_sin(xi), self.a
         ax1, ax1sq = a * x1, a * x1 * x1
         return (self.m - a * cx, a * sx, ax1 * sx, ax1 * cx, a * x2 * sx + ax1sq * cx, a * x2 * cx - ax1sq * sx,
                 sx, cx, xi)
@@ -351,26 +381,45 @@ class DiscFlatContact(Contact):
     def _face(self, S):  # pragma: no cover - abstract
         raise NotImplementedError
 
-    def _extras(self, P, s, S):  # pragma: no cover - abstract
+    def _extras(self, px, py, s, S):  # pragma: no cover - abstract
+        """``(vx, vy, face position, arm angle)``: the follower's unit rise velocity at the
+        contact point (px, py) (fixed frame), and the optional outputs (or None)."""
         raise NotImplementedError
 
     def evaluate(self, phi) -> ProfileSample:
         x, S = self._S(phi)
-        beta, b1, b2, p, p1, p2 = self._face(S)
+        n = x.size
         sg = self.sense
-        w = sg + b1
-        s = p1 / w
-        rho = p + p2 / w**2 - p1 * b2 / w**3
-        nx, ny = np.cos(beta), np.sin(beta)                 # face normal; J·n = (−ny, nx)
-        P = np.empty((x.size, 2))
-        P[:, 0] = p * nx - s * ny
-        P[:, 1] = p * ny + s * nx
-        v, pos, arm = self._extras(P, s, S)
-        delta = np.arctan2(-sg * (v[:, 0] * ny - v[:, 1] * nx), v[:, 0] * nx + v[:, 1] * ny)
-        rot = _rotator(np.cos(sg * x), np.sin(sg * x))
-        wr = w * rho
-        return ProfileSample(x, rot(P[:, 0], P[:, 1]), rot(-ny * wr, nx * wr), rot(nx, ny),
-                             rot(-sg * ny, sg * nx), _inv(rho), rho, None, None, None, delta, pos, arm)
+        out = _block(13, n)  # the last two rows are the face position and the arm angle, when given
+        point, point_d1, normal, tangent = out[0:2], out[2:4], out[4:6], out[6:8]
+        k, rho, delta = out[8:11]
+        pos = arm = None
+        for a in range(0, max(n, 1), _CHUNK):  # chunked as in DiscRollerContact.evaluate
+            b = min(a + _CHUNK, n)
+            Sc = S[:, a:b]
+            beta, b1, b2, p, p1, p2 = self._face(Sc)
+            w = sg + b1
+            s = p1 / w
+            rc = np.subtract(p + p2 / w**2, p1 * b2 / w**3, out=rho[a:b])
+            nx, ny = _cos_sin(beta)                             # face normal; J·n = (−ny, nx)
+            px, py = p * nx - s * ny, p * ny + s * nx
+            vx, vy, pc, xi = self._extras(px, py, s, Sc)
+            if pc is not None:
+                pos = out[11]
+                pos[a:b] = pc
+            if xi is not None:
+                arm = out[12]
+                arm[a:b] = xi
+            np.arctan2(-sg * (vx * ny - vy * nx), vx * nx + vy * ny, out=delta[a:b])
+            with np.errstate(divide="ignore"):
+                np.divide(1.0, rc, out=k[a:b])
+            c, sn = _cos_sin(sg * x[a:b])
+            wr = w * rc
+            _rot_into(point, a, b, px, py, c, sn)
+            _rot_into(point_d1, a, b, -ny * wr, nx * wr, c, sn)
+            _rot_into(normal, a, b, nx, ny, c, sn)
+            _rot_into(tangent, a, b, -sg * ny, sg * nx, c, sn)
+        return ProfileSample(x, point.T, point_d1.T, normal.T, tangent.T, k, rho, None, None, None, delta, pos, arm)
 
 
 class TranslatingFlatContact(DiscFlatContact):
@@ -381,12 +430,12 @@ class TranslatingFlatContact(DiscFlatContact):
         self.rb, self.face_offset = float(base_radius), float(face_offset)
 
     def _face(self, S):
-        z = np.zeros_like(S[0])
-        return z + math.pi / 2, z, z, self.rb + S[0], S[1], S[2]
+        # the face normal angle is the constant π/2: given as a scalar (its cos/sin are then
+        # taken once, not per sample), β′ = β″ = 0 likewise
+        return math.pi / 2, 0.0, 0.0, self.rb + S[0], S[1], S[2]
 
-    def _extras(self, P, s, S):
-        z = np.zeros_like(s)
-        return _xy(z, 1.0 + z), P[:, 0] - self.face_offset, None
+    def _extras(self, px, py, s, S):
+        return 0.0, 1.0, px - self.face_offset, None
 
 
 class OscillatingFlatContact(DiscFlatContact):
@@ -402,14 +451,14 @@ class OscillatingFlatContact(DiscFlatContact):
 
     def _face(self, S):
         xi, x1, x2 = self._xi(S)
-        sx, cx, m = np.sin(xi), np.cos(xi), self.m
+        (cx, sx), m = _cos_sin(xi), self.m
         return (math.pi / 2 - xi, -x1, -x2, self.f + m * sx, m * cx * x1, m * (cx * x2 - sx * x1**2))
 
-    def _extras(self, P, s, S):
+    def _extras(self, px, py, s, S):
         xi = self._xi(S)[0]
-        r = P - np.array([self.m, 0.0])
-        v = -_J(r) / np.hypot(r[:, 0], r[:, 1])[:, None]  # clockwise about the pivot
-        return v, s + self.m * np.cos(xi), xi
+        rx, ry = px - self.m, py - 0.0
+        d = np.hypot(rx, ry)
+        return ry / d, -rx / d, s + self.m * np.cos(xi), xi  # clockwise about the pivot
 
 
 class TranslatingCamContact(Contact):
