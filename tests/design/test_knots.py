@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import openpyxl
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from camfab.design.knots import (
@@ -63,7 +63,10 @@ def assert_reproduces_knots(t: KnotTable, prog: MotionProgram) -> None:
     """Both one-sided limits at every knot equal the knot values (per radian)."""
     x, vals = t.cycle_knots()
     m = 3 if t.degree == 5 else 4
-    scale = np.maximum(np.abs(vals[:, :m]).max(axis=0), 1e-300)
+    scale = np.abs(vals[:, :m]).max(axis=0)
+    # a derivative that is ~0 everywhere (tiny harmonics on a large lift) is judged against the lift's size:
+    # its rounding errors scale with S, not with itself
+    scale = np.maximum(scale, 1e-9 * max(scale[0], 1e-300))
     right = prog.evaluate(x[:-1], range(m)).T
     left = np.array([seg.end_values(True)[:m] for seg in prog.segments])
     np.testing.assert_array_less(np.abs(right - vals[:-1, :m]) / scale, REL)
@@ -73,6 +76,7 @@ def assert_reproduces_knots(t: KnotTable, prog: MotionProgram) -> None:
 def assert_continuity(prog: MotionProgram, order: int) -> None:
     peaks = prog.peaks("exact")
     scale = np.array([max(abs(p.max), abs(p.min), 1e-12) for p in peaks])
+    scale = np.maximum(scale, 1e-9 * scale[0])  # see assert_reproduces_knots
     for k, seg in enumerate(prog.segments):
         left = prog.segments[k - 1].end_values(True)
         right = seg.end_values(False)
@@ -457,6 +461,7 @@ def test_file_rows_are_validated_with_the_file_named(tmp_path):
     degree=st.sampled_from([5, 7]),
     closed=st.booleans(),
 )
+@example(amps=[0.0, 1e-13, 0.0, 1e-13], cuts=[1], degree=7, closed=False)  # ~zero derivatives on a 1 mm lift
 def test_program_passes_through_random_consistent_knots(amps, cuts, degree, closed):
     coef = smooth_coef(amps)
     angles = np.concatenate([[0.0], np.sort(cuts) / 10.0, [360.0] if closed else []])
