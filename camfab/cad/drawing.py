@@ -21,6 +21,12 @@ Layout (landscape)
   diameter, DMAX radius, bore diameter and, with a keyway, its width and the
   ``d + t2`` depth.
 
+A translating (wedge) cam is drawn as its plate in side view instead: the
+outline, the S = 0 line, a 0 mark at the travel-0 end, an arrow for the sense
+of sliding, and the overall length, the height of the S = 0 line and the
+height of the highest point dimensioned; its lift table gives the travel,
+the lift and the roller-centre height.
+
 Paper and scale
 ---------------
 ``paper="auto"`` tries A4 then A3 and keeps the sheet giving the larger
@@ -45,7 +51,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ExportError, GeometryError
+from ..errors import ExportError
 from .dxf import _ezdxf, write_deterministic
 from .plate import BulgeLoop, bore_loop, keyway_size
 
@@ -98,7 +104,7 @@ class SheetLayout:
     fits: bool
 
 
-def _layout_on(paper: str, extent_mm: float, n_rows: int, tpl: dict[str, Any]) -> SheetLayout:
+def _layout_on(paper: str, extent_mm, n_rows: int, tpl: dict[str, Any]) -> SheetLayout:
     w, h = tpl["paper"][paper]["width_mm"], tpl["paper"][paper]["height_mm"]
     fr, gap = tpl["frame"], tpl["frame"]["gap_mm"]
     fx0, fy0, fx1, fy1 = fr["left_mm"], fr["bottom_mm"], w - fr["right_mm"], h - fr["top_mm"]
@@ -113,22 +119,27 @@ def _layout_on(paper: str, extent_mm: float, n_rows: int, tpl: dict[str, Any]) -
     table = (fx1 - groups * colw, fy1 - (rows + 2.5) * rh, fx1, fy1)
     notes = (fx0, fy0, fx0 + tpl["notes"]["width_mm"], fy1)
     view = (notes[2] + gap, title[3] + gap, table[0] - gap, fy1)
-    room = min(view[2] - view[0], view[3] - view[1]) / 2 - tpl["view"]["clearance_mm"]
+    clear = tpl["view"]["clearance_mm"]
+    half_w, half_h = (extent_mm, extent_mm) if np.isscalar(extent_mm) else extent_mm
+    room_w, room_h = (view[2] - view[0]) / 2 - clear, (view[3] - view[1]) / 2 - clear
+    if np.isscalar(extent_mm):  # a disc cam: a circle of radius extent in the square part of the view
+        room_w = room_h = min(room_w, room_h)
     labels = tpl["view"]["scales"]
-    fits = [s for s in labels if extent_mm * parse_scale(s) <= room]
+    fits = [s for s in labels if half_w * parse_scale(s) <= room_w and half_h * parse_scale(s) <= room_h]
     label = fits[0] if fits else labels[-1]
     centre = ((view[0] + view[2]) / 2, (view[1] + view[3]) / 2)
     return SheetLayout(paper, (w, h), parse_scale(label), label, centre, (fx0, fy0, fx1, fy1), title, table,
                        groups, rows, notes, view, bool(fits))
 
 
-def sheet_layout(extent_mm: float, n_rows: int, paper: str = "auto") -> SheetLayout:
+def sheet_layout(extent_mm, n_rows: int, paper: str = "auto") -> SheetLayout:
     """Choose paper and scale for a cam of outer radius ``extent_mm`` and a lift table of ``n_rows`` rows.
 
     Parameters
     ----------
-    extent_mm : float
-        Largest distance of the cam outline from its centre (true mm).
+    extent_mm : float or (float, float)
+        Largest distance of the cam outline from its centre (true mm), or the half width and
+        half height of a translating cam's plate.
     n_rows : int
         Data rows of the lift table.
     paper : {"auto", "A4", "A3"}
@@ -259,7 +270,7 @@ def _lift_table(msp, layout: SheetLayout, table, closed: bool) -> None:
     _text(msp, f"LIFT TABLE (step {step:g}{'°' if closed else ' mm'})", ((x0 + x1) / 2, y1 - 0.75 * rh),
           h, "LIFT_TABLE", "MIDDLE_CENTER", width=x1 - x0 - 2)
     msp.add_line((x0, y1 - 1.5 * rh), (x1, y1 - 1.5 * rh), dxfattribs={"layer": "LIFT_TABLE"})
-    heads = ("ANGLE °" if closed else "TRAVEL mm", f"LIFT {unit}", "RADIUS mm")
+    heads = ("ANGLE °" if closed else "TRAVEL mm", f"LIFT {unit}", "RADIUS mm" if closed else "HEIGHT mm")
     gw = sum(widths)
     lift_dec = 4 if table.lift_unit == "deg" else 3
     for g in range(layout.table_groups):
@@ -373,17 +384,8 @@ def _view(msp, spec, geometry, shapes, layout: SheetLayout) -> None:
                                        cy + (ra + 2) * math.sin(math.radians(55))), 2.5, "ANNOTATION")
 
 
-def build_drawing(spec, geometry, report, shapes, *, paper: str = "auto", lift_step_deg: float = 10.0):
-    """The ezdxf document of :func:`drawing_sheet` and its :class:`SheetLayout`."""
-    from ..report.xlsx import lift_table
-
-    if not geometry.closed:
-        raise GeometryError("a drawing sheet needs a disc cam; translating (wedge) cams are not supported yet")
+def _new_doc(spec, layout: SheetLayout, shapes, tpl):
     ezdxf = _ezdxf()
-    tpl = load_template()
-    table = lift_table(spec, geometry, lift_step_deg)
-    extent = max([float(np.max(np.hypot(*lp.points.T))) for lp in shapes.profiles] + [geometry.max_radius])
-    layout = sheet_layout(extent, len(table.angle), paper)
     doc = ezdxf.new("R2010", setup=["linetypes"], units=4)
     doc.header["$INSUNITS"] = 4
     doc.header["$MEASUREMENT"] = 1
@@ -403,12 +405,134 @@ def build_drawing(spec, geometry, report, shapes, *, paper: str = "auto", lift_s
     msp = doc.modelspace()
     _rect(msp, (0.0, 0.0, *layout.size), "FRAME")
     _rect(msp, layout.frame, "FRAME")
+    return doc, msp
+
+
+def build_drawing(spec, geometry, report, shapes, *, paper: str = "auto", lift_step_deg: float = 10.0):
+    """The ezdxf document of :func:`drawing_sheet` and its :class:`SheetLayout`."""
+    from ..report.xlsx import lift_table
+
+    tpl = load_template()
+    if not geometry.closed:
+        table = lift_table(spec, geometry, 360.0 / _plate_table_intervals(geometry.period))
+        return _build_plate_drawing(spec, geometry, report, shapes, table, paper, tpl)
+    table = lift_table(spec, geometry, lift_step_deg)
+    extent = max([float(np.max(np.hypot(*lp.points.T))) for lp in shapes.profiles] + [geometry.max_radius])
+    layout = sheet_layout(extent, len(table.angle), paper)
+    doc, msp = _new_doc(spec, layout, shapes, tpl)
     _title_block(msp, layout, title_fields(spec, report, layout))
     _lift_table(msp, layout, table, geometry.closed)
     _notes(msp, layout, notes_text(spec, geometry, report, shapes, layout))
     _view(msp, spec, geometry, shapes, layout)
     _dimensions(msp, spec, geometry, layout)
     return doc, layout
+
+
+# ---------------------------------------------------------------------------
+# translating (wedge) cams: the plate in side view
+def _plate_table_intervals(length: float, most: int = 40) -> int:
+    """Rows of a translating cam's lift table: the finest round step (1, 2, 2.5, 5 × 10^k mm) that divides
+    the cam length into at most ``most`` intervals (36 equal intervals when none does)."""
+    for k in range(-2, 6):
+        for m in (1.0, 2.0, 2.5, 5.0):
+            n = length / (m * 10.0**k)
+            if n <= most and abs(n - round(n)) < 1e-9 * n:
+                return int(round(n))
+    return 36
+
+
+def _plate_box(shapes) -> tuple[float, float, float, float]:
+    pts = np.concatenate([lp.flatten(1e-3) for lp in shapes.profiles])
+    return float(pts[:, 0].min()), float(pts[:, 1].min()), float(pts[:, 0].max()), float(pts[:, 1].max())
+
+
+def _build_plate_drawing(spec, geometry, report, shapes, table, paper, tpl):
+    from dataclasses import replace
+
+    x0, y0, x1, y1 = _plate_box(shapes)
+    layout = sheet_layout(((x1 - x0) / 2, (y1 - y0) / 2), len(table.angle), paper)
+    vx0, vy0, vx1, vy1 = layout.view
+    s = layout.scale
+    # the true origin (bottom edge, travel 0 end) lands so that the plate's box is centred in the view
+    layout = replace(layout, centre=((vx0 + vx1) / 2 - s * (x0 + x1) / 2, (vy0 + vy1) / 2 - s * (y0 + y1) / 2))
+    doc, msp = _new_doc(spec, layout, shapes, tpl)
+    _title_block(msp, layout, title_fields(spec, report, layout))
+    _lift_table(msp, layout, table, geometry.closed)
+    _notes(msp, layout, plate_notes(spec, geometry, report, shapes, layout))
+    _plate_view(msp, spec, geometry, shapes, layout, (x0, y0, x1, y1))
+    return doc, layout
+
+
+def plate_notes(spec, geometry, report, shapes, layout: SheetLayout) -> list[str]:
+    """The numbered notes of a translating cam's sheet."""
+    m, f = spec.manufacturing, spec.follower
+    c = geometry.profiles[0]
+    dev = max(shapes.profile_deviation) if shapes.profile_deviation else 0.0
+    top = geometry.radius_extremes().max
+    slide = "LEFT" if spec.cam.direction == "left" else "RIGHT"
+    start = "left" if spec.cam.direction == "left" else "right"
+    errors = [x for x in report.findings if x.severity == "error"]
+    verdict = f"Check verdict: {report.verdict}"
+    if errors:
+        verdict += " — " + "; ".join(sorted({x.code for x in errors}))
+    elif report.verdict == "not_for_high_speed":
+        verdict += " — jerk discontinuity, not for high speeds"
+    return [
+        f"Material: {m.material or 'to be specified'}.",
+        f"Plate thickness {m.thickness_mm:g} mm; length {c.period:g} mm; no bore (sliding plate).",
+        f"Profile tolerance ±{m.tolerance_mm:g} mm; drawn arcs lie within {dev:.2g} mm of the exact profile.",
+        f"All dimensions in mm (true size); scale {layout.scale_label}.",
+        f"The cam slides {slide} as drawn; travel 0 is at its {start} end (marked 0), where the follower "
+        "starts; the lift table gives the follower lift after the cam has travelled the given distance.",
+        f"Follower: translating roller Ø{2 * (f.roller_radius_mm or 0.0):g} mm, moving perpendicular to the "
+        "bottom edge.",
+        f"The S = 0 line lies {f.base_height_mm:g} mm above the bottom edge; highest point of the profile "
+        f"{top:.3f} mm.",
+        "Lift table: lift in mm; HEIGHT = roller-centre height above the bottom edge (mm).",
+        verdict + ".",
+    ]
+
+
+def _plate_view(msp, spec, geometry, shapes, layout: SheetLayout, box) -> None:
+    s, (cx, cy) = layout.scale, layout.centre
+    x0, y0, x1, y1 = box
+    f = spec.follower
+
+    def at(x, y):
+        return (cx + s * x, cy + s * y)
+
+    for loop in shapes.profiles:
+        msp.add_lwpolyline(_place(loop, s, (cx, cy)), format="xyseb", close=True, dxfattribs={"layer": "PROFILE"})
+    h = f.base_height_mm
+    msp.add_line(at(x0, h), at(x1, h), dxfattribs={"layer": "BASE_CIRCLE"})  # the S = 0 line
+    _text(msp, "S = 0", (at(x1, h)[0] + 1.0, at(x1, h)[1]), 2.0, "ANNOTATION", "MIDDLE_LEFT")
+    left = spec.cam.direction == "left"
+    zero = x0 if left else x1
+    _text(msp, "0", (at(zero, y1)[0], at(zero, y1)[1] + 2.0), 2.5, "ANNOTATION", "BOTTOM_CENTER")
+    # direction of travel: an arrow above the plate
+    ya = at(0.0, y1)[1] + 8.0
+    xa0, xa1 = at(x0 + 0.35 * (x1 - x0), 0)[0], at(x0 + 0.65 * (x1 - x0), 0)[0]
+    tip, tail = (xa0, xa1) if left else (xa1, xa0)
+    msp.add_line((tail, ya), (tip, ya), dxfattribs={"layer": "ANNOTATION"})
+    d = 3.0 if tip < tail else -3.0
+    msp.add_solid([(tip, ya), (tip + d, ya + 1.0), (tip + d, ya - 1.0)], dxfattribs={"layer": "ANNOTATION"})
+    _text(msp, f"CAM SLIDES {'LEFT' if left else 'RIGHT'}", ((xa0 + xa1) / 2, ya + 1.5), 2.5, "ANNOTATION",
+          "BOTTOM_CENTER")
+    over = {"dimlfac": 1.0 / s}
+    attrs = {"layer": "DIMENSIONS"}
+    dims = [  # overall length under the plate; S = 0 height at the left end; highest point at the right end
+        dict(base=(at(x0, y0)[0], at(x0, y0)[1] - 8.0), p1=at(x0, y0), p2=at(x1, y0)),
+        dict(base=(at(x0, 0)[0] - 8.0, at(x0, 0)[1]), p1=at(x0, y0), p2=at(x0, h), angle=90.0),
+        dict(base=(at(x1, 0)[0] + 8.0, at(x1, 0)[1]), p1=at(x1, y0), p2=at(_x_of_top(geometry), y1), angle=90.0),
+    ]
+    for kw in dims:
+        dim = msp.add_linear_dim(dimstyle="CAMFAB", override=dict(over), dxfattribs=attrs, **kw)
+        dim.render()
+
+
+def _x_of_top(geometry) -> float:
+    ext = geometry.radius_extremes()
+    return float(geometry.evaluate(np.array([ext.at_max])).point[0, 0])
 
 
 def drawing_sheet(spec, geometry, report, shapes, *, paper: str = "auto", lift_step_deg: float = 10.0) -> str:
@@ -418,14 +542,16 @@ def drawing_sheet(spec, geometry, report, shapes, *, paper: str = "auto", lift_s
     ----------
     spec : DesignSpec
     geometry : CamGeometry
-        A disc cam (closed profiles).
+        A disc cam, or a translating cam (drawn as its plate in side view, with the overall
+        length, the height of the S = 0 line and of the highest point dimensioned).
     report : Report
         From :func:`camfab.design.assemble.check_design` (its verdict goes into the title block).
     shapes : CamShapes
         From :func:`camfab.cad.export.cam_shapes`; its arc-fitted ``profiles`` are drawn.
     paper : {"auto", "A4", "A3"}
     lift_step_deg : float
-        Step of the lift table (degrees, must divide 360).
+        Step of the lift table (degrees, must divide 360).  A translating cam's table uses the
+        finest round step in mm (1, 2, 2.5, 5 × 10^k) giving at most 40 rows.
 
     Returns
     -------
@@ -435,7 +561,7 @@ def drawing_sheet(spec, geometry, report, shapes, *, paper: str = "auto", lift_s
     Raises
     ------
     GeometryError
-        A translating (wedge) cam.
+        A translating cam whose plate cannot be built (e.g. no height under the profile).
     ValueError
         An unknown paper.
     SpecError

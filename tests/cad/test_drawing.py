@@ -12,7 +12,7 @@ from camfab.cad.drawing import LAYERS, build_drawing, drawing_sheet, load_templa
 from camfab.cad.export import cam_shapes
 from camfab.design.assemble import check_design, geometry_from_spec
 from camfab.design.spec import design_from_dict, load_design
-from camfab.errors import GeometryError, SpecError
+from camfab.errors import SpecError
 from camfab.offset.cutter import profile_curve
 from camfab.offset.discretize import measure_deviation
 from tests.conftest import EXAMPLES, base_design
@@ -220,15 +220,35 @@ def test_oscillating_and_flat_followers_draw():
     assert dims[3] == pytest.approx([200.0]) and 0 not in dims  # no bore: only the base circle (and DMAX)
 
 
-def test_translating_cam_is_refused(e9):
-    (spec, geom, report, shapes), _, _ = e9
-    wedge = design_from_dict(base_design(
-        cam={"kind": "translating", "speed_mm_s": 20.0},
-        follower={"type": "roller", "motion": "translating", "roller_radius_mm": 5.0, "cam_length_mm": 200.0},
-        motion=[{"law": "cycloidal", "lift": 8.0, "length_mm": 100.0},
-                {"law": "cycloidal", "lift": -8.0, "length_mm": 100.0}]))
-    with pytest.raises(GeometryError, match="disc cam"):
-        drawing_sheet(wedge, geometry_from_spec(wedge), check_design(wedge), shapes)
+def test_translating_cam_is_drawn_as_a_plate():
+    spec = load_design(EXAMPLES / "wedge_translating.toml")
+    job = _job(spec)
+    geom = job[1]
+    doc, lay = build_drawing(*job)
+    assert not doc.audit().has_errors
+    doc = ezdxf.read(io.StringIO(drawing_sheet(*job)))
+    centre, scale = _centre_scale(doc)
+    assert scale == lay.scale
+    # the plate outline, scaled back, is within tol of the exact outline
+    (pl,) = doc.modelspace().query("LWPOLYLINE[layer=='PROFILE']")
+    rows = np.array(list(pl.get_points("xyb")))
+    true = np.column_stack([(rows[:, :2] - centre) / scale, rows[:, 2]])
+    assert measure_deviation(true, profile_curve(geom.profiles[0])).max <= TOL + 1e-9
+    # the plate fits the view
+    x0, y0, x1, y1 = lay.view
+    assert x0 <= rows[:, 0].min() and rows[:, 0].max() <= x1 and y0 <= rows[:, 1].min() and rows[:, 1].max() <= y1
+    # overall length, the S = 0 line's height and the highest point, true size
+    assert sorted(_dims(doc)[0]) == pytest.approx(sorted([300.0, 20.0, 20.0 + 20.0]), abs=1e-9)
+    texts = _texts(doc, "LIFT_TABLE")
+    assert "LIFT TABLE (step 10 mm)" in texts and "TRAVEL mm" in texts and "HEIGHT mm" in texts
+    ents = [(e.dxf.text, e.dxf.align_point.x, e.dxf.align_point.y) for e in
+            doc.modelspace().query("TEXT[layer=='LIFT_TABLE']")]
+    travel = sorted(float(t) for t, *_ in ents if t.replace(".", "").isdigit() and float(t) % 10 == 0
+                    and len(t.split(".")) == 1)
+    assert travel == pytest.approx(np.arange(0, 300, 10))
+    assert "CAM SLIDES LEFT" in _texts(doc, "ANNOTATION")
+    text = doc.modelspace().query("MTEXT")[0].plain_text()
+    assert "slides LEFT" in text and "no bore" in text and "length 300 mm" in text
 
 
 def test_deterministic(e9):
