@@ -179,19 +179,88 @@ def _derivatives(curve: ParametricCurve, t, lo, hi) -> np.ndarray:
     h = np.minimum(1e-6 * curve.period, width / 8.0)
     fwd = t - h < lo
     bwd = (t + h > hi) & ~fwd
+    sgn = np.where(bwd, -1.0, 1.0)
+    hs = sgn * h
     cen = ~(fwd | bwd)
-    out = np.empty((t.size, 2))
-    if cen.any():
-        hc = h[cen][:, None]
-        out[cen] = (_points(curve, t[cen] + h[cen]) - _points(curve, t[cen] - h[cen])) / (2 * hc)
-    for sel, sgn in ((fwd, 1.0), (bwd, -1.0)):
-        if sel.any():
-            hs = sgn * h[sel]
-            p0 = _points(curve, t[sel])
-            p1 = _points(curve, t[sel] + hs)
-            p2 = _points(curve, t[sel] + 2 * hs)
-            out[sel] = (-3 * p0 + 4 * p1 - p2) / (2 * hs[:, None])
+    # one call for every stencil: central (t - h, t + h) or one-sided (t, t ± h, t ± 2h)
+    p = _points(curve, np.concatenate([np.where(cen, t - h, t), t + hs, t + 2 * hs]))
+    p0, p1, p2 = p[:t.size], p[t.size:2 * t.size], p[2 * t.size:]
+    out = np.where(cen[:, None], (p1 - p0) / (2 * h[:, None]), (-3 * p0 + 4 * p1 - p2) / (2 * hs[:, None]))
     return out.reshape(shape + (2,))
+
+
+class _Surrogate:
+    """Piecewise cubic Hermite interpolant of a curve from exact samples (never across a breakpoint).
+
+    Built from two calls of the exact curve (points, then one-sided
+    derivatives); used to *fit* without calling the exact curve again.
+    Results are always measured against the exact curve.
+    """
+
+    def __init__(self, curve: ParametricCurve, n: int, min_count: int = 4):
+        lo, hi = curve.pieces
+        counts = np.maximum(min_count, np.ceil(n * (hi - lo) / curve.period)).astype(int)
+        x = np.append(np.concatenate([l_ + (h_ - l_) * np.arange(c) / c for l_, h_, c in zip(lo, hi, counts)]),
+                      curve.period)
+        piece = np.repeat(np.arange(lo.size), counts)
+        a, b = x[:-1], x[1:]
+        p = _points(curve, x)
+        p[-1] = p[0]
+        d = _derivatives(curve, np.concatenate([a, b]), np.tile(lo[piece], 2), np.tile(hi[piece], 2))
+        d0, d1 = d[:a.size], d[a.size:]
+        h = (b - a)[:, None]
+        p0, p1 = p[:-1], p[1:]
+        self.curve = curve
+        self.x = x
+        self.first = np.concatenate([[0], np.cumsum(counts)])  # interval range of each piece
+        self.piece = piece
+        self.coef = np.stack([p0, d0, (3 * (p1 - p0) / h - 2 * d0 - d1) / h,
+                              (2 * (p0 - p1) / h + d0 + d1) / h ** 2])
+        self.points = p
+
+    def _index(self, t, piece=None):
+        i = np.searchsorted(self.x, t, side="right") - 1
+        if piece is None:
+            return np.clip(i, 0, self.x.size - 2)
+        return np.clip(i, self.first[piece], self.first[piece + 1] - 1)
+
+    def point(self, t, piece=None) -> np.ndarray:
+        t = np.asarray(t, dtype=float)
+        if piece is None:
+            t = np.where((t < 0) | (t > self.curve.period), np.mod(t, self.curve.period), t)
+        i = self._index(t, piece)
+        u = (t - self.x[i])[..., None]
+        c = self.coef[:, i]
+        return c[0] + u * (c[1] + u * (c[2] + u * c[3]))
+
+    def derivative(self, t, piece=None) -> np.ndarray:
+        t = np.asarray(t, dtype=float)
+        if piece is None:
+            t = np.where((t < 0) | (t > self.curve.period), np.mod(t, self.curve.period), t)
+        i = self._index(t, piece)
+        u = (t - self.x[i])[..., None]
+        c = self.coef[:, i]
+        return c[1] + u * (2 * c[2] + 3 * u * c[3])
+
+    def as_curve(self) -> ParametricCurve:
+        return ParametricCurve(self.point, self.curve.breakpoints, self.curve.period, self.derivative)
+
+    def error(self) -> float:
+        """Largest distance between surrogate and exact curve at the interval midpoints (one call)."""
+        mid = 0.5 * (self.x[:-1] + self.x[1:])
+        d = _points(self.curve, mid) - self.point(mid)
+        return float(np.hypot(d[:, 0], d[:, 1]).max())
+
+
+def _surrogate(curve: ParametricCurve, tol: float, n: int = 4096) -> tuple[_Surrogate, float]:
+    """A surrogate whose measured midpoint error is below ``tol / 200`` (grid refined as needed)."""
+    for _ in range(4):
+        sur = _Surrogate(curve, n)
+        err = sur.error()
+        if err <= tol / 200 or n >= 2 ** 17:
+            return sur, err
+        n = int(min(2 ** 17, n * max(2.0, min(8.0, (err / (tol / 400)) ** 0.25))))
+    return sur, err
 
 
 def _piece_index(curve: ParametricCurve, t: np.ndarray) -> np.ndarray:
@@ -349,7 +418,7 @@ class Chain:
         dist = np.full(q.shape[0], np.inf)
         which = np.zeros(q.shape[0], dtype=int)
         todo = np.arange(q.shape[0])
-        for k in (8, 64):
+        for k in (4, 64):
             k = min(k, owner.size)
             dm, idx = tree.query(q[todo], k=k)
             dm, idx = dm.reshape(todo.size, k), owner[idx.reshape(todo.size, k)]
@@ -514,8 +583,10 @@ class ArcDiscretisation:
     Attributes
     ----------
     params : (m,) ndarray
-        Curve parameters of the fitting nodes (0 … ``period``): the chain passes
-        exactly through ``P(params)``; every breakpoint is among them.
+        Curve parameters (0 … ``period``) where the chain passes exactly through
+        ``P(params)``: every breakpoint is among them.  For a free arc spline
+        (see :func:`arcs`) they are the breakpoints only; for interpolating
+        biarcs every fitting node.
     starts, ends : (n, 2) ndarray
         Entity end points; ``ends[i] == starts[i + 1]``.
     centres : (n, 2) ndarray
@@ -875,13 +946,16 @@ def _equidistribute(curve: ParametricCurve, nodes: np.ndarray, dev: np.ndarray, 
     return np.concatenate(grids)
 
 
-def _fit(curve: ParametricCurve, tol: float, kind: str, verify: Callable[[np.ndarray], float]):
+def _fit(curve: ParametricCurve, tol: float, kind: str, verify: Callable[[np.ndarray], float],
+         sur: Optional[tuple] = None):
     """Adaptive grid for ``kind`` within ``tol``: initial grid, refinement, one re-spread.
 
     ``verify(nodes)`` measures the finished result globally; should it exceed
     ``tol`` the target is tightened and refinement resumes.
     """
-    target = tol * (1.0 - MARGIN)
+    sur, sur_err = sur or _surrogate(curve, tol)
+    curve = sur.as_curve()  # fitting never calls the exact curve; verify() measures on it
+    target = tol * (1.0 - MARGIN) - sur_err
     nodes, dev = _refine(curve, _initial_grid(curve, target, kind), target, kind)
     for fill in (0.9,):
         alt, alt_dev = _refine(curve, _equidistribute(curve, nodes, dev, target, kind, fill),
@@ -896,6 +970,231 @@ def _fit(curve: ParametricCurve, tol: float, kind: str, verify: Callable[[np.nda
         nodes, dev = _refine(curve, nodes, target, kind, dev)
     raise GeometryError(f"could not verify the tolerance {tol:g} mm (measured {measured:.3g} mm): the curve "
                         "may have a cusp or cross itself (an undercut profile cannot be exported)")
+
+
+# --------------------------------------------------------------------------------------
+# free G1 arc splines (non-interpolating): the arcs stay inside the ±tol band
+# --------------------------------------------------------------------------------------
+#: model samples per arc of the free arc spline, and Lawson (minimax) iterations
+_SPLINE_SAMPLES = 12
+_LAWSON_ITERS = 16
+#: most arcs of one smooth piece fitted as a free spline (longer pieces use interpolating biarcs)
+_SPLINE_SPAN = 32
+
+
+def _span_model(sur: _Surrogate, piece: int, lo: float, hi: float, n_grid: int):
+    """Arc length, tangent angle and normal of the surrogate on ``[lo, hi]`` (one smooth piece)."""
+    t = np.linspace(lo, hi, n_grid)
+    tm = 0.5 * (t[:-1] + t[1:])
+    d = sur.derivative(t, piece)
+    dm = sur.derivative(tm, piece)
+    sp, spm = np.hypot(d[:, 0], d[:, 1]), np.hypot(dm[:, 0], dm[:, 1])
+    s = np.concatenate([[0.0], np.cumsum(np.diff(t) / 6.0 * (sp[:-1] + 4 * spm + sp[1:]))])
+    theta = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
+    return t, s, theta
+
+
+def _cumtrapz(f: np.ndarray, s: np.ndarray) -> np.ndarray:
+    ds = np.diff(s).reshape((-1,) + (1,) * (f.ndim - 1))
+    return np.concatenate([np.zeros((1,) + f.shape[1:]), np.cumsum(0.5 * ds * (f[1:] + f[:-1]), axis=0)])
+
+
+def _lawson(A: np.ndarray, b: np.ndarray, C: np.ndarray, dvec: np.ndarray, iters: int = _LAWSON_ITERS):
+    """Approximately minimise ``max |A k + b|`` subject to ``C k = d`` (Lawson's reweighting)."""
+    kp, *_ = np.linalg.lstsq(C, dvec, rcond=None)
+    _, sv, vt = np.linalg.svd(C)
+    rank = int((sv > sv[0] * 1e-12).sum()) if sv.size else 0
+    Z = vt[rank:].T
+    if Z.shape[1] == 0:
+        return kp, A @ kp + b
+    AZ = A @ Z
+    r0 = A @ kp + b
+    w = np.full(A.shape[0], 1.0 / A.shape[0])
+    best_k, best_e = None, np.inf
+    for _ in range(iters):
+        M = AZ * w[:, None]
+        H = AZ.T @ M
+        H[np.diag_indices_from(H)] += 1e-14 * np.trace(H) + 1e-300
+        y = np.linalg.solve(H, -(M.T @ r0))
+        k = kp + Z @ y
+        e = r0 + AZ @ y
+        emax = np.abs(e).max()
+        if emax < best_e:
+            best_k, best_e, best_res = k, emax, e
+        w = w * np.abs(e)
+        total = w.sum()
+        if not (total > 0):
+            break
+        w = np.maximum(w / total, 1e-12)
+    return best_k, best_res
+
+
+def _solve_span(s, theta, knots, th0, th1):
+    """Curvatures of the arcs on ``knots`` (arc length) minimising the model normal deviation."""
+    m = knots.size - 1
+    ell = np.diff(knots)
+    nrm = np.stack([-np.sin(theta), np.cos(theta)], axis=-1)
+    G = np.clip(s[:, None] - knots[None, :-1], 0.0, ell[None, :])  # (n, m): angle gained per curvature
+    Dk = _cumtrapz(G[:, :, None] * nrm[:, None, :], s)            # (n, m, 2)
+    Dt = _cumtrapz(((th0 - theta)[:, None]) * nrm, s)              # (n, 2)
+    A = np.einsum("nmi,ni->nm", Dk, nrm)
+    b = _dot(Dt, nrm)
+    scale = s[-1] / m
+    C = np.vstack([ell * scale, Dk[-1].T])
+    dvec = np.concatenate([[(th1 - th0) * scale], -Dt[-1]])
+    k, e = _lawson(A, b, C, dvec)
+    j = np.clip(np.searchsorted(knots, s, side="right") - 1, 0, m - 1)
+    per_arc = np.zeros(m)
+    np.maximum.at(per_arc, j, np.abs(e))
+    return k, per_arc
+
+
+def _place_knots(s, density, m):
+    cum = _cumtrapz(density, s)
+    if not (cum[-1] > 0):
+        return np.linspace(0.0, s[-1], m + 1)
+    knots = np.interp(np.linspace(0.0, cum[-1], m + 1), cum, s)
+    knots[0], knots[-1] = 0.0, s[-1]
+    return knots
+
+
+def _fit_span(sur: _Surrogate, piece: int, lo: float, hi: float, target: float):
+    """Fewest arcs (model) for the clamped span ``[lo, hi]``: ``(knots, k, s_total, theta0, theta1)``."""
+    t, s, theta = _span_model(sur, piece, lo, hi, 257)
+    kappa = np.gradient(theta, s)
+    dk = np.abs(np.gradient(kappa, s))
+    turn = np.abs(kappa) / MAX_TURNING_RAD
+    density = (dk / (124.7 * target)) ** (1.0 / 3.0) + turn
+    m = max(2, math.ceil(float(_cumtrapz(density, s)[-1])) + 1)
+    best = None
+    tried: dict = {}
+    for _ in range(12):
+        if m in tried:
+            break
+        if m > _SPLINE_SPAN:
+            return None
+        n_grid = max(129, _SPLINE_SAMPLES * m + 1)
+        t, s, theta = _span_model(sur, piece, lo, hi, n_grid)
+        knots = _place_knots(s, np.interp(s, np.linspace(0, s[-1], dk.size), density), m)
+        err = np.inf
+        for _ in range(2):
+            k, per_arc = _solve_span(s, theta, knots, theta[0], theta[-1])
+            err = per_arc.max()
+            # re-spread the knots: arc error ~ length³
+            dens = (np.maximum(per_arc, 1e-3 * err + 1e-300)) ** (1.0 / 3.0) / np.diff(knots)
+            dens = np.maximum(dens, np.abs(np.diff(theta[np.searchsorted(s, knots).clip(0, s.size - 1)]))
+                              / MAX_TURNING_RAD / np.diff(knots))
+            j = np.clip(np.searchsorted(knots, s, side="right") - 1, 0, m - 1)
+            knots_new = _place_knots(s, dens[j], m)
+            k2, pa2 = _solve_span(s, theta, knots_new, theta[0], theta[-1])
+            if pa2.max() < err:
+                knots, k, per_arc, err = knots_new, k2, pa2, pa2.max()
+            else:
+                break
+        tried[m] = err
+        ok = err <= target and np.all(np.abs(k * np.diff(knots)) < MAX_TURNING_RAD * 1.5)
+        if ok and (best is None or m < best[0].size - 1):
+            best = (knots, k)
+        if ok:
+            if (m - 1) in tried or m <= 2:
+                break
+            m = max(2, min(m - 1, math.floor(m * (err / target) ** (1.0 / 3.0))))
+        else:
+            if best is not None and best[0].size - 1 == m + 1:
+                break
+            m = max(m + 1, math.ceil(m * (err / target) ** (1.0 / 3.0)))
+    if best is None:
+        return None
+    knots, k = best
+    return knots, k, theta[0]
+
+
+def _span_chain(p0, t0, p1, t1, theta0, knots, k):
+    """Exact G1 arcs of a span from ``(p0, t0)`` to ``(p1, t1)``: the planned arcs, closed by a biarc."""
+    ell = np.diff(knots)
+    m = ell.size
+    n_free = m - 2
+    ang = theta0 + np.concatenate([[0.0], np.cumsum(k * ell)])
+    base = math.atan2(t0[1], t0[0])
+    ang = ang - ang[0] + base
+    starts = [p0]
+    tans = [t0]
+    ks, ls = [], []
+    for i in range(n_free):
+        T = np.array([math.cos(ang[i]), math.sin(ang[i])]) if i else t0
+        e = _entity_point(starts[-1], T, k[i], ell[i])
+        ks.append(k[i])
+        ls.append(ell[i])
+        starts.append(e)
+        tans.append(np.array([math.cos(ang[i + 1]), math.sin(ang[i + 1])]))
+    # closing biarc with the planned ratio of tangent lengths
+    def tanlen(kk, ll):
+        x = 0.5 * kk * ll
+        return ll / 2 if abs(x) < 1e-12 else math.tan(x) / kk
+    d1, d2 = tanlen(k[-2], ell[-2]), tanlen(k[-1], ell[-1])
+    ratio = d1 / d2 if d1 > 0 and d2 > 0 else 1.0
+    bi = _biarc(starts[-1][None], tans[-1][None], p1[None], t1[None], np.array([ratio]))
+    if not bi["valid"][0]:
+        bi = _biarc(starts[-1][None], tans[-1][None], p1[None], t1[None], np.array([1.0]))
+        if not bi["valid"][0]:
+            return None
+    s = np.array(starts[:n_free]).reshape(-1, 2)
+    T = np.array(tans[:n_free]).reshape(-1, 2)
+    S = np.concatenate([s, bi["s"][0]])
+    E = np.concatenate([np.array(starts[1:n_free + 1]).reshape(-1, 2), bi["e"][0]])
+    TT = np.concatenate([T, bi["T"][0]])
+    K = np.concatenate([np.array(ks), bi["k"][0]])
+    L = np.concatenate([np.array(ls), bi["ell"][0]])
+    # make every arc consistent with both its end points (ends[i] == starts[i + 1] exactly)
+    S_next = np.concatenate([S[1:], [p1]])
+    TT2, K2, L2, ok = _arc_from(S, TT, S_next)
+    if not ok.all():
+        return None
+    return S, TT2, K2, L2, S_next
+
+
+def _spline_chain(curve: ParametricCurve, sur: _Surrogate, target: float):
+    """A free G1 arc spline of the whole curve from the surrogate, or None."""
+    bp = curve.breakpoints
+    parts = []
+    pieces = []
+    for p in range(bp.size - 1):
+        lo, hi = float(bp[p]), float(bp[p + 1])
+        i0, i1 = sur.first[p], sur.first[p + 1]
+        p0 = sur.points[i0]
+        p1 = sur.points[i1] if i1 < sur.x.size - 1 else sur.points[0]
+        t0 = _unit(sur.coef[1, i0])
+        h = sur.x[i1] - sur.x[i1 - 1]
+        c = sur.coef[:, i1 - 1]
+        t1 = _unit(c[1] + h * (2 * c[2] + 3 * h * c[3]))
+        fit = _fit_span(sur, p, lo, hi, target)
+        if fit is None:
+            return None
+        knots, k, th0 = fit
+        ch = _span_chain(p0, t0, p1, t1, th0, knots, k)
+        if ch is None:
+            return None
+        parts.append(ch)
+        pieces.append(np.full(ch[0].shape[0], p))
+    cat = [np.concatenate([c[i] for c in parts]) for i in range(5)]
+    return Chain(*cat), np.concatenate(pieces)
+
+
+def _fit_spline(curve: ParametricCurve, sur: tuple, tol: float):
+    """The free arc spline within ``tol`` (measured on the exact curve), or None."""
+    target = 0.92 * tol * (1.0 - MARGIN) - sur[1]  # the model is close, not exact: keep a reserve
+    for _ in range(3):
+        with np.errstate(invalid="ignore", divide="ignore"):
+            fit = _spline_chain(curve, sur[0], target)
+        if fit is None:
+            return None
+        chain, pieces = fit
+        merged = _merge_cocircular(chain, pieces)
+        measured = measure_deviation(merged, curve).max
+        if measured <= tol:
+            return merged, measured
+        target *= 0.9 * tol / measured
+    return None
 
 
 # --------------------------------------------------------------------------------------
@@ -943,14 +1242,19 @@ def polyline(curve: ParametricCurve, *, tol: float = DEFAULT_EXPORT_TOL_MM) -> D
     return Discretisation(params=nodes, points=build(nodes), max_deviation=float(measured), tol=tol)
 
 
-def _arc_chain(curve: ParametricCurve, nodes: np.ndarray) -> tuple[Chain, np.ndarray]:
-    """The biarc chain of a node grid and the piece index of every entity."""
+def _arc_chain(curve: ParametricCurve, nodes: np.ndarray, fit_curve: ParametricCurve = None
+               ) -> tuple[Chain, np.ndarray]:
+    """The biarc chain of a node grid and the piece index of every entity.
+
+    The nodes are exact points of ``curve``; tangents and biarc ratios may be
+    taken from ``fit_curve`` (a surrogate of it).
+    """
     a, b = nodes[:-1], nodes[1:]
     pieces = _piece_index(curve, 0.5 * (a + b))
     bp = curve.breakpoints
     pts = _points(curve, nodes)
     pts[-1] = pts[0]  # one evaluation per node: ends[i] == starts[i + 1] bit for bit
-    ent = _interval_entities(curve, a, b, bp[pieces], bp[pieces + 1], "biarc", pts[:-1], pts[1:])
+    ent = _interval_entities(fit_curve or curve, a, b, bp[pieces], bp[pieces + 1], "biarc", pts[:-1], pts[1:])
     start = ent["s"].reshape(-1, 2)
     end = ent["e"].reshape(-1, 2)
     chain = Chain(start, ent["T"].reshape(-1, 2), ent["k"].ravel(), ent["ell"].ravel(), end)
@@ -1031,6 +1335,16 @@ def arcs(curve: ParametricCurve, *, tol: float = DEFAULT_EXPORT_TOL_MM) -> ArcDi
     smaller kept.
     Consecutive co-circular arcs in one piece are merged, and the final chain
     is verified with :func:`measure_deviation`.
+
+    First, a *free* (non-interpolating) G1 arc spline is tried: per smooth
+    piece, clamped to the exact point and one-sided tangent at both
+    breakpoints, the arc curvatures minimise (Lawson minimax on a linear model
+    of the normal deviation) the deviation inside the ±tol band, knots are
+    re-spread by the per-arc error and the fewest arcs kept; the last two arcs
+    of a piece are the biarc closing it exactly.  It is used when it measures
+    within ``tol`` (else the interpolating biarcs above).  All fitting runs on
+    a Hermite surrogate of a few batched exact samples; only the
+    verification calls the exact curve again.
     """
     tol = validate_tol(tol)
     _check_closed(curve, tol)
@@ -1040,7 +1354,7 @@ def arcs(curve: ParametricCurve, *, tol: float = DEFAULT_EXPORT_TOL_MM) -> ArcDi
     def build(nodes):
         key = nodes.tobytes()
         if key not in cache:
-            chain, pieces = _arc_chain(curve, nodes)
+            chain, pieces = _arc_chain(curve, nodes, fit_curve)
             merged = _merge_cocircular(chain, pieces)
             result = (chain, measure_deviation(chain, curve).max) if merged is chain else None
             if result is None:
@@ -1051,8 +1365,15 @@ def arcs(curve: ParametricCurve, *, tol: float = DEFAULT_EXPORT_TOL_MM) -> ArcDi
             cache[key] = result
         return cache[key]
 
-    nodes, _ = _fit(curve, tol, "biarc", lambda nodes: build(nodes)[1])
-    chain, measured = build(nodes)
+    sur = _surrogate(curve, tol)
+    fit_curve = sur[0].as_curve()
+    spline = _fit_spline(curve, sur, tol)
+    if spline is not None:
+        chain, measured = spline
+        nodes = curve.breakpoints.copy()
+    else:
+        nodes, _ = _fit(curve, tol, "biarc", lambda nodes: build(nodes)[1], sur)
+        chain, measured = build(nodes)
     line = chain.curvature == 0
     ksafe = np.where(line, 1.0, chain.curvature)
     centres = np.where(line[:, None], np.nan, chain.start + _perp(chain.tangent) / ksafe[:, None])
@@ -1098,30 +1419,61 @@ def _local_maxima(values: np.ndarray, cyclic: bool, top: int) -> np.ndarray:
 
 
 class _CurveProjector:
-    """Closest-point queries on the exact curve from a dense sample grid."""
+    """Closest-point queries on the exact curve.
 
-    def __init__(self, curve: ParametricCurve, ts: np.ndarray):
-        self.curve = curve
-        self.ts = ts
-        self.n = ts.size - 1
-        self.tree = cKDTree(_points(curve, ts[:-1]))
-        piece = _piece_index(curve, 0.5 * (ts[:-1] + ts[1:]))
-        self.lo = curve.breakpoints[piece]
-        self.hi = curve.breakpoints[piece + 1]
+    The foot of every query point is found by Newton iterations on a cubic
+    Hermite surrogate of the dense exact samples (on both sample intervals
+    touching the nearest sample, never across a breakpoint); the distance is
+    then taken to the *exact* curve point at that foot, one batched call, so
+    it is always an upper bound of the true distance.
+    """
 
-    def __call__(self, x: np.ndarray, t_hint: Optional[np.ndarray] = None) -> tuple[np.ndarray, np.ndarray]:
+    def __init__(self, sur: _Surrogate):
+        self.sur = sur
+        self.curve = sur.curve
+        self.x = sur.x
+        self.n = sur.x.size - 1
+        self.tree = cKDTree(sur.points[:-1])
+
+    def __call__(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Distance from each ``x`` ``(N, 2)`` to the curve and the foot parameter."""
         _, j = self.tree.query(x)
-        # the two sample intervals touching the nearest sample (never across a breakpoint)
         iv = np.stack([(j - 1) % self.n, j], axis=1)  # (N, 2)
-        a, b = self.ts[iv], self.ts[iv + 1]
-        xx = np.broadcast_to(x[:, None, :], iv.shape + (2,))
-        t = _project(self.curve, xx, 0.5 * (a + b), a, b, self.lo[iv], self.hi[iv])
-        d = xx - _points(self.curve, t)
-        dist = np.hypot(d[..., 0], d[..., 1])
+        a, h = self.x[iv], self.x[iv + 1] - self.x[iv]
+        c = self.sur.coef[:, iv]
+        xx = x[:, None, :]
+        u = 0.5 * h
+        for _ in range(6):
+            uu = u[..., None]
+            p = c[0] + uu * (c[1] + uu * (c[2] + uu * c[3]))
+            d = c[1] + uu * (2 * c[2] + 3 * uu * c[3])
+            dd = 2 * c[2] + 6 * uu * c[3]
+            r = p - xx
+            g = _dot(r, d)
+            hess = _dot(d, d) + _dot(r, dd)
+            step = g / np.where(hess > 0, hess, np.maximum(_dot(d, d), 1e-300))
+            u = np.clip(u - step, 0.0, h)
+        t = a + u
+        diff = xx - _points(self.curve, t)
+        dist = np.hypot(diff[..., 0], diff[..., 1])
         best = dist.argmin(axis=1)
         rows = np.arange(x.shape[0])
         return dist[rows, best], t[rows, best]
+
+
+def _zoom_max(f: Callable[[np.ndarray], np.ndarray], lo: np.ndarray, hi: np.ndarray,
+              levels: int = 2, m: int = 33) -> np.ndarray:
+    """Maximum of ``f`` on each ``[lo, hi]`` by nested sample grids (one batched call of ``f`` per level)."""
+    best = np.full(lo.size, -np.inf)
+    grid = np.linspace(0.0, 1.0, m)
+    rows = np.arange(lo.size)
+    for _ in range(levels):
+        u = lo[:, None] + (hi - lo)[:, None] * grid
+        v = f(u)
+        j = v.argmax(axis=1)
+        best = np.maximum(best, v[rows, j])
+        lo, hi = u[rows, np.maximum(j - 1, 0)], u[rows, np.minimum(j + 1, m - 1)]
+    return best
 
 
 def measure_deviation(entities, curve: ParametricCurve, *, samples: int = 20000,
@@ -1140,8 +1492,8 @@ def measure_deviation(entities, curve: ParametricCurve, *, samples: int = 20000,
     per_entity : int, optional
         Samples per entity, ends included.
     refine_top : int, optional
-        How many of the worst local maxima of each direction are refined by a
-        golden-section search.
+        How many of the worst local maxima of each direction are refined by
+        nested sample grids.
 
     Returns
     -------
@@ -1150,34 +1502,38 @@ def measure_deviation(entities, curve: ParametricCurve, *, samples: int = 20000,
 
     Notes
     -----
-    Curve to entities: exact point-to-line / point-to-arc distances of curve
-    samples to the chain.  Entities to curve: every entity sample is projected
-    onto the exact curve by Gauss-Newton on both sample intervals touching the
-    nearest curve sample (never across a breakpoint).  The worst local maxima
-    of each direction are then refined by golden-section search.
+    Curve to entities: exact point-to-line / point-to-arc distances of exact
+    curve samples to the chain.  Entities to curve: every entity sample is
+    projected onto the curve (Newton on a Hermite interpolant of the exact
+    samples and derivatives, on both sample intervals touching the nearest
+    curve sample, never across a breakpoint) and its distance taken to the
+    exact curve point at the foot, an upper bound.  The worst local maxima of
+    each direction are then refined by two nested grids around them.  The
+    exact curve is called a fixed, small number of times (batched).
     """
     chain = _as_chain(entities)
     if chain.n == 0:
         raise ValueError("no entities to measure")
-    ts = _curve_grid(curve, max(int(samples), 8 * chain.n))
-    q = _points(curve, ts[:-1])
+    sur = _Surrogate(curve, max(int(samples), 8 * chain.n), min_count=8)
+    ts = sur.x
+    q = sur.points[:-1]
     d_a, _ = chain.distance(q)
     n_t = ts.size - 1
 
     def g_a(t):
-        return chain.distance(_points(curve, t))[0]
+        return chain.distance(_points(curve, t.ravel()))[0].reshape(t.shape)
 
     top = _local_maxima(d_a, True, refine_top)
     lo_t = np.where(top > 0, ts[top - 1], ts[n_t - 1] - curve.period)
     hi_t = ts[top + 1]
-    best_a = _golden_max(g_a, lo_t, hi_t) if top.size else np.zeros(0)
+    best_a = _zoom_max(g_a, lo_t, hi_t) if top.size else np.zeros(0)
     i_a = int(np.argmax(d_a))
     worst_a, at_a = float(d_a[i_a]), float(ts[i_a])
     if best_a.size and best_a.max() > worst_a:
         worst_a = float(best_a.max())
         at_a = float(np.mod(0.5 * (lo_t + hi_t)[best_a.argmax()], curve.period))
 
-    proj = _CurveProjector(curve, ts)
+    proj = _CurveProjector(sur)
     x, u = chain.sample(per_entity)
     d_b, t_b = proj(x.reshape(-1, 2))
     i_b = int(np.argmax(d_b))
@@ -1190,10 +1546,10 @@ def measure_deviation(entities, curve: ParametricCurve, *, samples: int = 20000,
         u_hi = u[ent, np.minimum(ui + 1, per_entity - 1)]
 
         def g_b(uu):
-            pts = _entity_point(chain.start[ent], chain.tangent[ent], chain.curvature[ent], uu)
-            return proj(pts)[0]
+            pts = _entity_point(chain.start[ent, None], chain.tangent[ent, None], chain.curvature[ent, None], uu)
+            return proj(pts.reshape(-1, 2))[0].reshape(uu.shape)
 
-        best_b = _golden_max(g_b, u_lo, u_hi)
+        best_b = _zoom_max(g_b, u_lo, u_hi)
         if best_b.max() > worst_b:
             worst_b = float(best_b.max())
             at_b = float(t_b.reshape(d_b2.shape)[ent[best_b.argmax()], ui[best_b.argmax()]])
