@@ -26,15 +26,16 @@ through 360° has ``from_deg > to_deg``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from enum import Enum
 from typing import Any, Callable
 
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar
 
 from .motion_report import Finding, MotionReport, analyse_motion, verdict_of
-from .profile import CamGeometry, Contact, OscillatingRollerContact, _default_step, _intervals, extremum
+from .profile import (CamGeometry, Contact, OscillatingRollerContact, ProfileSample, _bracket_min, _bracket_root,
+                      _cross, _default_step, _extremum_steps, _gather, _grid, _integrate_steps, _intervals, _mapped,
+                      _run)
 
 __all__ = ["Code", "Finding", "Report", "check", "positive_ranges", "CUSP_TOL_MM", "DEFAULT_PRESSURE_LIMIT_DEG"]
 
@@ -149,24 +150,182 @@ def check(geometry: CamGeometry, *, pressure_angle_limit_deg: float | None = Non
         findings += rep.findings
     summary = _empty_summary()
     to_user = geometry.to_user
+    # every quantity is planned as solver jobs; the jobs of all planners run together, so that
+    # all refinements of one contact share one profile evaluation per round
+    planners = []
     for k, c in enumerate(geometry.profiles):
         tag = f"profile {k + 1}: " if len(geometry.profiles) > 1 else ""
-        findings += _curvature(c, tag, to_user, tool_radius_mm, summary)
+        planners.append(_curvature(c, tag, to_user, tool_radius_mm, summary))
         if c.kind == "roller":
             lim = pressure_angle_limit_deg
             if lim is None:
                 lim = DEFAULT_PRESSURE_LIMIT_DEG["oscillating" if isinstance(c, OscillatingRollerContact)
                                                  else "translating"]
-            findings += _pressure(c, tag, to_user, lim, summary)
+            planners.append(_pressure(c, tag, to_user, lim, summary))
         else:
-            findings += _face(c, tag, to_user, face_margin_mm, summary)
-    if geometry.closed:
-        ext = geometry.radius_extremes()
-        summary["base_radius_mm"] = ext.min
-        summary["max_radius_mm"] = max(geometry.radius_extremes(k).max for k in range(len(geometry.profiles)))
-    summary["area_mm2"] = geometry.area()
+            planners.append(_face(c, tag, to_user, face_margin_mm, summary))
+    planners.append(_extent(geometry, summary))
+    for found in _schedule(planners):
+        findings += found
     summary["initial_arm_angle_deg"] = geometry.initial_arm_angle_deg
     return Report(name, tuple(findings), summary, motion_report, geometry.x_unit)
+
+
+# ---------------------------------------------------------------------------
+# batched evaluation.  A planner is a generator that yields lists of jobs (contact, solver
+# generator, extractor ProfileSample → values) and is sent the list of their results; it
+# returns its findings.  _schedule runs the planners in lockstep and _Shared runs all their
+# jobs together: per round, one evaluation per contact for every pending request, and the
+# dense sample grids (the same for every quantity of a contact) evaluated once per check.
+_BIG = 256  # requests of at least this many points are cached (dense grids)
+
+
+def _take(s: ProfileSample, sl: slice) -> ProfileSample:
+    return ProfileSample(*(None if v is None else v[sl] for v in (getattr(s, f.name) for f in fields(s))))
+
+
+class _Shared:
+    def __init__(self):
+        self.cache: dict = {}
+
+    def run(self, jobs: list) -> list:
+        res: list = [None] * len(jobs)
+        req: dict[int, np.ndarray] = {}
+        for i, (_, gen, _) in enumerate(jobs):
+            try:
+                req[i] = np.asarray(next(gen), dtype=float).ravel()
+            except StopIteration as stop:
+                res[i] = stop.value
+        while req:
+            vals = self._values(jobs, req)
+            for i, v in vals.items():
+                try:
+                    req[i] = np.asarray(jobs[i][1].send(v), dtype=float).ravel()
+                except StopIteration as stop:
+                    res[i] = stop.value
+                    del req[i]
+        return res
+
+    def _values(self, jobs, req) -> dict[int, np.ndarray]:
+        groups: dict[int, list[int]] = {}
+        for i in req:
+            groups.setdefault(id(jobs[i][0]), []).append(i)
+        out: dict[int, np.ndarray] = {}
+        for idx in groups.values():
+            c = jobs[idx[0]][0]
+            keys, new, small = {}, {}, []
+            for i in idx:
+                x = req[i]
+                if x.size >= _BIG:
+                    keys[i] = key = (id(c), x.size, x.tobytes())
+                    if key not in self.cache and key not in new:
+                        new[key] = x
+                else:
+                    small.append(i)
+            parts = list(new.values()) + [req[i] for i in small]
+            if parts:
+                sample = c.evaluate(np.concatenate(parts) if len(parts) > 1 else parts[0])
+                off = 0
+                for key, x in new.items():
+                    self.cache[key] = _take(sample, slice(off, off + x.size))
+                    off += x.size
+                memo: dict = {}
+                for i in small:
+                    ext = jobs[i][2]
+                    if id(ext) not in memo:
+                        memo[id(ext)] = ext(sample)
+                    out[i] = memo[id(ext)][off:off + req[i].size]
+                    off += req[i].size
+            memo = {}
+            for i, key in keys.items():
+                ext = jobs[i][2]
+                if (key, id(ext)) not in memo:
+                    memo[key, id(ext)] = ext(self.cache[key])
+                out[i] = memo[key, id(ext)]
+        return out
+
+
+def _schedule(planners: list) -> list:
+    shared = _Shared()
+    results: list = [None] * len(planners)
+    cur: dict[int, list] = {}
+    for i, p in enumerate(planners):
+        try:
+            cur[i] = next(p)
+        except StopIteration as stop:
+            results[i] = stop.value
+    while cur:
+        keys = list(cur)
+        found = shared.run([job for i in keys for job in cur[i]])
+        off = 0
+        for i in keys:
+            n = len(cur[i])
+            try:
+                cur[i] = planners[i].send(found[off:off + n])
+            except StopIteration as stop:
+                results[i] = stop.value
+                del cur[i]
+            off += n
+    return results
+
+
+def _kp(s):
+    return s.curvature_pitch
+
+
+def _rho(s):
+    return s.rho
+
+
+def _pa(s):
+    return s.pressure_angle
+
+
+def _face_pos(s):
+    return s.face_position
+
+
+def _radius(s):
+    return np.hypot(s.point[:, 0], s.point[:, 1])
+
+
+def _height(s):
+    return s.point[:, 1]
+
+
+def _green(s):
+    return 0.5 * _cross(s.point, s.point_d1)
+
+
+def _green_open(s):
+    return s.point[:, 1] * s.point_d1[:, 0]
+
+
+def _extent(geometry: CamGeometry, summary):
+    """Planner: base and largest radius (closed cams) and the area, as
+    :meth:`CamGeometry.radius_extremes` and :meth:`CamGeometry.area` compute them."""
+    cls = type(geometry)
+    plain = cls.radius_extremes is CamGeometry.radius_extremes and cls.area is CamGeometry.area and all(
+        type(c).radius is Contact.radius for c in geometry.profiles)
+    if not plain:
+        if geometry.closed:
+            summary["base_radius_mm"] = geometry.radius_extremes().min
+            summary["max_radius_mm"] = max(geometry.radius_extremes(k).max for k in range(len(geometry.profiles)))
+        summary["area_mm2"] = geometry.area()
+        return []
+    jobs = []
+    c0 = geometry.profiles[0]
+    if geometry.closed:
+        jobs.append((c0, _extremum_steps(c0.breakpoints), _radius if c0.closed else _height))
+        jobs += [(c, _extremum_steps(c.breakpoints, maximize=True), _radius if c.closed else _height)
+                 for c in geometry.profiles]
+    jobs.append((c0, _integrate_steps(c0.breakpoints, rtol=1e-11), _green if c0.closed else _green_open))
+    res = yield jobs
+    if geometry.closed:
+        summary["base_radius_mm"] = res[0][1]
+        summary["max_radius_mm"] = max(r[1] for r in res[1:-1])
+    summary["area_mm2"] = abs(res[-1])
+    return []
 
 
 def _empty_summary() -> dict[str, Any]:
@@ -183,25 +342,39 @@ def _span(to_user, lo, hi, unit) -> str:
     return f"at {a:.6g}{unit}" if abs(b - a) < 1e-9 else f"from {a:.6g}{unit} to {b:.6g}{unit}"
 
 
-def _curvature(c: Contact, tag, to_user, tool, summary) -> list[Finding]:
+def _curvature(c: Contact, tag, to_user, tool, summary):
+    """Planner: undercut, cusp and concave-radius findings (and the radius-of-curvature summary)."""
     out: list[Finding] = []
     edges, closed = c.breakpoints, c.closed
     unit = "°" if closed else " mm"
     if c.kind == "roller":
         rr = c.roller_radius
-        kp = lambda x: c.evaluate(x).curvature_pitch  # noqa: E731
-        xa, kmax = extremum(kp, edges, maximize=True)
-        xb, kmin = extremum(kp, edges)
+        lim = max(rr, tool or 0.0)
+
+        def g(s):
+            return np.where(s.curvature_pitch < 0, -lim * s.curvature - 1.0, -1.0)
+
+        # the ranges are searched together with the extrema (used only if these call for them)
+        jobs = [(c, _extremum_steps(edges, maximize=True), _kp), (c, _extremum_steps(edges), _kp)]
+        if rr > 0:
+            jobs.append((c, _positive_ranges_steps(edges, closed=closed), lambda s: rr * s.curvature_pitch - 1.0))
+        if lim > 0:
+            jobs.append((c, _positive_ranges_steps(edges, closed=closed), g))
+        (xa, kmax), (xb, kmin), *found = yield jobs
         roc = {"min_convex": (1.0 / kmax - rr) if kmax > 0 else None,
                "min_concave": (1.0 / -kmin + rr) if kmin < 0 else None,
                "at_deg": _where(to_user, xa) if kmax > 0 else None,
                "at_min_concave_deg": _where(to_user, xb) if kmin < 0 else None,
                "pitch_min_convex": 1.0 / kmax if kmax > 0 else None, "max": None}
         _merge_roc(summary, roc)
+        undercut = rr > 0 and kmax > 0 and rr - 1.0 / kmax > CUSP_TOL_MM
+        concave = lim > 0 and kmin < 0 and 1.0 / -kmin + rr < lim
+        if rr > 0 and not undercut:
+            found.pop(0)
         if rr > 0 and kmax > 0:
             dev = rr - 1.0 / kmax  # > 0: undercut
-            if dev > CUSP_TOL_MM:
-                for lo, hi, xw, gw in positive_ranges(lambda x: rr * kp(x) - 1.0, edges, closed=closed):
+            if undercut:
+                for lo, hi, xw, gw in found.pop(0):
                     rp = rr / (1.0 + gw)
                     out.append(Finding(Code.UNDERCUT.value, "error", _where(to_user, lo), _where(to_user, hi), rp, rr,
                                        f"{tag}undercut {_span(to_user, lo, hi, unit)}: the pitch curve is convex with "
@@ -210,26 +383,22 @@ def _curvature(c: Contact, tag, to_user, tool, summary) -> list[Finding]:
                                        "base circle or use a smaller roller"))
             elif dev >= -CUSP_TOL_MM:
                 out.append(_cusp(tag, to_user, xa, 1.0 / kmax, rr, unit, "the pitch-curve radius equals the roller radius"))
-        lim = max(rr, tool or 0.0)
-        if lim > 0 and kmin < 0 and 1.0 / -kmin + rr < lim:
-            def g(x):
-                s = c.evaluate(x)
-                return np.where(s.curvature_pitch < 0, -lim * s.curvature - 1.0, -1.0)
+        if concave:
             fits = 1.0 / -kmin + rr
-            for lo, hi, xw, gw in positive_ranges(g, edges, closed=closed):
+            for lo, hi, xw, gw in found.pop(0):
                 out.append(Finding(Code.CONCAVE_RADIUS_BELOW_ROLLER.value, "warning", _where(to_user, lo),
                                    _where(to_user, hi), lim / (1.0 + gw), lim,
                                    f"{tag}concave stretch {_span(to_user, lo, hi, unit)} with radius down to "
                                    f"{fits:.6g} mm, tighter than the {lim:.6g} mm cutter; the largest tool radius "
                                    f"that fits is {fits:.6g} mm"))
         return out
-    rho = lambda x: c.evaluate(x).rho  # noqa: E731
-    xa, rmin = extremum(rho, edges)
-    xb, rmax = extremum(rho, edges, maximize=True)
+    (xa, rmin), (xb, rmax), ranges = yield [(c, _extremum_steps(edges), _rho),
+                                            (c, _extremum_steps(edges, maximize=True), _rho),
+                                            (c, _positive_ranges_steps(edges, closed=closed), lambda s: -s.rho)]
     _merge_roc(summary, {"min_convex": rmin, "min_concave": None, "at_deg": _where(to_user, xa),
                          "at_min_concave_deg": None, "pitch_min_convex": None, "max": rmax})
     if rmin < -CUSP_TOL_MM:
-        for lo, hi, xw, gw in positive_ranges(lambda x: -rho(x), edges, closed=closed):
+        for lo, hi, xw, gw in ranges:
             out.append(Finding(Code.UNDERCUT.value, "error", _where(to_user, lo), _where(to_user, hi), -gw, 0.0,
                                f"{tag}undercut {_span(to_user, lo, hi, unit)}: the radius of curvature is negative "
                                f"(down to {-gw:.6g} mm at {_where(to_user, xw):.6g}{unit}); the profile crosses itself "
@@ -260,11 +429,15 @@ def _cusp(tag, to_user, x, value, limit, unit, why) -> Finding:
                    "stress. Enlarge the base circle (or use a smaller roller)")
 
 
-def _pressure(c: Contact, tag, to_user, lim_deg, summary) -> list[Finding]:
+def _pressure(c: Contact, tag, to_user, lim_deg, summary):
+    """Planner: pressure-angle findings and summary."""
     edges, unit = c.breakpoints, ("°" if c.closed else " mm")
-    pa = lambda x: c.evaluate(x).pressure_angle  # noqa: E731
-    xa, dmax = extremum(pa, edges, maximize=True)
-    xb, dmin = extremum(pa, edges)
+    lim = math.radians(lim_deg)
+    # the ranges beyond ± the limit are searched together with the extrema
+    (xa, dmax), (xb, dmin), *found = yield [
+        (c, _extremum_steps(edges, maximize=True), _pa), (c, _extremum_steps(edges), _pa),
+        *[(c, _positive_ranges_steps(edges, closed=c.closed), lambda s, sign=sign: sign * s.pressure_angle - lim)
+          for sign in (1.0, -1.0)]]
     cur = summary["pressure_angle_deg"]
     new = {"max": math.degrees(dmax), "min": math.degrees(dmin), "at_max_deg": _where(to_user, xa),
            "at_min_deg": _where(to_user, xb), "limit": lim_deg}
@@ -275,12 +448,11 @@ def _pressure(c: Contact, tag, to_user, lim_deg, summary) -> list[Finding]:
             cur["max"], cur["at_max_deg"] = new["max"], new["at_max_deg"]
         if new["min"] < cur["min"]:
             cur["min"], cur["at_min_deg"] = new["min"], new["at_min_deg"]
-    lim = math.radians(lim_deg)
     out = []
-    for sign, worst in ((1.0, dmax), (-1.0, dmin)):
+    for sign, worst, ranges in zip((1.0, -1.0), (dmax, dmin), found):
         if sign * worst - lim <= _PA_TOL_RAD:
             continue
-        for lo, hi, xw, gw in positive_ranges(lambda x: sign * pa(x) - lim, edges, closed=c.closed):
+        for lo, hi, xw, gw in ranges:
             val = sign * math.degrees(gw + lim)
             out.append(Finding(Code.PRESSURE_ANGLE_EXCEEDED.value, "error", _where(to_user, lo), _where(to_user, hi),
                                val, sign * lim_deg,
@@ -290,11 +462,11 @@ def _pressure(c: Contact, tag, to_user, lim_deg, summary) -> list[Finding]:
     return out
 
 
-def _face(c: Contact, tag, to_user, margin, summary) -> list[Finding]:
+def _face(c: Contact, tag, to_user, margin, summary):
+    """Planner: the face-length findings and summary."""
     edges = c.breakpoints
-    pos = lambda x: c.evaluate(x).face_position  # noqa: E731
-    xa, pmin = extremum(pos, edges)
-    xb, pmax = extremum(pos, edges, maximize=True)
+    (xa, pmin), (xb, pmax) = yield [(c, _extremum_steps(edges), _face_pos),
+                                    (c, _extremum_steps(edges, maximize=True), _face_pos)]
     out = []
     a, b = _where(to_user, xa), _where(to_user, xb)
     if getattr(c, "xi0", None) is None:  # translating face: either side of the stem
@@ -331,28 +503,71 @@ def positive_ranges(g: Callable[[np.ndarray], np.ndarray], edges, *, closed: boo
     breakpoint are merged, and for ``closed`` curves a range crossing the
     period end wraps (then ``x_from > x_to``).
     """
+    return _run(g, _positive_ranges_steps(edges, closed=closed, step=step))
+
+
+def _roots_of(xs_l, v_l, roots: dict):
+    """Generator: refine (all at once) the sign changes of ``v > 0`` between adjacent samples
+    of each interval that are not in ``roots`` yet (keyed by the sample pair); fills ``roots``."""
+    A, FA, B, FB = [], [], [], []
+    for xs, vv in zip(xs_l, v_l):
+        pos = vv > 0
+        for j in np.flatnonzero(pos[:-1] != pos[1:]):
+            if (xs[j], xs[j + 1]) not in roots:
+                A.append(xs[j]), FA.append(vv[j]), B.append(xs[j + 1]), FB.append(vv[j + 1])
+    if A:
+        r = yield from _bracket_root(np.array(A), np.array(FA), np.array(B), np.array(FB), xtol=1e-14, rtol=1e-15)
+        roots.update({(a, b): float(x) for a, b, x in zip(A, B, r)})
+
+
+def _positive_ranges_steps(edges, *, closed: bool = True, step: float | None = None):
+    """Generator form of :func:`positive_ranges` (for :func:`~.profile._run` / ``_gather``):
+    one dense sampling, then every refinement batched (one call of g per round)."""
     edges = np.asarray(edges, dtype=float)
     per0, per1 = edges[0], edges[-1]
     step = step or _default_step(per1 - per0)
+    ivs = _intervals(edges, step)
+    if not ivs:
+        return []
+    grid, starts = _grid(ivs)
+    v = np.asarray((yield grid), dtype=float)
+    ends = np.r_[starts[1:], grid.size]
+    xs_l = [grid[s:e] for s, e in zip(starts, ends)]
+    v_l = [v[s:e] for s, e in zip(starts, ends)]
+    # refine each interval's largest sample (so that narrow bumps between samples are seen)
+    # together with the roots of the sign changes already sampled
+    ok = [k for k, vv in enumerate(v_l) if not np.isnan(vv).all()]
+    jobs = []
+    if ok:
+        i = np.array([int(np.nanargmax(v_l[k])) for k in ok])
+        n = np.array([len(xs_l[k]) for k in ok])
+        il, ih = np.maximum(i - 1, 0), np.minimum(i + 1, n - 1)
+        pick = lambda idx: np.array([xs_l[k][j] for k, j in zip(ok, idx)])  # noqa: E731
+        val = lambda idx: np.array([v_l[k][j] for k, j in zip(ok, idx)])  # noqa: E731
+        lo, hi, f0 = pick(il), pick(ih), val(i)
+        clean = lambda y: np.where(np.isnan(y), np.inf, -np.asarray(y, dtype=float))  # noqa: E731
+        tol = np.maximum(1e-9 * (hi - lo), 16 * np.finfo(float).eps * np.maximum(1.0, np.abs(hi)))
+        jobs.append(_mapped(_bracket_min(lo, clean(val(il)), pick(i), clean(f0), hi, clean(val(ih)), tol), clean))
+    roots: dict[tuple[float, float], float] = {}
+    jobs.append(_roots_of(xs_l, v_l, roots))
+    done = yield from _gather(jobs)
+    if ok:
+        rx, rf = done[0]
+        for m, k in enumerate(ok):
+            if -rf[m] > f0[m] and lo[m] < rx[m] < hi[m]:
+                j = int(np.searchsorted(xs_l[k], rx[m]))
+                xs_l[k] = np.insert(xs_l[k], j, rx[m])
+                v_l[k] = np.insert(v_l[k], j, -rf[m])
+        yield from _roots_of(xs_l, v_l, roots)  # sign changes made by an inserted maximum
+    pos_l = [vv > 0 for vv in v_l]
     raw: list[list[float]] = []
-    for a, b, xs in _intervals(edges, step):
-        # add refined local maxima so that narrow bumps between samples are seen
-        v = g(xs)
-        i = int(np.nanargmax(v))
-        lo, hi = xs[max(i - 1, 0)], xs[min(i + 1, len(xs) - 1)]
-        r = minimize_scalar(lambda t: -float(g(np.array([t]))[0]), bounds=(lo, hi), method="bounded",
-                            options={"xatol": 1e-13 * max(1.0, abs(hi))})
-        if -r.fun > v[i] and lo < r.x < hi:
-            xs = np.sort(np.append(xs, r.x))
-            v = g(xs)
-        pos = v > 0
+    for k, (a, b, _) in enumerate(ivs):
+        pos = pos_l[k]
         if not pos.any():
             continue
         start = a if pos[0] else None
-        for j in range(len(xs) - 1):
-            if pos[j] == pos[j + 1]:
-                continue
-            root = brentq(lambda t: float(g(np.array([t]))[0]), xs[j], xs[j + 1], xtol=1e-14, rtol=1e-15)
+        for j in np.flatnonzero(pos[:-1] != pos[1:]):
+            root = roots[(xs_l[k][j], xs_l[k][j + 1])]
             if pos[j + 1]:
                 start = root
             else:
@@ -370,15 +585,21 @@ def positive_ranges(g: Callable[[np.ndarray], np.ndarray], edges, *, closed: boo
     if closed and len(merged) > 1 and merged[0][0] - per0 < tol and per1 - merged[-1][1] < tol:
         last = merged.pop()
         merged[0][0] = last[0]
-    out = []
+    # the worst value of every range, all searched at once
+    spans, jobs = [], []
     for lo, hi in merged:
         lo = per0 if lo - per0 < tol else lo
         hi = per1 if per1 - hi < tol else hi
         parts = [(lo, hi)] if lo <= hi else [(lo, per1), (per0, hi)]
-        sub = np.unique(np.concatenate([np.asarray(edges)[(edges > a) & (edges < b)] for a, b in parts]
-                                       + [np.array([a, b]) for a, b in parts]))
-        xw, gw = extremum(g, sub, maximize=True, step=step) if len(parts) == 1 else \
-            max((extremum(g, np.unique(np.r_[a, edges[(edges > a) & (edges < b)], b]), maximize=True, step=step)
-                 for a, b in parts), key=lambda t: t[1])
+        if len(parts) == 1:
+            subs = [np.unique(np.r_[lo, edges[(edges > lo) & (edges < hi)], hi])]
+        else:
+            subs = [np.unique(np.r_[a, edges[(edges > a) & (edges < b)], b]) for a, b in parts]
+        spans.append((lo, hi, len(jobs), len(subs)))
+        jobs += [_extremum_steps(sub, maximize=True, step=step) for sub in subs]
+    found = yield from _gather(jobs)
+    out = []
+    for lo, hi, k, m in spans:
+        xw, gw = max(found[k:k + m], key=lambda t: t[1])
         out.append((float(lo), float(hi), float(xw), float(gw)))
     return out

@@ -54,7 +54,6 @@ from dataclasses import dataclass
 from typing import Callable, Protocol, Sequence
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from ..errors import SpecError
 from .mechanisms import (Mechanism, OscillatingFlat, OscillatingRoller, TranslatingCamRoller,
@@ -501,49 +500,250 @@ def _default_step(period: float) -> float:
     return period / 1440.0
 
 
+# Solvers as generators: a solver ``yield``s the parameter values it needs (1-D array) and is
+# sent f at them; :func:`_run` drives one with a plain f, :func:`_gather` runs several in
+# lockstep (one request per round), so that many searches share one f call per round — the
+# cost of a profile evaluation is mostly per call, not per point.
+def _run(f: Callable[[np.ndarray], np.ndarray], gen):
+    """Drive solver generator ``gen`` with ``f``; its return value."""
+    try:
+        x = next(gen)
+        while True:
+            x = gen.send(np.asarray(f(x), dtype=float))
+    except StopIteration as stop:
+        return stop.value
+
+
+def _gather(gens):
+    """Generator: run solver generators in lockstep, each round one request (their
+    concatenation); returns the list of their results."""
+    gens = list(gens)
+    res: list = [None] * len(gens)
+    req: dict[int, np.ndarray] = {}
+    for i, g in enumerate(gens):
+        try:
+            req[i] = np.asarray(next(g), dtype=float).ravel()
+        except StopIteration as stop:
+            res[i] = stop.value
+    while req:
+        keys = list(req)
+        v = yield (req[keys[0]] if len(keys) == 1 else np.concatenate([req[i] for i in keys]))
+        off = 0
+        for i in keys:
+            n = req[i].size
+            try:
+                req[i] = np.asarray(gens[i].send(v[off:off + n]), dtype=float).ravel()
+            except StopIteration as stop:
+                res[i] = stop.value
+                del req[i]
+            off += n
+    return res
+
+
+def _mapped(gen, fn):
+    """Generator: ``gen`` with every value array it is sent passed through ``fn`` first."""
+    try:
+        x = next(gen)
+        while True:
+            x = gen.send(fn((yield x)))
+    except StopIteration as stop:
+        return stop.value
+
+
+#: extrema equal to this relative difference are ties (rounding of repeated lobes)
+_TIE = 1e-10
+#: bracket values within this relative difference of the best are equal to rounding
+_FLAT = 64 * np.finfo(float).eps
+#: ratio of the point ladder placed around each estimate per round
+_LADDER = 0.01
+
+
+def _trials(u: np.ndarray, a: np.ndarray, b: np.ndarray, tol: np.ndarray) -> np.ndarray:
+    """(k, m) trial points of one round: the estimate u, u ± w·r^j (w = b − a, r =
+    :data:`_LADDER`, down to the tolerance) and the quarter points of [a, b] (so that the
+    bracket at least halves whatever the estimate), clipped to [a, b]."""
+    w = b - a
+    ratio = float(np.max(w / np.maximum(tol, 1e-300)))
+    J = int(min(max(math.ceil(math.log(max(ratio, 1.0)) / -math.log(_LADDER)), 1), 8))
+    steps = w[:, None] * _LADDER ** np.arange(1, J + 1)[None, :]
+    pts = np.concatenate([u[:, None], u[:, None] - steps, u[:, None] + steps,
+                          a[:, None] + w[:, None] * np.array([0.25, 0.5, 0.75])[None, :]], axis=1)
+    return np.clip(pts, a[:, None], b[:, None])
+
+
+def _neighbours(P: np.ndarray, F: np.ndarray, j: np.ndarray):
+    """For sample rows P (positions) / F (values) and chosen column j per row: the nearest
+    sample on each side (position, value), or the chosen sample itself where none."""
+    r = np.arange(len(P))
+    xj, fj = P[r, j], F[r, j]
+    left = P < xj[:, None]
+    li = np.argmax(np.where(left, P, -np.inf), axis=1)
+    hl = left.any(axis=1)
+    right = P > xj[:, None]
+    ri = np.argmin(np.where(right, P, np.inf), axis=1)
+    hr = right.any(axis=1)
+    return (np.where(hl, P[r, li], xj), np.where(hl, F[r, li], fj), xj, fj,
+            np.where(hr, P[r, ri], xj), np.where(hr, F[r, ri], fj))
+
+
+def _bracket_min(a, fa, x, fx, b, fb, tol, *, rounds: int = 60):
+    """Generator: vectorised safeguarded minimisation of k one-dimensional problems.
+
+    Each problem has a bracket [a, b] with its best sample x (a ≤ x ≤ b, fx ≤ fa, fb;
+    x may be an end).  Each round samples, for all problems at once, the vertex of the
+    parabola through (a, x, b) with a ladder of points around it and the quarter points
+    of the bracket, then shrinks the bracket to the neighbours of the best sample: the
+    bracket at least halves per round and shrinks by ~1/r² per round once the parabola
+    is accurate.  Stops when b − a ≤ tol or when f at a and b equals f at x to rounding
+    (:data:`_FLAT`).  Values must be NaN-free (use +inf).
+    Returns ``(x, fx)`` arrays.
+    """
+    a, fa, x, fx, b, fb = (np.array(t, dtype=float) for t in (a, fa, x, fx, b, fb))
+    tol = np.broadcast_to(np.asarray(tol, dtype=float), a.shape).copy()
+    done = ~(b - a > tol)
+    for _ in range(rounds):
+        act = np.flatnonzero(~done)
+        if act.size == 0:
+            break
+        A, FA, X, FX, B, FB = a[act], fa[act], x[act], fx[act], b[act], fb[act]
+        d1, d2, f1, f2 = X - A, B - X, FA - FX, FB - FX
+        with np.errstate(all="ignore"):
+            u = X + 0.5 * (d2 * d2 * f1 - d1 * d1 * f2) / (d2 * f1 + d1 * f2)
+        u = np.where(np.isfinite(u) & (d1 > 0) & (d2 > 0), u, X)
+        pts = _trials(u, A, B, tol[act])
+        v = yield pts.ravel()
+        v = np.asarray(v, dtype=float).reshape(pts.shape)
+        P = np.concatenate([X[:, None], A[:, None], B[:, None], pts], axis=1)
+        F = np.concatenate([FX[:, None], FA[:, None], FB[:, None], v], axis=1)
+        j = np.argmin(F, axis=1)  # ties keep the current best (column 0)
+        a[act], fa[act], x[act], fx[act], b[act], fb[act] = _neighbours(P, F, j)
+        # done when the bracket is narrow, or when its ends differ from the best by rounding only
+        # (the samples cannot locate the extremum any better; the value is then exact to rounding)
+        with np.errstate(invalid="ignore"):
+            flat = np.maximum(fa[act], fb[act]) - fx[act] <= _FLAT * np.abs(fx[act])
+        done[act] = ~(b[act] - a[act] > tol[act]) | flat
+    return x, fx
+
+
+def _bracket_root(a, fa, b, fb, *, xtol: float = 1e-14, rtol: float = 1e-15, rounds: int = 80):
+    """Generator: vectorised bracketing root refinement of k problems, where ``f > 0`` differs
+    at a and b (NaN counts as not positive).
+
+    Each round samples, for all problems at once, the secant estimate with a ladder of
+    points around it and the quarter points of the bracket, and keeps the first sign
+    change from a (the bracket at least halves per round, and shrinks by ~1/r² once
+    the secant is accurate).  Stops when b − a < xtol + rtol·|x| (brentq's test).
+    Returns the bracket end with the smaller |f| per problem.
+    """
+    a, fa, b, fb = (np.array(t, dtype=float) for t in (a, fa, b, fb))
+    for _ in range(rounds):
+        act = np.flatnonzero(b - a >= xtol + rtol * np.maximum(np.abs(a), np.abs(b)))
+        if act.size == 0:
+            break
+        A, FA, B, FB = a[act], fa[act], b[act], fb[act]
+        with np.errstate(all="ignore"):
+            u = A - FA * (B - A) / (FB - FA)
+        u = np.where(np.isfinite(u), u, 0.5 * (A + B))
+        pts = _trials(u, A, B, np.full(act.size, xtol))
+        v = yield pts.ravel()
+        v = np.asarray(v, dtype=float).reshape(pts.shape)
+        P = np.concatenate([A[:, None], pts, B[:, None]], axis=1)
+        F = np.concatenate([FA[:, None], v, FB[:, None]], axis=1)
+        o = np.argsort(P, axis=1, kind="stable")
+        P, F = np.take_along_axis(P, o, 1), np.take_along_axis(F, o, 1)
+        flip = (F[:, :-1] > 0) != (F[:, 1:] > 0)  # the ends differ, so some adjacent pair does
+        j = np.argmax(flip, axis=1)
+        r = np.arange(act.size)
+        a[act], fa[act], b[act], fb[act] = P[r, j], F[r, j], P[r, j + 1], F[r, j + 1]
+    with np.errstate(invalid="ignore"):
+        take_a = ~(np.abs(fb) < np.abs(fa))
+    return np.where(take_a, a, b)
+
+
+def _candidates(grid: np.ndarray, starts: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Indices of local minima of v (NaN-free) within each interval of the concatenated grid
+    (intervals start at ``starts``; the first and last sample of an interval compare one-sidedly)."""
+    first = np.zeros(v.size, dtype=bool)
+    first[starts] = True
+    last = np.roll(first, -1)
+    last[-1] = True
+    le_prev = np.r_[True, v[1:] <= v[:-1]] | first
+    le_next = np.r_[v[:-1] <= v[1:], True] | last
+    return np.flatnonzero(le_prev & le_next)
+
+
+def _grid(ivs) -> tuple[np.ndarray, np.ndarray]:
+    """Concatenated sample grid of :func:`_intervals` and the start index of each interval."""
+    sizes = np.array([len(xs) for _, _, xs in ivs], dtype=int)
+    starts = np.r_[0, np.cumsum(sizes)[:-1]]
+    return np.concatenate([xs for _, _, xs in ivs]), starts
+
+
+def _extremum_steps(edges, *, maximize: bool = False, step: float | None = None, keep: int = 4):
+    """Generator form of :func:`extremum` (for :func:`_run` / :func:`_gather`)."""
+    edges = np.asarray(edges, dtype=float)
+    step = step or _default_step(edges[-1] - edges[0])
+    sgn = -1.0 if maximize else 1.0
+    ivs = _intervals(edges, step)
+    if not ivs:
+        return 0.0, float(sgn * math.inf)
+    grid, starts = _grid(ivs)
+
+    def clean(y):
+        y = sgn * np.asarray(y, dtype=float)
+        return np.where(np.isnan(y), np.inf, y)
+
+    v = clean((yield grid))
+    loc = _candidates(grid, starts, v)
+    loc = loc[np.argsort(v[loc], kind="stable")][:keep]
+    end = np.r_[starts[1:], grid.size] - 1
+    iv = np.searchsorted(starts, loc, side="right") - 1
+    lo_i, hi_i = np.maximum(loc - 1, starts[iv]), np.minimum(loc + 1, end[iv])
+    lo, hi = grid[lo_i], grid[hi_i]
+    ref = hi > lo
+    rx, rv = grid[loc].copy(), np.full(loc.size, np.inf)
+    if ref.any():
+        tol = 1e-9 * (hi[ref] - lo[ref])
+        tol = np.maximum(tol, 16 * np.finfo(float).eps * np.maximum(1.0, np.abs(hi[ref])))
+        xr, fr = yield from _mapped(_bracket_min(lo[ref], v[lo_i[ref]], grid[loc[ref]], v[loc[ref]], hi[ref],
+                                                 v[hi_i[ref]], tol), clean)
+        rx[ref], rv[ref] = xr, np.where(np.isfinite(fr), fr, np.inf)
+    # the best of (grid value, refined value) per candidate; equal extrema (to rounding, e.g.
+    # repeated lobes) resolve to the smallest parameter, not to whichever rounding favoured
+    seq = np.stack([v[loc], rv], axis=1).ravel()
+    at = np.stack([grid[loc], rx], axis=1).ravel()
+    best = float(np.min(seq))
+    if not best < math.inf:
+        return 0.0, float(sgn * math.inf)
+    tie = np.flatnonzero(seq <= best + _TIE * abs(best))
+    k = int(tie[np.argmin(at[tie])])
+    return float(at[k]), float(sgn * seq[k])
+
+
 def extremum(f: Callable[[np.ndarray], np.ndarray], edges, *, maximize: bool = False,
              step: float | None = None, keep: int = 4) -> tuple[float, float]:
     """Global extremum of a vectorised ``f`` between breakpoints ``edges``.
 
-    Dense sampling per interval, then bounded Brent refinement of the best
-    ``keep`` local candidates.  Returns ``(x, value)``.
+    Dense sampling of every breakpoint interval (one call of f), then a safeguarded
+    parabolic refinement (:func:`_bracket_min`) of the best ``keep`` local candidates,
+    all at once (one call of f per round).  Returns ``(x, value)``.
     """
-    edges = np.asarray(edges, dtype=float)
-    step = step or _default_step(edges[-1] - edges[0])
-    sgn = -1.0 if maximize else 1.0
-    cands = []
-    for a, b, xs in _intervals(edges, step):
-        v = sgn * f(xs)
-        v = np.where(np.isnan(v), np.inf, v)
-        loc = np.flatnonzero(np.r_[True, v[1:] <= v[:-1]] & np.r_[v[:-1] <= v[1:], True])
-        cands += [(v[i], a, b, xs, int(i)) for i in loc]
-    cands.sort(key=lambda c: c[0])
-    best = (math.inf, 0.0)
-    for v0, a, b, xs, i in cands[:keep]:
-        lo, hi = xs[max(i - 1, 0)], xs[min(i + 1, len(xs) - 1)]
-        if v0 < best[0]:
-            best = (v0, xs[i])
-        if hi > lo:
-            r = minimize_scalar(lambda t: float(sgn * f(np.array([t]))[0]), bounds=(lo, hi), method="bounded",
-                                options={"xatol": 1e-13 * max(1.0, abs(hi))})
-            if np.isfinite(r.fun) and r.fun < best[0]:
-                best = (float(r.fun), float(r.x))
-    return float(best[1]), float(sgn * best[0])
+    return _run(f, _extremum_steps(edges, maximize=maximize, step=step, keep=keep))
 
 
-def integrate(f: Callable[[np.ndarray], np.ndarray], edges, *, rtol: float = 1e-11) -> float:
-    """∫ f between breakpoints by adaptive 20-point Gauss–Legendre (vectorised per pass)."""
+def _integrate_steps(edges, *, rtol: float = 1e-11):
+    """Generator form of :func:`integrate`."""
     xg, wg = np.polynomial.legendre.leggauss(20)
     edges = np.asarray(edges, dtype=float)
     todo = np.stack([edges[:-1], edges[1:]], axis=1)
     todo = todo[todo[:, 1] > todo[:, 0]]
 
-    def quad(iv):
+    def nodes(iv):
         mid, half = (iv[:, 0] + iv[:, 1]) / 2, (iv[:, 1] - iv[:, 0]) / 2
-        pts = mid[:, None] + half[:, None] * xg[None, :]
-        return half * (f(pts.ravel()).reshape(pts.shape) @ wg)
+        return mid[:, None] + half[:, None] * xg[None, :], half
 
-    whole = quad(todo)
+    pts, half = nodes(todo)
+    whole = half * ((yield pts.ravel()).reshape(pts.shape) @ wg)
     total, scale = 0.0, max(abs(whole.sum()), 1e-300)
     span = edges[-1] - edges[0]
     for _ in range(40):
@@ -551,12 +751,21 @@ def integrate(f: Callable[[np.ndarray], np.ndarray], edges, *, rtol: float = 1e-
             break
         mid = (todo[:, 0] + todo[:, 1]) / 2
         left, right = np.stack([todo[:, 0], mid], 1), np.stack([mid, todo[:, 1]], 1)
-        ql, qr = quad(left), quad(right)
+        pl, hl = nodes(left)
+        pr, hr = nodes(right)
+        v = yield np.concatenate([pl.ravel(), pr.ravel()])
+        ql = hl * (v[:pl.size].reshape(pl.shape) @ wg)
+        qr = hr * (v[pl.size:].reshape(pr.shape) @ wg)
         ok = np.abs(ql + qr - whole) <= rtol * scale * (todo[:, 1] - todo[:, 0]) / span + 1e-300
         total += float((ql + qr)[ok].sum())
         todo = np.concatenate([left[~ok], right[~ok]])
         whole = np.concatenate([ql[~ok], qr[~ok]])
     return total + float(whole.sum())
+
+
+def integrate(f: Callable[[np.ndarray], np.ndarray], edges, *, rtol: float = 1e-11) -> float:
+    """∫ f between breakpoints by adaptive 20-point Gauss–Legendre (vectorised: one call of f per pass)."""
+    return _run(f, _integrate_steps(edges, rtol=rtol))
 
 
 # ---------------------------------------------------------------------------
