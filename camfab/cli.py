@@ -394,6 +394,8 @@ def _verify_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--tol", type=float, default=None, help="tolerance, mm (default: the design's)")
     p.add_argument("--safe-z", type=float, default=25.0)
     p.add_argument("--profile", type=int, default=1, help="which profile of a conjugate pair (1 or 2)")
+    p.add_argument("--comp-radius", type=float, default=None, metavar="MM",
+                   help="radius in the controller's D register for G41/G42 programs (default: the tool radius)")
     p.add_argument("--json", action="store_true")
 
 
@@ -409,6 +411,8 @@ def cmd_verify(args: argparse.Namespace) -> int:
     tool = args.tool_diameter if args.tool_diameter is not None else spec.manufacturing.tool_diameter_mm
     if tool is None:
         raise UsageError("no tool: give --tool-diameter or [manufacturing] tool_diameter_mm")
+    if args.comp_radius is not None and not (math.isfinite(args.comp_radius) and args.comp_radius > 0):
+        raise UsageError(f"--comp-radius {args.comp_radius:g}: must be a positive radius in mm")
     geom = geometry_from_spec(spec)
     if not 1 <= args.profile <= len(geom.profiles):
         raise UsageError(f"--profile {args.profile}: the design has {len(geom.profiles)} profile(s)")
@@ -423,7 +427,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
         raise UsageError(f"{args.program}: {exc}") from None
     rep = verify(moves, exact_curve_distance=signed_distance(offset_curve(contact, tool / 2), tol=tol),
                  part_distance=signed_distance(profile_curve(contact), tol=tol), tool_radius=tool / 2, tol=tol,
-                 safe_z=args.safe_z, top_z=0.0)
+                 safe_z=args.safe_z, top_z=0.0, comp_radius=args.comp_radius)
     data = rep.to_dict()
     if args.json:
         print(json.dumps(data, indent=2))

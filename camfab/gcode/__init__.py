@@ -3,9 +3,11 @@
 Flow: a closed tool-centre contour (lines and arcs, from :mod:`camfab.offset`) and a :class:`Job`
 -> :func:`contour_toolpath` -> :class:`Program` (common model, mm) -> :func:`dumps` / :func:`write_gcode`
 with a post-processor (``linuxcnc``, ``fanuc``, ``grbl``) -> G-code text -> :func:`parse` (back-plot)
--> :func:`verify` against the exact curves.  :func:`lift_table_csv` writes the polar lift table for cam
+-> :func:`verify` against the exact curves (programs under G41/G42 are first run through
+:func:`simulate_compensation`, the controller's offset of the part contour).  :func:`lift_table_csv` writes the polar lift table for cam
 grinders.
 """
+from camfab.gcode.compensation import simulate_compensation
 from camfab.gcode.geom import ContourDistance, arc_sweep
 from camfab.gcode.lift_table import lift_angles, lift_table_csv, write_lift_table
 from camfab.gcode.parse import Backplot, GcodeError, Move, Samples, backplot, parse, sample
@@ -19,6 +21,6 @@ __all__ = [
     "Arc", "Backplot", "Comment", "ContourDistance", "Coolant", "CutterComp", "Feed", "GcodeError", "Job",
     "Move", "POSTS", "Program", "Rapid", "Samples", "Segment", "Spindle", "ToolChange", "VerifyProblem",
     "VerifyReport", "arc_sweep", "as_contour", "backplot", "contour_toolpath", "dumps", "get_post",
-    "lift_angles", "lift_table_csv", "offset_contour", "orient_contour", "parse", "sample", "verify",
+    "lift_angles", "lift_table_csv", "offset_contour", "orient_contour", "parse", "sample", "simulate_compensation", "verify",
     "write_gcode", "write_lift_table",
 ]

@@ -1,21 +1,37 @@
 """Verify a back-plotted program against the exact geometry it is meant to cut.
 
+Programs with cutter compensation (G41/G42) carry the part contour, not the tool centre.  They are first
+turned into the tool-centre path the controller would run, by
+:func:`camfab.gcode.compensation.simulate_compensation` (moves offset by the compensation radius, rolling
+arcs at convex corners, trimmed concave corners, LinuxCNC-style ramp-on and ramp-off), and every check
+below then sees that simulated path, exactly as for a tool-centre program.  The simulation itself reports
+what a controller would refuse or what would cut into the part: ``COMP_ENTRY`` (compensation turned on by
+an arc, or by an entry move not longer than the tool radius), ``COMP_EXIT`` (turned off by an arc, or by a
+move shorter than the tool diameter), ``COMP_ARC_RADIUS`` (an arc whose radius is smaller than the tool
+radius with the tool on its centre's side), ``COMP_CORNER`` (a concave corner or notch too tight for the
+tool: the offset moves do not meet), ``COMP_SIDE_CHANGE`` (G41 <-> G42 without G40); and
+``COMP_WRONG_SIDE`` when a gouging G41/G42 stretch would not gouge compensated to the other side.
+
 Checks (all vectorised over densely sampled moves):
 
 * **deviation** - the largest ``|exact_curve_distance|`` over the finishing-pass cutting moves at final
   depth (moves labelled ``FINISH CONTOUR`` by camfab's posts; without such labels, every horizontal
-  cutting move at the deepest Z, which then includes any lead-in arcs);
+  cutting move at the deepest Z, which then includes any lead-in arcs); for simulated compensated moves
+  the exact tool-centre curve is the set of points ``tool_radius`` from the part, so their deviation is
+  ``|part_distance - tool_radius|``;
 * **gouge** - a cutting move below the stock top whose tool centre comes closer to the finished part
-  than ``tool_radius - tol`` (``part_distance < tool_radius - tol``);
+  than ``tool_radius - tol`` (``part_distance < tool_radius - tol``), compensated or not, with the
+  program lines involved;
 * **rapids** - a rapid with horizontal travel below ``safe_z - tol`` (or before Z is known), a rapid that
   descends below the stock top, or a rapid below the stock top whose tool overlaps the part;
 * **feed** - a cutting move before any feed was set (or at F0); cutting below the top with the spindle off;
-* **arcs** - an arc whose start and end radius differ by more than ``tol``;
-* **coverage** (optional, ``curve_points``) - the largest distance from points of the exact curve to
-  the finishing back-plot, so a program that skips part of the contour fails too.
+* **arcs** - an arc whose start and end radius differ by more than ``tol`` (as programmed);
+* **coverage** (optional, ``curve_points``) - the largest distance from points of the exact tool-centre
+  curve to the finishing back-plot (simulated for compensated programs), so a program that skips part of
+  the contour fails too.
 
-Moves cut under cutter compensation (G41/G42) carry the part contour, not the tool centre: they are
-measured against ``part_distance`` (deviation), and gouge when they enter the part by more than ``tol``.
+Every problem names the program line (1-based); moves the simulation inserts (corner arcs, bridges) carry
+the line of the programmed move they lead into.
 """
 from __future__ import annotations
 
@@ -25,6 +41,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
+from camfab.gcode.compensation import CompensatedPath, simulate_compensation
 from camfab.gcode.parse import Backplot, sample
 
 __all__ = ["VerifyProblem", "VerifyReport", "verify"]
@@ -106,7 +123,8 @@ def _r(v: float) -> float:
 def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
            part_distance: Callable[[np.ndarray], np.ndarray], tool_radius: float, tol: float,
            safe_z: float, top_z: float = 0.0, step: float | None = None,
-           finish_label: str = "FINISH CONTOUR", curve_points: np.ndarray | None = None) -> VerifyReport:
+           finish_label: str = "FINISH CONTOUR", curve_points: np.ndarray | None = None,
+           comp_radius: float | None = None) -> VerifyReport:
     """Check a back-plotted program.
 
     Parameters
@@ -133,6 +151,9 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
         Comment label (prefix, case-insensitive) of the finishing contour moves.
     curve_points : ndarray (m, 2), optional
         Points on the exact tool-centre curve; enables the coverage check.
+    comp_radius : float, optional
+        Radius the controller compensates G41/G42 moves by (what the D register holds); default
+        ``tool_radius``.  Gouge and deviation are always measured for ``tool_radius``.
 
     Returns
     -------
@@ -173,6 +194,21 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
                 "ARC_RADIUS_MISMATCH", f"arc start and end radii differ by "
                 f"{abs(m.radius_start - m.radius_end):.4f} mm (> tol {tol} mm)", m.line))
 
+    # -- cutter compensation: simulate it, then check the tool-centre path ------------------------------
+    programmed = moves
+    comp_path: CompensatedPath | None = None
+    r_comp = r_tool if comp_radius is None else float(comp_radius)
+    join_tol = max(0.1 * tol, 1e-6)
+    if any(m.comp != "G40" for m in moves):
+        comp_path = simulate_compensation(moves, r_comp, join_tol=join_tol)
+        problems.extend(VerifyProblem(p.code, p.message, p.line) for p in comp_path.problems)
+        c = comp_path.corners
+        notes.append(f"cutter compensation simulated with radius {r_comp:g} mm over {len(comp_path.runs)} "
+                     f"G41/G42 stretch(es): {c['rolling']} rolling corner arc(s), {c['trimmed']} trimmed "
+                     "concave corner(s); the checks below see the simulated tool-centre path")
+        moves = list(comp_path.moves)
+        cutting = [i for i, m in enumerate(moves) if m.is_cutting]
+
     # -- gouge ---------------------------------------------------------------------------------------
     gouge_at = None
     if cutting:
@@ -182,9 +218,8 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
         if below.any():
             p = pts[below]
             ii = idx[below]
-            comp = np.array([moves[i].comp != "G40" for i in ii])
             d = np.asarray(part_distance(p[:, :2]), dtype=float)
-            pen = np.where(comp, -d, r_tool - d)
+            pen = r_tool - d
             bad = pen > tol
             if bad.any():
                 w = int(np.argmax(np.where(bad, pen, -np.inf)))
@@ -195,6 +230,11 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
                     "GOUGE", f"the tool enters the finished profile by up to {pen[w]:.4f} mm "
                     f"(> tol {tol} mm) at X{p[w, 0]:.4f} Y{p[w, 1]:.4f} Z{p[w, 2]:.4f}; "
                     f"lines {_line_list(lines)}", moves[int(ii[w])].line))
+                if comp_path is not None:
+                    runs = comp_path.run[ii[bad]]
+                    worst = {int(k): float(pen[bad][runs == k].max()) for k in np.unique(runs) if k >= 0}
+                    problems.extend(_wrong_side(comp_path, programmed, worst, part_distance, r_tool, r_comp,
+                                                tol, top_z, step, join_tol))
 
     # -- deviation -----------------------------------------------------------------------------------
     lab = finish_label.upper()
@@ -213,12 +253,13 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
     if fin_final:
         smp = sample([moves[i] for i in fin_final], step)
         pts, idx = smp.points, np.asarray(fin_final)[smp.index]
+        # simulated compensated moves: the exact tool-centre curve is where the part is tool_radius away
         comp = np.array([moves[i].comp != "G40" for i in idx])
         dev = np.empty(len(pts))
         if (~comp).any():
             dev[~comp] = np.abs(np.asarray(exact_curve_distance(pts[~comp, :2]), dtype=float))
         if comp.any():
-            dev[comp] = np.abs(np.asarray(part_distance(pts[comp, :2]), dtype=float))
+            dev[comp] = np.abs(np.asarray(part_distance(pts[comp, :2]), dtype=float) - r_tool)
         w = int(np.argmax(dev))
         max_dev = _r(dev[w])
         if dev[w] > tol:
@@ -226,7 +267,7 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
                 "DEVIATION", f"the finishing pass deviates {dev[w]:.4f} mm from the exact curve "
                 f"(> tol {tol} mm) at X{pts[w, 0]:.4f} Y{pts[w, 1]:.4f}", moves[int(idx[w])].line))
         if curve_points is not None:
-            gap = _r(_coverage_gap(np.asarray(curve_points, float).reshape(-1, 2), pts[:, :2], idx))
+            gap = _r(_coverage_gap(np.asarray(curve_points, float).reshape(-1, 2), pts[:, :2], idx, step))
             if gap > tol:
                 problems.append(VerifyProblem(
                     "COVERAGE", f"part of the exact curve is {gap:.4f} mm from the finishing pass "
@@ -273,30 +314,74 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
                         finish_moves=len(fin_final), notes=tuple(notes))
 
 
+def _wrong_side(comp_path: CompensatedPath, programmed, worst: dict, part_distance, r_tool: float,
+                r_comp: float, tol: float, top_z: float, step: float, join_tol: float) -> list[VerifyProblem]:
+    """``COMP_WRONG_SIDE`` for each gouging G41/G42 stretch that would not gouge on the other side."""
+    swapped = simulate_compensation(programmed, r_comp, swap_side=True, join_tol=join_tol)
+    out = []
+    for run, pen_now in sorted(worst.items()):
+        info = comp_path.runs[run]
+        sel = [i for i, m in enumerate(swapped.moves) if swapped.run[i] == run and m.is_cutting]
+        if not sel:
+            continue
+        smp = sample([swapped.moves[i] for i in sel], step)
+        below = smp.points[:, 2] < top_z - _EPS_Z
+        if not below.any():
+            continue
+        pen = r_tool - np.asarray(part_distance(smp.points[below, :2]), dtype=float)
+        if float(pen.max()) > tol:
+            continue
+        other = "G42" if info.side == "G41" else "G41"
+        out.append(VerifyProblem(
+            "COMP_WRONG_SIDE", f"{info.side} (lines {info.first_line}-{info.last_line}) compensates to the "
+            f"wrong side of the contour: the tool cuts up to {pen_now:.4f} mm into the part; with {other} "
+            "it would not gouge", info.entry_line if info.entry_line is not None else info.first_line))
+    return out
+
+
 def _line_list(lines: Sequence[int], limit: int = 8) -> str:
     head = ", ".join(str(v) for v in lines[:limit])
     return head + (f" and {len(lines) - limit} more" if len(lines) > limit else "")
 
 
-def _coverage_gap(curve: np.ndarray, pts: np.ndarray, idx: np.ndarray) -> float:
-    """Largest distance from curve points to the polyline through the back-plot samples."""
+def _coverage_gap(curve: np.ndarray, pts: np.ndarray, idx: np.ndarray, step: float) -> float:
+    """Largest distance from curve points to the polyline through the back-plot samples.
+
+    Consecutive samples are joined when they belong to one move, or to consecutive moves that meet (at
+    most ``step`` apart once repeated junction points are dropped).  Each curve point is measured to the
+    polyline segments at its few nearest samples, so a junction visited twice (the start and end of a
+    closed contour) or a very short move between two long ones (a corner arc of a compensated path) does
+    not hide the segment it lies on.
+    """
     from scipy.spatial import cKDTree
 
     if len(pts) == 0 or len(curve) == 0:
         return math.inf
-    _, near = cKDTree(pts).query(curve)
-    best = np.hypot(*(curve - pts[near]).T)
-    for off in (-1, 1):
-        a = near
-        b = near + off
-        ok = (b >= 0) & (b < len(pts))
-        b = np.clip(b, 0, len(pts) - 1)
-        ok &= idx[a] == idx[b]
-        pa, pb = pts[a], pts[b]
-        ab = pb - pa
-        L2 = np.einsum("ij,ij->i", ab, ab)
-        t = np.where(L2 > 0, np.einsum("ij,ij->i", curve - pa, ab) / np.where(L2 > 0, L2, 1), 0)
-        q = pa + np.clip(t, 0, 1)[:, None] * ab
-        d = np.hypot(*(curve - q).T)
-        best = np.where(ok, np.minimum(best, d), best)
+    keep = np.ones(len(pts), dtype=bool)
+    keep[1:] = np.hypot(*np.diff(pts, axis=0).T) > 1e-9
+    pts, idx = pts[keep], idx[keep]
+    n = len(pts)
+    best = np.full(len(curve), np.inf)
+    if n == 1:
+        return float(np.hypot(*(curve - pts[0]).T).max())
+    seg = np.hypot(*np.diff(pts, axis=0).T)
+    link = (idx[1:] == idx[:-1]) | ((idx[1:] > idx[:-1]) & (seg <= step * (1 + 1e-9) + 1e-9))
+    k = min(8, n)
+    _, near = cKDTree(pts).query(curve, k=k)
+    near = near.reshape(len(curve), k)
+    for j in range(k):
+        a = near[:, j]
+        best = np.minimum(best, np.hypot(*(curve - pts[a]).T))
+        for off in (-1, 0):  # the segments (a-1, a) and (a, a+1)
+            s0 = a + off
+            ok = (s0 >= 0) & (s0 < n - 1)
+            s0 = np.clip(s0, 0, n - 2)
+            ok &= link[s0]
+            pa, pb = pts[s0], pts[s0 + 1]
+            ab = pb - pa
+            L2 = np.einsum("ij,ij->i", ab, ab)
+            t = np.where(L2 > 0, np.einsum("ij,ij->i", curve - pa, ab) / np.where(L2 > 0, L2, 1), 0)
+            q = pa + np.clip(t, 0, 1)[:, None] * ab
+            d = np.hypot(*(curve - q).T)
+            best = np.where(ok, np.minimum(best, d), best)
     return float(best.max())

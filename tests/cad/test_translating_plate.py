@@ -144,9 +144,11 @@ def test_gcode_for_the_plate_verifies_in_every_post(wedge):
     centre = signed_distance(offset_curve(c, r), tol=tol)
     for post in ("linuxcnc", "fanuc", "grbl"):
         rep = verify(parse(dumps(cp.program, post)), exact_curve_distance=centre, part_distance=part,
-                     tool_radius=r, tol=tol, safe_z=job.safe_z_mm)
+                     tool_radius=r, tol=tol, safe_z=job.safe_z_mm,
+                     curve_points=offset_curve(c, r).point(np.linspace(0, offset_curve(c, r).period, 2000)))
         assert rep.ok, rep.to_dict()["problems"]
         assert rep.max_deviation_mm <= tol and not rep.gouge
+        assert rep.coverage_gap_mm <= tol  # the whole outline, corners included, is cut
 
 
 def test_tool_path_rounds_the_plate_corners():

@@ -115,6 +115,24 @@ def test_cli_gcode_verify_roundtrip(tmp_path, capsys):
     assert s == pytest.approx(float(prog(np.radians(a))[0]), abs=5e-7)
 
 
+def test_cli_compensated_program_is_simulated(tmp_path, capsys):
+    out = tmp_path / "c.nc"
+    assert main(["gcode", "ejemplo9rt", "--compensation", "G41", "-o", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["verify", str(out), "--design", "ejemplo9rt", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["ok"]
+    # the controller holding a radius 0.01 mm too large leaves the part 0.01 mm oversize
+    assert main(["verify", str(out), "--design", "ejemplo9rt", "--json", "--comp-radius", "3.01"]) == 1
+    data = json.loads(capsys.readouterr().out)
+    assert data["max_deviation_mm"] == pytest.approx(0.01, abs=2e-3)
+    # the wrong side cuts into the part
+    out.write_text(out.read_text().replace("G41", "G42"))
+    assert main(["verify", str(out), "--design", "ejemplo9rt", "--json"]) == 1
+    codes = {p["code"] for p in json.loads(capsys.readouterr().out)["problems"]}
+    assert {"GOUGE", "COMP_WRONG_SIDE"} <= codes
+    assert main(["verify", str(out), "--design", "ejemplo9rt", "--comp-radius", "-1"]) == 2
+
+
 def test_cli_verify_json_and_failure_exit(tmp_path, capsys):
     out = tmp_path / "c.nc"
     assert main(["gcode", "ejemplo9rt", "-o", str(out)]) == 0
