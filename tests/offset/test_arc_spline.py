@@ -45,8 +45,12 @@ def example(name):
     return _CACHE[name]
 
 
+SMOOTH = ["ejemplo9rt", "indexing_packaging", "typical12", "press_feed_oscillating", "valve_exhaust_ej1",
+          "constant_width"]
+
+
 @pytest.mark.parametrize("tol", [1e-2, 1e-3, 1e-4, 1e-5])
-@pytest.mark.parametrize("name", ["ejemplo9rt", "indexing_packaging"])
+@pytest.mark.parametrize("name", SMOOTH)
 def test_example_profiles_within_tol_and_g1(name, tol):
     _, curve, dense = example(name)
     res = arcs(curve, tol=tol)
@@ -78,3 +82,50 @@ def test_arc_counts_at_one_micron():
     assert counts["ejemplo9rt"] <= 80, counts
     assert counts["indexing_packaging"] <= 58, counts
     assert counts["typical12"] <= 125, counts
+
+
+def _one_sided_tangents(curve, t):
+    """Unit tangents arriving at and leaving ``t`` (finite differences inside each side)."""
+    h = 1e-7 * curve.period
+    p = curve.point(np.mod(np.array([t - 2 * h, t - h, t, t + h, t + 2 * h]), curve.period))
+    left = 3 * p[2] - 4 * p[1] + p[0]
+    right = -3 * p[2] + 4 * p[3] - p[4]
+    return left / np.linalg.norm(left), right / np.linalg.norm(right)
+
+
+def test_cam_profile_breakpoints_are_g1():
+    """Motion-program junctions of a disc-cam profile are tangent continuous (no true corners)."""
+    _, curve, _ = example("typical12")
+    for t in curve.breakpoints[:-1]:
+        a, b = _one_sided_tangents(curve, t)
+        assert abs(a[0] * b[1] - a[1] * b[0]) < 1e-5
+
+
+@pytest.mark.parametrize("tol", [1e-2, 1e-3, 1e-4, 1e-5])
+def test_translating_outline_keeps_corners(tol):
+    """The plate outline of a translating cam: within tol, G1 except at its true (plate) corners."""
+    if "wedge_translating" not in _CACHE:
+        g = geometry_from_spec(load_design("camfab/templates/examples/wedge_translating.toml"))
+        c = profile_curve(g.profiles[0])
+        _CACHE["wedge_translating"] = (g, c, Dense(c))
+    _, curve, dense = _CACHE["wedge_translating"]
+    res = arcs(curve, tol=tol)
+    assert check_arcs(res, dense) <= tol
+    assert res.max_deviation <= tol
+    assert_chain_consistent(res)
+    jumps = tangent_jumps(res)
+    joint = np.roll(res.starts, -1, axis=0)
+    corner_t = []
+    for t in curve.breakpoints[:-1]:
+        a, b = _one_sided_tangents(curve, t)
+        if abs(math.atan2(a[0] * b[1] - a[1] * b[0], a @ b)) > 1e-3:
+            corner_t.append(t)
+    assert len(corner_t) >= 4  # the plate corners
+    at_corner = np.zeros(len(jumps), bool)
+    for t in corner_t:
+        pt = curve.point(np.array([t]))[0]
+        hit = np.linalg.norm(joint - pt, axis=1) < 1e-9
+        assert hit.sum() == 1            # the corner is a vertex, passed exactly
+        assert jumps[hit][0] > 1e-3      # and stays a corner
+        at_corner |= hit
+    assert jumps[~at_corner].max() < 1e-7
