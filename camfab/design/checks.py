@@ -26,15 +26,16 @@ through 360° has ``from_deg > to_deg``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from enum import Enum
 from typing import Any, Callable
 
 import numpy as np
 
 from .motion_report import Finding, MotionReport, analyse_motion, verdict_of
-from .profile import (CamGeometry, Contact, OscillatingRollerContact, ProfileSample, _bracket_min, _bracket_root,
-                      _cross, _default_step, _extremum_steps, _gather, _grid, _integrate_steps, _intervals, _mapped,
+from .profile import (CamGeometry, Contact, OscillatingRollerContact, _bracket_min, _bracket_root,
+                      _channel_solvers, _cross, _default_step, _ExtremaPlan, _extrema_steps,
+                      _extremum_steps, _gather, _integrate_steps, _mapped, _sampling,
                       _run)
 
 __all__ = ["Code", "Finding", "Report", "check", "positive_ranges", "CUSP_TOL_MM", "DEFAULT_PRESSURE_LIMIT_DEG"]
@@ -172,23 +173,76 @@ def check(geometry: CamGeometry, *, pressure_angle_limit_deg: float | None = Non
 
 
 # ---------------------------------------------------------------------------
-# batched evaluation.  A planner is a generator that yields lists of jobs (contact, solver
-# generator, extractor ProfileSample → values) and is sent the list of their results; it
-# returns its findings.  _schedule runs the planners in lockstep and _Shared runs all their
-# jobs together: per round, one evaluation per contact for every pending request, and the
-# dense sample grids (the same for every quantity of a contact) evaluated once per check.
-_BIG = 256  # requests of at least this many points are cached (dense grids)
+# batched evaluation.  A planner is a generator that yields lists of jobs (contact, solver,
+# extractor ProfileSample → values) and is sent the list of their results; it returns its
+# findings.  _schedule runs the planners in lockstep and _Shared runs all their jobs together:
+# the extremum (_Ext) and range (_Ranges) searches of one contact as one solver
+# (:func:`_positive_ranges_multi`: one dense sampling, one solver step per round for all), and
+# per round one evaluation per contact for every pending request.
 
 
-def _take(s: ProfileSample, sl: slice) -> ProfileSample:
-    return ProfileSample(*(None if v is None else v[sl] for v in (getattr(s, f.name) for f in fields(s))))
+class _Ext:
+    """Job marker: the global extremum between breakpoints ``edges`` (as :func:`_extremum_steps`);
+    the searches of one contact in a round are run as one solver (:func:`_extrema_steps`)."""
+
+    __slots__ = ("edges", "maximize")
+
+    def __init__(self, edges, maximize: bool = False):
+        self.edges, self.maximize = np.asarray(edges, dtype=float), maximize
+
+
+class _Ranges:
+    """Job marker: the ranges where the extracted function is > 0 (as :func:`_positive_ranges_steps`
+    with the default step); those of one contact and edges in a round run as one solver."""
+
+    __slots__ = ("edges", "closed")
+
+    def __init__(self, edges, closed: bool = True):
+        self.edges, self.closed = np.asarray(edges, dtype=float), bool(closed)
+
+
+def _stacked(exts):
+    return lambda s: np.stack([np.asarray(e(s), dtype=float) for e in exts])
 
 
 class _Shared:
-    def __init__(self):
-        self.cache: dict = {}
-
     def run(self, jobs: list) -> list:
+        # one solver per contact: its extremum and ranges searches (of the same edges) together
+        per: dict[int, tuple[list[int], dict]] = {}
+        for i, (c, gen, _) in enumerate(jobs):
+            if isinstance(gen, _Ext):
+                per.setdefault(id(c), ([], {}))[0].append(i)
+            elif isinstance(gen, _Ranges):
+                per.setdefault(id(c), ([], {}))[1].setdefault((gen.edges.tobytes(), gen.closed), []).append(i)
+        if not per:
+            return self._run(jobs)
+        todo, owners = [], []
+        for exts, rng in per.values():
+            groups = list(rng.values())
+            if not groups:
+                groups = [[]]
+            for g, idx in enumerate(groups):
+                mine = exts if g == 0 else []
+                c = jobs[(idx or mine)[0]][0]
+                specs = [(jobs[i][1].edges, jobs[i][1].maximize) for i in mine]
+                if idx:
+                    first = jobs[idx[0]][1]
+                    gen = _positive_ranges_multi(first.edges, first.closed, len(idx), specs)
+                else:
+                    gen = _extrema_steps(specs)
+                todo.append((c, gen, _stacked([jobs[i][2] for i in idx + mine])))
+                owners.append(idx + mine)
+        plain = [i for i, (_, gen, _) in enumerate(jobs) if not isinstance(gen, (_Ext, _Ranges))]
+        done = self._run([jobs[i] for i in plain] + todo)
+        res: list = [None] * len(jobs)
+        for i, r in zip(plain, done):
+            res[i] = r
+        for idx, r in zip(owners, done[len(plain):]):
+            for i, ri in zip(idx, r):
+                res[i] = ri
+        return res
+
+    def _run(self, jobs: list) -> list:
         res: list = [None] * len(jobs)
         req: dict[int, np.ndarray] = {}
         for i, (_, gen, _) in enumerate(jobs):
@@ -207,41 +261,23 @@ class _Shared:
         return res
 
     def _values(self, jobs, req) -> dict[int, np.ndarray]:
+        """One evaluation per contact of all the pending requests (each extractor applied once)."""
         groups: dict[int, list[int]] = {}
         for i in req:
             groups.setdefault(id(jobs[i][0]), []).append(i)
         out: dict[int, np.ndarray] = {}
         for idx in groups.values():
             c = jobs[idx[0]][0]
-            keys, new, small = {}, {}, []
+            parts = [req[i] for i in idx]
+            sample = c.evaluate(np.concatenate(parts) if len(parts) > 1 else parts[0])
+            memo: dict = {}
+            off = 0
             for i in idx:
-                x = req[i]
-                if x.size >= _BIG:
-                    keys[i] = key = (id(c), x.size, x.tobytes())
-                    if key not in self.cache and key not in new:
-                        new[key] = x
-                else:
-                    small.append(i)
-            parts = list(new.values()) + [req[i] for i in small]
-            if parts:
-                sample = c.evaluate(np.concatenate(parts) if len(parts) > 1 else parts[0])
-                off = 0
-                for key, x in new.items():
-                    self.cache[key] = _take(sample, slice(off, off + x.size))
-                    off += x.size
-                memo: dict = {}
-                for i in small:
-                    ext = jobs[i][2]
-                    if id(ext) not in memo:
-                        memo[id(ext)] = ext(sample)
-                    out[i] = memo[id(ext)][off:off + req[i].size]
-                    off += req[i].size
-            memo = {}
-            for i, key in keys.items():
                 ext = jobs[i][2]
-                if (key, id(ext)) not in memo:
-                    memo[key, id(ext)] = ext(self.cache[key])
-                out[i] = memo[key, id(ext)]
+                if id(ext) not in memo:
+                    memo[id(ext)] = ext(sample)
+                out[i] = memo[id(ext)][..., off:off + req[i].size]
+                off += req[i].size
         return out
 
 
@@ -316,8 +352,8 @@ def _extent(geometry: CamGeometry, summary):
     jobs = []
     c0 = geometry.profiles[0]
     if geometry.closed:
-        jobs.append((c0, _extremum_steps(c0.breakpoints), _radius if c0.closed else _height))
-        jobs += [(c, _extremum_steps(c.breakpoints, maximize=True), _radius if c.closed else _height)
+        jobs.append((c0, _Ext(c0.breakpoints), _radius if c0.closed else _height))
+        jobs += [(c, _Ext(c.breakpoints, True), _radius if c.closed else _height)
                  for c in geometry.profiles]
     jobs.append((c0, _integrate_steps(c0.breakpoints, rtol=1e-11), _green if c0.closed else _green_open))
     res = yield jobs
@@ -355,11 +391,11 @@ def _curvature(c: Contact, tag, to_user, tool, summary):
             return np.where(s.curvature_pitch < 0, -lim * s.curvature - 1.0, -1.0)
 
         # the ranges are searched together with the extrema (used only if these call for them)
-        jobs = [(c, _extremum_steps(edges, maximize=True), _kp), (c, _extremum_steps(edges), _kp)]
+        jobs = [(c, _Ext(edges, True), _kp), (c, _Ext(edges), _kp)]
         if rr > 0:
-            jobs.append((c, _positive_ranges_steps(edges, closed=closed), lambda s: rr * s.curvature_pitch - 1.0))
+            jobs.append((c, _Ranges(edges, closed), lambda s: rr * s.curvature_pitch - 1.0))
         if lim > 0:
-            jobs.append((c, _positive_ranges_steps(edges, closed=closed), g))
+            jobs.append((c, _Ranges(edges, closed), g))
         (xa, kmax), (xb, kmin), *found = yield jobs
         roc = {"min_convex": (1.0 / kmax - rr) if kmax > 0 else None,
                "min_concave": (1.0 / -kmin + rr) if kmin < 0 else None,
@@ -392,9 +428,9 @@ def _curvature(c: Contact, tag, to_user, tool, summary):
                                    f"{fits:.6g} mm, tighter than the {lim:.6g} mm cutter; the largest tool radius "
                                    f"that fits is {fits:.6g} mm"))
         return out
-    (xa, rmin), (xb, rmax), ranges = yield [(c, _extremum_steps(edges), _rho),
-                                            (c, _extremum_steps(edges, maximize=True), _rho),
-                                            (c, _positive_ranges_steps(edges, closed=closed), lambda s: -s.rho)]
+    (xa, rmin), (xb, rmax), ranges = yield [(c, _Ext(edges), _rho),
+                                            (c, _Ext(edges, True), _rho),
+                                            (c, _Ranges(edges, closed), lambda s: -s.rho)]
     _merge_roc(summary, {"min_convex": rmin, "min_concave": None, "at_deg": _where(to_user, xa),
                          "at_min_concave_deg": None, "pitch_min_convex": None, "max": rmax})
     if rmin < -CUSP_TOL_MM:
@@ -435,8 +471,8 @@ def _pressure(c: Contact, tag, to_user, lim_deg, summary):
     lim = math.radians(lim_deg)
     # the ranges beyond ± the limit are searched together with the extrema
     (xa, dmax), (xb, dmin), *found = yield [
-        (c, _extremum_steps(edges, maximize=True), _pa), (c, _extremum_steps(edges), _pa),
-        *[(c, _positive_ranges_steps(edges, closed=c.closed), lambda s, sign=sign: sign * s.pressure_angle - lim)
+        (c, _Ext(edges, True), _pa), (c, _Ext(edges), _pa),
+        *[(c, _Ranges(edges, c.closed), lambda s, sign=sign: sign * s.pressure_angle - lim)
           for sign in (1.0, -1.0)]]
     cur = summary["pressure_angle_deg"]
     new = {"max": math.degrees(dmax), "min": math.degrees(dmin), "at_max_deg": _where(to_user, xa),
@@ -465,8 +501,7 @@ def _pressure(c: Contact, tag, to_user, lim_deg, summary):
 def _face(c: Contact, tag, to_user, margin, summary):
     """Planner: the face-length findings and summary."""
     edges = c.breakpoints
-    (xa, pmin), (xb, pmax) = yield [(c, _extremum_steps(edges), _face_pos),
-                                    (c, _extremum_steps(edges, maximize=True), _face_pos)]
+    (xa, pmin), (xb, pmax) = yield [(c, _Ext(edges), _face_pos), (c, _Ext(edges, True), _face_pos)]
     out = []
     a, b = _where(to_user, xa), _where(to_user, xb)
     if getattr(c, "xi0", None) is None:  # translating face: either side of the stem
@@ -520,16 +555,172 @@ def _roots_of(xs_l, v_l, roots: dict):
         roots.update({(a, b): float(x) for a, b, x in zip(A, B, r)})
 
 
+def _positive_ranges_multi(edges, closed: bool, k: int, ext=()):
+    """Generator: k :func:`_positive_ranges_steps` searches (default step) of k functions over
+    the same ``edges`` and the :func:`_extremum_steps` searches ``ext`` (``(edges, maximize)``)
+    of further functions, run as one: it yields parameter values and is sent a
+    (k + len(ext), n) array, row j the j-th function at them (the ranges' first).  Every
+    search gives exactly its own result (the solvers run one batch per search, see
+    :func:`~.profile._bracket_min_multi`).  Returns the k lists of ranges, then the extrema."""
+    edges = np.asarray(edges, dtype=float)
+    per0, per1 = edges[0], edges[-1]
+    step = _default_step(per1 - per0)
+    ivs, grid, starts = _sampling(edges, step)
+    plan = _ExtremaPlan([(e, mx, None, k + i) for i, (e, mx) in enumerate(ext)], base=k)
+    nrows = k + len(ext)
+    if not ivs:
+        return [[] for _ in range(k)] + ((yield from _extrema_steps(plan.specs, nrows=nrows)) if ext else [])
+    if plan.grids and plan.grids[0] is grid:
+        req, poff = plan.grids, 0
+    else:
+        req, poff = [grid, *plan.grids], grid.size
+    Vall = np.asarray((yield np.concatenate(req) if len(req) > 1 else grid), dtype=float).reshape(nrows, -1)
+    V = Vall[:k, :grid.size]
+    nint = len(ivs)
+    sizes = np.diff(np.r_[starts, grid.size])
+    seg = np.repeat(np.arange(nint), sizes)
+    inner = np.ones(grid.size - 1, dtype=bool)  # sample pairs inside one interval
+    inner[starts[1:] - 1] = False
+    # per search: refine each interval's largest sample (so that narrow bumps between samples are
+    # seen), together with the roots of the sign changes already sampled
+    mrows, info = [], []
+    A, FA, B, FB, Jb = [], [], [], [], []
+    for j in range(k):
+        v = V[j]
+        nan = np.isnan(v)
+        w = np.where(nan, -np.inf, v)
+        ok = np.flatnonzero(~np.logical_and.reduceat(nan, starts))
+        q = np.flatnonzero(((v[:-1] > 0) != (v[1:] > 0)) & inner)
+        A.append(grid[q]), FA.append(v[q]), B.append(grid[q + 1]), FB.append(v[q + 1]), Jb.append(np.full(q.size, j))
+        if not ok.size:
+            info.append(None)
+            continue
+        eq = np.flatnonzero(w == np.maximum.reduceat(w, starts)[seg])  # nanargmax per interval
+        i = eq[np.searchsorted(eq, starts[ok])]
+        il, ih = np.maximum(i - 1, starts[ok]), np.minimum(i + 1, starts[ok] + sizes[ok] - 1)
+        lo, hi, f0 = grid[il], grid[ih], v[i]
+        tol = np.maximum(1e-9 * (hi - lo), 16 * np.finfo(float).eps * np.maximum(1.0, np.abs(hi)))
+        mrows.append((lo, _neg(v[il]), grid[i], _neg(f0), hi, _neg(v[ih]), tol, np.full(ok.size, j)))
+        info.append((ok, lo, hi, f0))
+    rootss: list[dict] = [{} for _ in range(k)]
+    A, FA, B, FB, Jb = (np.concatenate(t) for t in (A, FA, B, FB, Jb))
+    ecols = plan.prepare(Vall, poff) if ext else None
+    if ecols is not None:
+        mrows.append(ecols)
+    mcols = [np.concatenate([r[q] for r in mrows]) for q in range(8)] if mrows else None
+    vrow = np.r_[np.arange(k), plan.row].astype(np.intp)
+    sgn = np.r_[np.full(k, -1.0), plan.sgn]
+    mres, rr = yield from _channel_solvers(nrows, (mcols, vrow, sgn) if mrows else None,
+                                           (A, FA, B, FB, Jb, vrow) if A.size else None)
+    if A.size:
+        for a, b, x, j in zip(A.tolist(), B.tolist(), rr.tolist(), Jb.tolist()):
+            rootss[j][(a, b)] = x
+    ext_out = plan.finish(*(mres if mres is not None else (None, None)), mcols[7] if mrows else None) if ext else []
+    # insert the refined maxima above their interval's samples; refine the sign changes they make
+    xs_ls: list = [None] * k
+    v_ls: list = [None] * k
+    A, FA, B, FB, Jb = [], [], [], [], []
+    for j in range(k):
+        if info[j] is None:
+            continue
+        ok, lo, hi, f0 = info[j]
+        m = mcols[7] == j
+        rx, rf = mres[0][m], mres[1][m]
+        for q in np.flatnonzero((-rf > f0) & (lo < rx) & (rx < hi)):
+            mm = ok[q]
+            if xs_ls[j] is None:
+                xs_ls[j] = {}
+                v_ls[j] = {}
+            xs = grid[starts[mm]:starts[mm] + sizes[mm]]
+            vv = V[j, starts[mm]:starts[mm] + sizes[mm]]
+            at = int(np.searchsorted(xs, rx[q]))
+            xs = np.concatenate((xs[:at], rx[q:q + 1], xs[at:]))
+            vv = np.concatenate((vv[:at], -rf[q:q + 1], vv[at:]))
+            xs_ls[j][mm], v_ls[j][mm] = xs, vv
+            pos = vv > 0
+            for r in np.flatnonzero(pos[:-1] != pos[1:]):
+                if (xs[r], xs[r + 1]) not in rootss[j]:
+                    A.append(xs[r]), FA.append(vv[r]), B.append(xs[r + 1]), FB.append(vv[r + 1]), Jb.append(j)
+    if A:
+        A, B, Jb = np.array(A), np.array(B), np.array(Jb, dtype=np.intp)
+        _, rr = yield from _channel_solvers(nrows, None, (A, np.array(FA), B, np.array(FB), Jb, vrow))
+        for a, b, x, j in zip(A.tolist(), B.tolist(), rr.tolist(), Jb.tolist()):
+            rootss[j][(a, b)] = x
+    specs, spans_l = [], []
+    tol = 1e-9 * max(per1 - per0, 1.0)
+    for j in range(k):
+        spans, roots = [], rootss[j]
+        if xs_ls[j]:  # the samples with the inserted maxima
+            xs_l = [xs_ls[j].get(m, grid[starts[m]:starts[m] + sizes[m]]) for m in range(nint)]
+            v_l = [v_ls[j].get(m, V[j, starts[m]:starts[m] + sizes[m]]) for m in range(nint)]
+            xa, va = np.concatenate(xs_l), np.concatenate(v_l)
+            st = np.r_[0, np.cumsum([len(t) for t in xs_l])[:-1]]
+            inn = np.ones(xa.size - 1, dtype=bool)
+            inn[st[1:] - 1] = False
+        else:
+            xa, va, st, inn = grid, V[j], starts, inner
+        pos = va > 0
+        anypos = np.logical_or.reduceat(pos, st)
+        chg = np.flatnonzero((pos[:-1] != pos[1:]) & inn)
+        cut = np.searchsorted(chg, st)
+        raw: list[list[float]] = []
+        for m in np.flatnonzero(anypos):
+            a, b, _ = ivs[m]
+            start = a if pos[st[m]] else None
+            for q in chg[cut[m]:cut[m + 1] if m + 1 < nint else chg.size]:
+                root = roots[(xa[q], xa[q + 1])]
+                if pos[q + 1]:
+                    start = root
+                else:
+                    raw.append([start, root])
+                    start = None
+            if start is not None:
+                raw.append([start, b])
+        merged: list[list[float]] = []
+        for r in raw:
+            if merged and abs(r[0] - merged[-1][1]) < tol:
+                merged[-1][1] = r[1]
+            else:
+                merged.append(r)
+        if closed and len(merged) > 1 and merged[0][0] - per0 < tol and per1 - merged[-1][1] < tol:
+            last = merged.pop()
+            merged[0][0] = last[0]
+        for lo, hi in merged:
+            lo = per0 if lo - per0 < tol else lo
+            hi = per1 if per1 - hi < tol else hi
+            parts = [(lo, hi)] if lo <= hi else [(lo, per1), (per0, hi)]
+            if len(parts) == 1:
+                subs = [np.unique(np.r_[lo, edges[(edges > lo) & (edges < hi)], hi])]
+            else:
+                subs = [np.unique(np.r_[a, edges[(edges > a) & (edges < b)], b]) for a, b in parts]
+            spans.append((lo, hi, len(specs), len(subs)))
+            specs += [(sub, True, step, j) for sub in subs]
+        spans_l.append(spans)
+    found = (yield from _extrema_steps(specs, nrows=nrows)) if specs else []
+    out = []
+    for spans in spans_l:
+        res = []
+        for lo, hi, q, m in spans:
+            xw, gw = max(found[q:q + m], key=lambda t: t[1])
+            res.append((float(lo), float(hi), float(xw), float(gw)))
+        out.append(res)
+    return out + ext_out
+
+
+def _neg(y):
+    y = np.asarray(y, dtype=float)
+    return np.where(np.isnan(y), np.inf, -y)
+
+
 def _positive_ranges_steps(edges, *, closed: bool = True, step: float | None = None):
     """Generator form of :func:`positive_ranges` (for :func:`~.profile._run` / ``_gather``):
     one dense sampling, then every refinement batched (one call of g per round)."""
     edges = np.asarray(edges, dtype=float)
     per0, per1 = edges[0], edges[-1]
     step = step or _default_step(per1 - per0)
-    ivs = _intervals(edges, step)
+    ivs, grid, starts = _sampling(edges, step)
     if not ivs:
         return []
-    grid, starts = _grid(ivs)
     v = np.asarray((yield grid), dtype=float)
     ends = np.r_[starts[1:], grid.size]
     xs_l = [grid[s:e] for s, e in zip(starts, ends)]

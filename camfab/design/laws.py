@@ -88,12 +88,23 @@ def _trig(kind: str, w: float, amp: float, nu: int, u: np.ndarray) -> np.ndarray
 def _poly(coeffs: tuple[float, ...]) -> ShapeFn:
     """Shape from ascending polynomial coefficients in ``u``."""
     base = np.polynomial.Polynomial(coeffs)
-    derivs = [base.deriv(k) if k else base for k in range(6)]
+    derivs = [tuple(float(c) for c in (base.deriv(k) if k else base).coef) for k in range(6)]
 
     def shape(u, nu):
-        return derivs[nu](u)
+        return horner(derivs[nu], u)
 
+    shape.coeffs = derivs  # type: ignore[attr-defined]
     return shape
+
+
+def horner(c: tuple[float, ...], u: np.ndarray) -> np.ndarray:
+    """``Σ c[i]·uⁱ`` by Horner's rule, operation for operation as
+    :func:`numpy.polynomial.polynomial.polyval` (so bit-identical to it), without its
+    per-call overhead."""
+    out = c[-1] + u * 0.0
+    for ci in c[-2::-1]:
+        out = ci + out * u
+    return out
 
 
 def _simple_harmonic(u, nu):
@@ -244,6 +255,34 @@ _LAW_LIST = [
 
 #: every standard law by its design-file key
 LAWS: dict[str, Law] = {law.name: law for law in _LAW_LIST}
+
+#: single-term trigonometric laws, for evaluating several derivative orders at once:
+#: ``f⁽ᵛ⁾ = _trig(kind, w, amp, ν, u)``, plus ``add0`` at ν = 0 ("u" adds u) and ``add1`` at
+#: ν = 1 (None: nothing), exactly as the shape functions above compute them
+TRIG1: dict[str, tuple] = {
+    "simple_harmonic": ("c", PI, -0.5, 0.5, None),
+    "cycloidal": ("s", 2 * PI, -1 / (2 * PI), "u", 1.0),
+    "semiharmonic_vf0": ("s", PI / 2, 1.0, None, None),
+    "semiharmonic_vi0": ("c", PI / 2, -1.0, 1.0, None),
+    "semicycloidal_vf0": ("s", PI, 1 / PI, "u", 1.0),
+    "semicycloidal_vi0": ("s", PI, -1 / PI, "u", 1.0),
+}
+
+
+def trig_rows(name: str, orders, u: np.ndarray) -> np.ndarray:
+    """``[f⁽ᵛ⁾(u) for ν in orders]`` of a :data:`TRIG1` law as one (len(orders), n) array, value
+    for value as its shape function (one sine call for all orders)."""
+    kind, w, amp, add0, add1 = TRIG1[name]
+    base = {"s": 0.0, "c": PI / 2}[kind]
+    a = np.array([amp * w**nu for nu in orders])
+    ph = np.array([base + nu * PI / 2 for nu in orders])
+    out = a[:, None] * np.sin(w * u + ph[:, None])
+    for r, nu in enumerate(orders):
+        if nu == 0 and add0 is not None:
+            out[r] += u if add0 == "u" else add0
+        elif nu == 1 and add1 is not None:
+            out[r] += add1
+    return out
 
 #: half-period laws: name -> (end with non-zero velocity, end slope in units of L/β)
 HALF_PERIOD: dict[str, tuple[str, float]] = {

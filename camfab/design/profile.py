@@ -496,6 +496,25 @@ def _intervals(edges: np.ndarray, step: float):
     return out
 
 
+_GRIDS: dict = {}
+
+
+def _sampling(edges: np.ndarray, step: float):
+    """``(ivs, grid, starts)``: :func:`_intervals` and :func:`_grid` of ``edges``, memoised (the
+    checks sample the same breakpoints many times); the arrays are read-only."""
+    key = (edges.tobytes(), float(step))
+    hit = _GRIDS.get(key)
+    if hit is None:
+        ivs = _intervals(edges, step)
+        grid, starts = _grid(ivs) if ivs else (np.empty(0), np.empty(0, dtype=int))
+        for arr in (grid, starts, *(xs for _, _, xs in ivs)):
+            arr.setflags(write=False)
+        if len(_GRIDS) >= 256:
+            _GRIDS.clear()
+        hit = _GRIDS[key] = (ivs, grid, starts)
+    return hit
+
+
 def _default_step(period: float) -> float:
     return period / 1440.0
 
@@ -684,10 +703,9 @@ def _extremum_steps(edges, *, maximize: bool = False, step: float | None = None,
     edges = np.asarray(edges, dtype=float)
     step = step or _default_step(edges[-1] - edges[0])
     sgn = -1.0 if maximize else 1.0
-    ivs = _intervals(edges, step)
+    ivs, grid, starts = _sampling(edges, step)
     if not ivs:
         return 0.0, float(sgn * math.inf)
-    grid, starts = _grid(ivs)
 
     def clean(y):
         y = sgn * np.asarray(y, dtype=float)
@@ -720,6 +738,233 @@ def _extremum_steps(edges, *, maximize: bool = False, step: float | None = None,
     return float(at[k]), float(sgn * seq[k])
 
 
+def _trials_multi(u, a, b, tol, bt, nb: int) -> np.ndarray:
+    """:func:`_trials` of rows from several independent batches (row r in batch ``bt[r]``):
+    each row gets the points it would get in a call of its batch alone, the ladder entries
+    beyond its batch's ladder length being repeats of the estimate u."""
+    w = b - a
+    ratio = w / np.maximum(tol, 1e-300)
+    if nb == 1:
+        rmax = np.array([np.max(ratio)])
+    else:
+        rmax = np.full(nb, -np.inf)
+        np.maximum.at(rmax, bt, ratio)
+    lad = -math.log(_LADDER)
+    Jb = np.array([int(min(max(math.ceil(math.log(max(r, 1.0)) / lad), 1), 8)) if r > -math.inf else 1
+                   for r in rmax.tolist()], dtype=np.intp)
+    Jr = Jb[bt]
+    jm = int(Jr.max())
+    steps = w[:, None] * _LADDER ** np.arange(1, jm + 1)[None, :]
+    if int(Jr.min()) < jm:
+        steps[np.arange(1, jm + 1)[None, :] > Jr[:, None]] = 0.0  # u ± 0 = u: a repeat
+    pts = np.concatenate([u[:, None], u[:, None] - steps, u[:, None] + steps,
+                          a[:, None] + w[:, None] * _QUARTERS[None, :]], axis=1)
+    return np.clip(pts, a[:, None], b[:, None])
+
+
+_QUARTERS = np.array([0.25, 0.5, 0.75])
+
+
+class _ExtremaPlan:
+    """Several :func:`_extremum_steps` searches of functions given as rows of a value array:
+    their dense grids (:attr:`grids`), the refinement rows after the dense sampling
+    (:meth:`prepare`) and the results (:meth:`finish`), each exactly as its own search.
+
+    ``specs`` holds ``(edges, maximize[, step[, row]])``; search i reads row ``row`` (default
+    i) of the values and is refinement batch ``base + i``."""
+
+    def __init__(self, specs, base: int = 0):
+        self.specs = [(np.asarray(sp[0], dtype=float), sp[1], sp[2] if len(sp) > 2 else None,
+                       sp[3] if len(sp) > 3 else i) for i, sp in enumerate(specs)]
+        self.sgn = np.array([-1.0 if mx else 1.0 for _, mx, _, _ in self.specs])
+        self.row = np.array([r for _, _, _, r in self.specs], dtype=np.intp)
+        self.base = base
+        self.samp = [_sampling(e, st or _default_step(e[-1] - e[0])) for e, _, st, _ in self.specs]
+        offs, parts, total = [], {}, 0
+        for ivs, grid, starts in self.samp:
+            if ivs and id(grid) not in parts:
+                parts[id(grid)] = (total, grid)
+                total += grid.size
+            offs.append(parts[id(grid)][0] if ivs else 0)
+        self.offs, self.grids, self.size = offs, [g for _, g in parts.values()], total
+        self.plan: list = []
+
+    def prepare(self, V: np.ndarray, off: int = 0):
+        """The refinement rows (lo, f(lo), x, f(x), hi, f(hi), tol, batch) from the values V at
+        the dense grids (which start at column ``off``), or None.  All searches at once: their
+        samples concatenated (each interval of each search an interval of the whole)."""
+        act = [i for i, (ivs, _, _) in enumerate(self.samp) if ivs]
+        self.act = act
+        if not act:
+            return None
+        sizes = np.array([self.samp[i][1].size for i in act])
+        base = np.r_[0, np.cumsum(sizes)[:-1]]
+        gx = np.concatenate([self.samp[i][1] for i in act])
+        cols = np.concatenate([off + self.offs[i] + np.arange(self.samp[i][1].size) for i in act])
+        own = np.repeat(np.arange(len(act)), sizes)
+        v = np.repeat(self.sgn[act], sizes) * V[np.repeat(self.row[act], sizes), cols]
+        v = np.where(np.isnan(v), np.inf, v)
+        starts = np.concatenate([self.samp[i][2] + bs for i, bs in zip(act, base)])
+        loc = _candidates(gx, starts, v)
+        loc = loc[np.lexsort((loc, v[loc], own[loc]))]  # per search, by value (stable)
+        grp = own[loc]
+        first = np.searchsorted(grp, np.arange(len(act)))
+        rank = np.arange(loc.size) - first[grp]
+        keep = rank < 4
+        loc, grp, rank = loc[keep], grp[keep], rank[keep]
+        end = np.r_[starts[1:], gx.size] - 1
+        iv = np.searchsorted(starts, loc, side="right") - 1
+        lo_i, hi_i = np.maximum(loc - 1, starts[iv]), np.minimum(loc + 1, end[iv])
+        lo, hi = gx[lo_i], gx[hi_i]
+        ref = hi > lo
+        self.cand = (len(act), grp, rank, v[loc], gx[loc], ref)
+        if not ref.any():
+            return None
+        tol = 1e-9 * (hi[ref] - lo[ref])
+        tol = np.maximum(tol, 16 * np.finfo(float).eps * np.maximum(1.0, np.abs(hi[ref])))
+        return [lo[ref], v[lo_i[ref]], gx[loc[ref]], v[loc[ref]], hi[ref], v[hi_i[ref]], tol,
+                self.base + np.asarray(act)[grp[ref]]]
+
+    def channels(self) -> tuple[np.ndarray, np.ndarray]:
+        """Value row and sign of every batch (indexed from :attr:`base`)."""
+        return self.row, self.sgn
+
+    def finish(self, xr_all=None, fr_all=None, owner=None) -> list:
+        """``(x, value)`` of every search, from the refined rows (``owner`` = their batches)."""
+        out = [(0.0, float(sg * math.inf)) for sg in self.sgn]
+        if not getattr(self, "act", None):
+            return out
+        m, grp, rank, vloc, xloc, ref = self.cand
+        seq = np.full((m, 4, 2), np.inf)
+        at = np.full((m, 4, 2), np.inf)
+        seq[grp, rank, 0], at[grp, rank, 0], at[grp, rank, 1] = vloc, xloc, xloc
+        if ref.any():
+            # the refined rows in the order prepare gave them
+            act = np.asarray(self.act)
+            sel = np.flatnonzero(np.isin(owner, self.base + act))
+            fr = fr_all[sel]
+            at[grp[ref], rank[ref], 1] = xr_all[sel]
+            seq[grp[ref], rank[ref], 1] = np.where(np.isfinite(fr), fr, np.inf)
+        # the best of (grid value, refined value) per candidate; equal extrema (to rounding,
+        # e.g. repeated lobes) resolve to the smallest parameter
+        seq, at = seq.reshape(m, 8), at.reshape(m, 8)
+        best = np.min(seq, axis=1)
+        with np.errstate(invalid="ignore"):
+            tie = seq <= (best + _TIE * np.abs(best))[:, None]
+        j = np.argmin(np.where(tie, at, np.inf), axis=1)
+        r = np.arange(m)
+        xs, vs = at[r, j], seq[r, j]
+        for q, i in enumerate(self.act):
+            if best[q] < math.inf:
+                out[i] = (float(xs[q]), float(self.sgn[i] * vs[q]))
+        return out
+
+
+def _channel_solvers(nrows: int, mins=None, roots=None, *, min_rounds: int = 60, root_rounds: int = 80):
+    """Generator: independent batches of :func:`_bracket_min` and :func:`_bracket_root` problems,
+    stepped together (one request per round), on functions given as the rows of the
+    (nrows, n) value arrays it is sent (it yields the points).
+
+    ``mins`` = (rows (lo, f(lo), x, f(x), hi, f(hi), tol, batch), value row of each batch,
+    sign of each batch): the minimised value is ``sign·f`` (NaN → +inf); ``roots`` = (a, f(a),
+    b, f(b), batch, value row of each batch), refined to ``b − a < 1e-14 + 1e-15·|x|``.  Every
+    problem takes exactly the trial points it takes in its batch's own solver (the ladder
+    length of a round is its batch's, see :func:`_trials_multi`), so it ends with exactly that
+    result.  Returns ``((x, fx), roots)`` (None where not asked)."""
+    xtol, rtol = 1e-14, 1e-15
+    if mins is not None:
+        a, fa, x, fx, b, fb = (np.array(t, dtype=float) for t in mins[0][:6])
+        tol = np.asarray(mins[0][6], dtype=float)
+        mb = np.asarray(mins[0][7], dtype=np.intp)
+        done = ~(b - a > tol)
+        mrow, msg = np.asarray(mins[1], dtype=np.intp), np.asarray(mins[2], dtype=float)
+        nbm = int(mb.max()) + 1 if mb.size else 0
+    else:
+        nbm, done = 0, np.zeros(0, dtype=bool)
+    if roots is not None:
+        ra, rfa, rb, rfb = (np.array(t, dtype=float) for t in roots[:4])
+        rbt = np.asarray(roots[4], dtype=np.intp)
+        rrow = np.asarray(roots[5], dtype=np.intp)
+        nbr = int(rbt.max()) + 1 if rbt.size else 0
+    else:
+        nbr = 0
+    mround = rround = 0
+    empty = np.zeros(0, dtype=np.intp)
+    while True:
+        mact = np.flatnonzero(~done) if mins is not None and mround < min_rounds else empty
+        ract = (np.flatnonzero(rb - ra >= xtol + rtol * np.maximum(np.abs(ra), np.abs(rb)))
+                if roots is not None and rround < root_rounds else empty)
+        nm, nr = mact.size, ract.size
+        if nm + nr == 0:
+            break
+        parts = []
+        if nm:
+            A, FA, X, FX, B, FB = a[mact], fa[mact], x[mact], fx[mact], b[mact], fb[mact]
+            d1, d2, f1, f2 = X - A, B - X, FA - FX, FB - FX
+            with np.errstate(all="ignore"):
+                u = X + 0.5 * (d2 * d2 * f1 - d1 * d1 * f2) / (d2 * f1 + d1 * f2)
+            u = np.where(np.isfinite(u) & (d1 > 0) & (d2 > 0), u, X)
+            parts.append((u, A, B, tol[mact], mb[mact], mrow[mb[mact]]))
+        if nr:
+            RA, RFA, RB, RFB = ra[ract], rfa[ract], rb[ract], rfb[ract]
+            with np.errstate(all="ignore"):
+                ur = RA - RFA * (RB - RA) / (RFB - RFA)
+            ur = np.where(np.isfinite(ur), ur, 0.5 * (RA + RB))
+            parts.append((ur, RA, RB, np.full(nr, xtol), nbm + rbt[ract], rrow[rbt[ract]]))
+        cols = [np.concatenate(t) for t in zip(*parts)] if len(parts) > 1 else list(parts[0])
+        pts = _trials_multi(*cols[:5], nbm + nbr)
+        V = np.asarray((yield pts.ravel()), dtype=float).reshape(nrows, -1)
+        Y = V[cols[5][:, None], np.arange(pts.size).reshape(pts.shape)]
+        if nm:
+            v = msg[mb[mact]][:, None] * Y[:nm]
+            v = np.where(np.isnan(v), np.inf, v)
+            P = np.concatenate([X[:, None], A[:, None], B[:, None], pts[:nm]], axis=1)
+            F = np.concatenate([FX[:, None], FA[:, None], FB[:, None], v], axis=1)
+            j = np.argmin(F, axis=1)  # ties keep the current best (column 0)
+            a[mact], fa[mact], x[mact], fx[mact], b[mact], fb[mact] = _neighbours(P, F, j)
+            with np.errstate(invalid="ignore"):
+                flat = np.maximum(fa[mact], fb[mact]) - fx[mact] <= _FLAT * np.abs(fx[mact])
+            done[mact] = ~(b[mact] - a[mact] > tol[mact]) | flat
+            mround += 1
+        if nr:
+            P = np.concatenate([RA[:, None], pts[nm:], RB[:, None]], axis=1)
+            F = np.concatenate([RFA[:, None], Y[nm:], RFB[:, None]], axis=1)
+            o = np.argsort(P, axis=1, kind="stable")
+            P, F = np.take_along_axis(P, o, 1), np.take_along_axis(F, o, 1)
+            flip = (F[:, :-1] > 0) != (F[:, 1:] > 0)  # the ends differ, so some adjacent pair does
+            j = np.argmax(flip, axis=1)
+            r = np.arange(nr)
+            ra[ract], rfa[ract], rb[ract], rfb[ract] = P[r, j], F[r, j], P[r, j + 1], F[r, j + 1]
+            rround += 1
+    out_r = None
+    if roots is not None:
+        with np.errstate(invalid="ignore"):
+            take_a = ~(np.abs(rfb) < np.abs(rfa))
+        out_r = np.where(take_a, ra, rb)
+    return ((x, fx) if mins is not None else None), out_r
+
+
+def _extrema_steps(specs, nrows: int | None = None):
+    """Generator: many :func:`_extremum_steps` searches of different functions run as one.
+
+    ``specs`` holds ``(edges, maximize[, step[, row]])`` per search; the generator yields the
+    parameter values it needs and is sent a (rows, n) array of the functions at them, search
+    i using row ``row`` (default i).
+    Each search gives exactly the result of its own :func:`_extremum_steps`.  Returns the
+    list of ``(x, value)``."""
+    plan = _ExtremaPlan(specs)
+    nrows = nrows or (int(plan.row.max()) + 1 if len(plan.row) else 0)
+    if not plan.grids:
+        return [(0.0, float(sg * math.inf)) for sg in plan.sgn]
+    allx = np.concatenate(plan.grids) if len(plan.grids) > 1 else plan.grids[0]
+    V = np.asarray((yield allx), dtype=float).reshape(nrows, -1)
+    cols = plan.prepare(V)
+    if cols is None:
+        return plan.finish()
+    (xr, fr), _ = yield from _channel_solvers(nrows, (cols, *plan.channels()))
+    return plan.finish(xr, fr, cols[7])
+
+
 def extremum(f: Callable[[np.ndarray], np.ndarray], edges, *, maximize: bool = False,
              step: float | None = None, keep: int = 4) -> tuple[float, float]:
     """Global extremum of a vectorised ``f`` between breakpoints ``edges``.
@@ -731,9 +976,12 @@ def extremum(f: Callable[[np.ndarray], np.ndarray], edges, *, maximize: bool = F
     return _run(f, _extremum_steps(edges, maximize=maximize, step=step, keep=keep))
 
 
+_GAUSS20 = np.polynomial.legendre.leggauss(20)
+
+
 def _integrate_steps(edges, *, rtol: float = 1e-11):
     """Generator form of :func:`integrate`."""
-    xg, wg = np.polynomial.legendre.leggauss(20)
+    xg, wg = _GAUSS20
     edges = np.asarray(edges, dtype=float)
     todo = np.stack([edges[:-1], edges[1:]], axis=1)
     todo = todo[todo[:, 1] > todo[:, 0]]

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..errors import Problem, SpecError
 from ..tolerances import ANGLE_SUM_TOL_DEG
-from .laws import GENERIC, HALF_PERIOD, LAWS, get_law, law_names
+from .laws import GENERIC, HALF_PERIOD, LAWS, TRIG1, get_law, horner, law_names, trig_rows
 
 __all__ = [
     "SegmentInput",
@@ -81,7 +81,7 @@ class Segment:
             ders = [c]
             for _ in range(5):
                 ders.append(np.polynomial.polynomial.polyder(ders[-1]) if ders[-1].size > 1 else np.zeros(1))
-            object.__setattr__(self, "_dcoeffs", tuple(ders))
+            object.__setattr__(self, "_dcoeffs", tuple(tuple(float(v) for v in d) for d in ders))
 
     @property
     def end(self) -> float:
@@ -94,8 +94,8 @@ class Segment:
 
     def du(self, u: np.ndarray, nu: int) -> np.ndarray:
         """``nu``-th derivative of S with respect to ``u`` (absolute units)."""
-        if self.coeffs is not None:
-            return np.polynomial.polynomial.polyval(u, self._dcoeffs[nu])
+        if self.coeffs is not None:  # Horner as numpy's polyval, without its overhead
+            return horner(self._dcoeffs[nu], np.asarray(u, dtype=float))
         out = self.lift * LAWS[self.law](u, nu)
         return out + self.s0 if nu == 0 else out
 
@@ -187,9 +187,13 @@ class MotionProgram:
     segments: tuple[Segment, ...]
     period: float = TWO_PI
     _starts: np.ndarray = field(init=False, repr=False, compare=False)
+    _tab: "_Tables" = field(init=False, repr=False, compare=False)
+    _memo: dict = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "_starts", np.array([s.start for s in self.segments]))
+        object.__setattr__(self, "_tab", _Tables(self.segments))
+        object.__setattr__(self, "_memo", {})  # results of the analyses (the program is immutable)
 
     # ---- construction -------------------------------------------------
     @classmethod
@@ -251,15 +255,19 @@ class MotionProgram:
         xr = np.mod(xa, self.period)
         idx = self.segment_index(xr)
         out = np.empty((len(orders), xr.size))
-        # group the samples by segment (stable counting sort) and visit only the segments hit
+        tab = self._tab
+        if xr.size <= _GROUPED_MAX * len(self.segments):
+            # few samples per segment: one pass per *kind* of segment (law), all its segments at
+            # once with per-sample parameters, instead of one per segment and order
+            tab.grouped(xr, idx, orders, out, xr.size <= _UNIFORM_MAX * len(self.segments))
+            return out
+        # many samples per segment: group the samples by segment (stable counting sort) and
+        # visit only the segments hit, with scalar parameters
         order = np.argsort(idx.astype(np.int16), kind="stable")
         bounds = np.searchsorted(idx[order], np.arange(len(self.segments) + 1))
         for k in np.flatnonzero(bounds[1:] > bounds[:-1]):
-            seg = self.segments[k]
             sel = order[bounds[k]:bounds[k + 1]]
-            u = (xr[sel] - seg.start) / seg.span
-            for row, nu in enumerate(orders):
-                out[row, sel] = seg.values(u, nu)
+            tab.segment(k, xr[sel], orders, out, sel)
         return out
 
     def __call__(self, x, nu: int = 0) -> np.ndarray:
@@ -278,6 +286,12 @@ class MotionProgram:
         from ..tolerances import CONTINUITY_REL_TOL
 
         tol = CONTINUITY_REL_TOL if rel_tol is None else rel_tol
+        key = ("junctions", tol, internal)
+        if key not in self._memo:
+            self._memo[key] = self._junctions(tol, internal)
+        return list(self._memo[key])
+
+    def _junctions(self, tol: float, internal: bool) -> list[Junction]:
         scale = [max(abs(p.max), abs(p.min), 1e-2) for p in self.peaks("exact")]
         out = []
         n = len(self.segments)
@@ -314,13 +328,264 @@ class MotionProgram:
         1°, or 1 mm for translating cams) from 0 to the period inclusive, a
         sample on a junction counted on both sides.
         """
-        if mode == "exact":
-            return tuple(_exact_peak(self, nu) for nu in range(4))  # type: ignore[return-value]
+        if mode == "exact":  # computed once (the program is immutable; Peak is frozen)
+            if "peaks" not in self._memo:
+                self._memo["peaks"] = tuple(_exact_peak(self, nu) for nu in range(4))
+            return self._memo["peaks"]  # type: ignore[return-value]
         if mode == "camdas":
             if step is None:
                 step = math.pi / 180.0 if abs(self.period - TWO_PI) < 1e-12 else 1.0
             return _sampled_peaks(self, step)
         raise ValueError(f"'{mode}' is not a valid peaks mode, must be one of: exact, camdas")
+
+
+# ---------------------------------------------------------------------------
+# fast evaluation
+#: at most this many samples per segment (on average) are evaluated law by law, not segment by segment
+_GROUPED_MAX = 256
+#: at most this many per segment: one pass for all the segments of the common laws (see _Tables.grouped)
+_UNIFORM_MAX = 16
+_DWELL, _POLY, _LAW, _LAWPOLY, _TRIG, _UNIFORM = 0, 1, 2, 3, 4, 5
+
+
+class _Tables:
+    """Per-segment parameters of a program in arrays, for :meth:`MotionProgram.evaluate`.
+
+    The arithmetic is :meth:`Segment.values`' operation for operation (so the results are
+    bit-identical): ``(L·f⁽ᵛ⁾(u) + s0)`` for ν = 0 and ``L·f⁽ᵛ⁾(u) / βᵛ`` otherwise for a
+    standard law, ``p⁽ᵛ⁾(u) / βᵛ`` (Horner) for a polynomial segment, ``u = (x − x0)/β``.
+    """
+
+    def __init__(self, segs: Sequence[Segment]):
+        self.segs = segs
+        self.start = np.array([s.start for s in segs], dtype=float)
+        self.span = np.array([s.span for s in segs], dtype=float)
+        self.lift = np.array([s.lift for s in segs], dtype=float)
+        self.s0 = np.array([s.s0 for s in segs], dtype=float)
+        # kind of each segment: dwell, polynomial (coefficients), or a law (key = its name)
+        keys: list = []
+        self.kind: list[tuple[int, object]] = []
+        gid = []
+        ukeys: list = []
+        self.ukind: list[tuple[int, object]] = []
+        ugid = []
+        for s in segs:
+            if s.coeffs is not None:
+                key, kind = "#poly", (_POLY, None)
+            elif s.law == "dwell":
+                key, kind = "#dwell", (_DWELL, None)
+            elif hasattr(LAWS[s.law].shape, "coeffs"):  # polynomial laws, together
+                key, kind = "#lawpoly", (_LAWPOLY, None)
+            elif s.law in TRIG1:
+                key, kind = s.law, (_TRIG, s.law)
+            else:
+                key, kind = s.law, (_LAW, LAWS[s.law].shape)
+            if key not in keys:
+                keys.append(key)
+                self.kind.append(kind)
+            gid.append(keys.index(key))
+            # the uniform grouping (few samples): dwells, polynomial and trigonometric laws together
+            if kind[0] in (_DWELL, _LAWPOLY, _TRIG):
+                key, kind = "#uniform", (_UNIFORM, None)
+            if key not in ukeys:
+                ukeys.append(key)
+                self.ukind.append(kind)
+            ugid.append(ukeys.index(key))
+        self.gid = np.array(gid, dtype=np.int8 if len(keys) < 127 else np.int16)
+        self.ngroups = len(keys)
+        self.ugid = np.array(ugid, dtype=np.int8 if len(ukeys) < 127 else np.int16)
+        self.nugroups = len(ukeys)
+        self._pow: dict[int, np.ndarray] = {}
+        self._dwell: dict[int, tuple] = {}
+        self._coef: dict[int, np.ndarray] = {}
+
+    def spanpow(self, nu: int) -> np.ndarray:
+        """βᵛ per segment (as ``Segment.values`` computes it)."""
+        p = self._pow.get(nu)
+        if p is None:
+            p = self._pow[nu] = np.array([s.span**nu for s in self.segs], dtype=float)
+        return p
+
+    def dwell(self, nu: int) -> tuple:
+        """The constant value of S⁽ᵛ⁾ on each dwell segment (scalars, and as an array)."""
+        d = self._dwell.get(nu)
+        if d is None:
+            vals = [((s.lift * 0.0) + s.s0) if nu == 0 else (s.lift * 0.0) / s.span**nu for s in self.segs]
+            d = self._dwell[nu] = (vals, np.array(vals, dtype=float))
+        return d
+
+    def coef(self, nu: int) -> np.ndarray:
+        """(n_segments, width) ascending coefficients of p⁽ᵛ⁾ of the polynomial segments (or of
+        f⁽ᵛ⁾ of the polynomial laws), padded with high-order zeros (which leave Horner's rule
+        exact), zero rows elsewhere."""
+        c = self._coef.get(nu)
+        if c is None:
+            rows = []
+            for s in self.segs:
+                if s.coeffs is not None:
+                    rows.append(s._dcoeffs[nu])
+                elif s.law in LAWS and hasattr(LAWS[s.law].shape, "coeffs"):
+                    rows.append(LAWS[s.law].shape.coeffs[nu])
+                else:
+                    rows.append((0.0,))
+            c = np.zeros((len(rows), max(len(r) for r in rows)))
+            for i, r in enumerate(rows):
+                c[i, :len(r)] = r
+            self._coef[nu] = c
+        return c
+
+    def uniform(self, orders) -> tuple:
+        """Tables of the uniform formula for ``orders``: ``f⁽ᵛ⁾(u) = a·sin(w·u + φ) + p(u)``
+        (dwell: a = w = φ = 0, p = 0; polynomial law: a = 0; single-term trigonometric law:
+        p = what it adds at ν = 0, 1).  Returns (C (orders, segments, width), a (orders,
+        segments), w (segments), φ (orders, segments), βᵛ (orders, segments))."""
+        key = ("uniform", tuple(orders))
+        hit = self._coef.get(key)  # type: ignore[call-overload]
+        if hit is None:
+            segs = self.segs
+            rows, amp, ph = [], np.zeros((len(orders), len(segs))), np.zeros((len(orders), len(segs)))
+            w = np.zeros(len(segs))
+            for r, nu in enumerate(orders):
+                row = []
+                for i, s in enumerate(segs):
+                    law = s.law if s.coeffs is None else None
+                    if law in TRIG1:
+                        kind, wi, a, add0, add1 = TRIG1[law]
+                        w[i] = wi
+                        amp[r, i] = a * wi**nu
+                        ph[r, i] = {"s": 0.0, "c": math.pi / 2}[kind] + nu * math.pi / 2
+                        add = add0 if nu == 0 else add1 if nu == 1 else None
+                        row.append((0.0, 1.0) if add == "u" else (0.0,) if add is None else (float(add),))
+                    elif law is not None and law != "dwell" and hasattr(LAWS[law].shape, "coeffs"):
+                        row.append(LAWS[law].shape.coeffs[nu])
+                    else:
+                        row.append((0.0,))
+                rows.append(row)
+            width = max(len(c) for row in rows for c in row)
+            C = np.zeros((len(orders), len(segs), width))
+            for r, row in enumerate(rows):
+                for i, c in enumerate(row):
+                    C[r, i, :len(c)] = c
+            D = np.array([self.spanpow(nu) if nu < 6 else np.array([s.span**nu for s in segs]) for nu in orders])
+            hit = self._coef[key] = (C, amp, w, ph, D)  # type: ignore[index]
+        return hit
+
+    def dwells(self, orders) -> np.ndarray:
+        """(len(orders), n_segments) :meth:`dwell` values."""
+        key = ("dwell", tuple(orders))
+        hit = self._coef.get(key)  # type: ignore[call-overload]
+        if hit is None:
+            hit = self._coef[key] = np.array([self.dwell(nu)[1] for nu in orders])  # type: ignore[index]
+        return hit
+
+    def stacked(self, orders) -> tuple[np.ndarray, np.ndarray]:
+        """(len(orders), n_segments, width) :meth:`coef` and (len(orders), n_segments) βᵛ."""
+        key = tuple(orders)
+        hit = self._coef.get(key)
+        if hit is None:
+            cs = [self.coef(nu) for nu in key]
+            w = max(c.shape[1] for c in cs)
+            C = np.zeros((len(cs), cs[0].shape[0], w))
+            for r, c in enumerate(cs):
+                C[r, :, :c.shape[1]] = c
+            D = np.array([self.spanpow(nu) if nu < 6 else np.array([s.span**nu for s in self.segs])
+                          for nu in key])
+            hit = self._coef[key] = (C, D)  # type: ignore[index]
+        return hit
+
+    def segment(self, k: int, x: np.ndarray, orders, out: np.ndarray, sel) -> None:
+        """``out[:, sel]`` = the orders of segment k at x (its samples, already reduced)."""
+        seg = self.segs[k]
+        kind, shape = self.kind[self.gid[k]]
+        if kind == _DWELL:
+            for row, nu in enumerate(orders):
+                out[row, sel] = self.dwell(nu)[0][k]
+            return
+        u = x
+        u -= seg.start
+        u /= seg.span
+        if kind in (_LAWPOLY, _TRIG):
+            shape = LAWS[seg.law].shape
+        for row, nu in enumerate(orders):
+            if kind == _POLY:
+                v = horner(seg._dcoeffs[nu], u)
+            else:
+                v = shape(u, nu)
+                v = seg.lift * v
+                if nu == 0:
+                    v += seg.s0
+            if nu != 0:
+                v /= self.spanpow(nu)[k] if nu < 6 else seg.span**nu
+            out[row, sel] = v
+
+    def grouped(self, xr: np.ndarray, idx: np.ndarray, orders, out: np.ndarray, uniform: bool = False) -> None:
+        """``out`` = the orders at every xr (segment indices idx), one pass per kind (with
+        ``uniform``, one for all dwells, polynomial and single-term trigonometric laws: fewest
+        operations, but each sample pays for a sine and the longest polynomial)."""
+        if uniform and not np.isfinite(xr).all():
+            uniform = False  # the uniform formula would turn a dwell's value at NaN into NaN
+        gids, kinds = (self.ugid, self.ukind) if uniform else (self.gid, self.kind)
+        if len(kinds) == 1:
+            parts = [(0, slice(None))]
+        else:
+            key = gids[idx]
+            order = np.argsort(key, kind="stable")
+            bounds = np.searchsorted(key[order], np.arange(len(kinds) + 1))
+            parts = [(g, order[bounds[g]:bounds[g + 1]]) for g in range(len(kinds)) if bounds[g + 1] > bounds[g]]
+        for g, sel in parts:
+            kind, shape = kinds[g]
+            si = idx[sel]
+            if kind == _DWELL:
+                out[:, sel] = self.dwells(orders)[:, si]
+                continue
+            u = (xr[sel] - self.start[si]) / self.span[si]
+            if kind == _UNIFORM:  # dwells, polynomial and single-term trigonometric laws, every order at once
+                C, amp, w, ph, D = self.uniform(orders)
+                c = C[:, si, :]
+                v = c[:, :, -1] + u * 0.0
+                for j in range(c.shape[2] - 2, -1, -1):
+                    v = c[:, :, j] + v * u
+                # the law's own order of operations: trig term first, then what it adds (p)
+                v = amp[:, si] * np.sin(w[si] * u + ph[:, si]) + v
+                v = self.lift[si] * v
+                for row, nu in enumerate(orders):
+                    if nu == 0:
+                        v[row] += self.s0[si]
+                v /= D[:, si]  # 1 for ν = 0: exact
+                out[:, sel] = v
+                continue
+            if kind in (_LAWPOLY, _POLY, _TRIG):  # every order at once
+                C, D = self.stacked(orders)
+                if kind == _TRIG:
+                    v = trig_rows(shape, orders, u)
+                else:
+                    c = C[:, si, :]
+                    v = c[:, :, -1] + u * 0.0
+                    for j in range(c.shape[2] - 2, -1, -1):
+                        v = c[:, :, j] + v * u
+                if kind != _POLY:
+                    v = self.lift[si] * v
+                    for row, nu in enumerate(orders):
+                        if nu == 0:
+                            v[row] += self.s0[si]
+                v /= D[:, si]  # 1 for ν = 0: exact
+                out[:, sel] = v
+                continue
+            if kind == _LAW:
+                lift = self.lift[si]
+            for row, nu in enumerate(orders):
+                if kind == _POLY:
+                    c = self.coef(nu)[si]
+                    v = c[:, -1] + u * 0.0
+                    for j in range(c.shape[1] - 2, -1, -1):
+                        v = c[:, j] + v * u
+                else:
+                    v = lift * shape(u, nu)
+                    if nu == 0:
+                        v += self.s0[si]
+                if nu != 0:
+                    v /= self.spanpow(nu)[si] if nu < 6 else np.array([s.span**nu for s in self.segs])[si]
+                out[row, sel] = v
 
 
 # ---------------------------------------------------------------------------
@@ -338,10 +603,24 @@ def _critical_points(seg: Segment, nu: int, lo: float, hi: float) -> list[float]
             return []
         r = np.polynomial.polynomial.polyroots(np.trim_zeros(c, "b")) if len(np.trim_zeros(c, "b")) > 1 else []
         return [float(z.real) for z in np.atleast_1d(r) if abs(z.imag) < 1e-9 and lo < z.real < hi]
+    if seg.law == "dwell":
+        # constant: every point is a (non-strict) extremum, but none comes before the piece's
+        # start, which is a candidate already with the same value — the peaks are unchanged
+        return []
     from scipy.optimize import brentq
 
-    def d(t):
-        return float(seg.du(np.array([t]), nu + 1)[0])
+    coeffs = getattr(LAWS[seg.law].shape, "coeffs", None)
+    if coeffs is not None:  # polynomial law: Horner in Python floats, operation for operation as du()
+        c, lift = coeffs[nu + 1], seg.lift
+
+        def d(t):
+            out = c[-1] + t * 0.0
+            for ci in c[-2::-1]:
+                out = ci + out * t
+            return lift * out
+    else:
+        def d(t):
+            return float(seg.du(np.array([t]), nu + 1)[0])
 
     grid = np.linspace(lo, hi, 129)
     vals = seg.du(grid, nu + 1)

@@ -1,0 +1,115 @@
+"""The fast evaluation paths agree exactly with the reference formulas.
+
+``MotionProgram.evaluate`` evaluates few samples law by law (or all common laws with one
+formula) and many samples segment by segment; every path must give, value for value, what
+``Segment.values`` gives (the operation-for-operation definition).  ``check`` runs its
+extremum and range searches merged into shared solvers; each must give exactly what the
+standalone searches (``extremum``, ``positive_ranges``) give.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import camfab.design.program as program_mod
+from camfab.design.checks import check, positive_ranges
+from camfab.design.laws import law_names
+from camfab.design.mechanisms import OscillatingRoller, TranslatingFlat, TranslatingRoller
+from camfab.design.profile import CamGeometry, extremum
+from camfab.design.program import MotionProgram
+
+PI = math.pi
+
+
+def _every_law_program() -> MotionProgram:
+    """Every law, rising and returning, generic polynomials and half-period laws."""
+    half = {"semiharmonic_vf0", "semiharmonic_vi0", "semicycloidal_vf0", "semicycloidal_vi0", "poly5", "poly7"}
+    rows = []
+    for law in law_names():
+        if law not in half:
+            rows += [(law, 5.0, 8), ("dwell", 0, 2), (law, -5.0, 8), ("dwell", 0, 2)]
+    rows += [("poly5", 3, 10), ("dwell", 0, 5), ("poly7", -3, 10), ("dwell", 0, 5)]
+    # half-period laws with the matching constant velocity (end slopes 2L/β and (π/2)L/β)
+    rows += [("semicycloidal_vi0", 1, 6), ("constant_velocity", 2, 6), ("semicycloidal_vf0", 1, 6),
+             ("semiharmonic_vi0", -1, 6), ("constant_velocity", -PI / 2, 6), ("semiharmonic_vf0", -1, 6),
+             ("cycloidal", -(2 - PI / 2), 6)]
+    rows.append(("dwell", 0, 360 - sum(r[2] for r in rows)))
+    return MotionProgram.from_segments(rows)
+
+
+def _reference(prog: MotionProgram, x: np.ndarray, orders) -> np.ndarray:
+    xr = np.mod(x, prog.period)
+    idx = prog.segment_index(xr)
+    out = np.empty((len(orders), x.size))
+    for i in range(x.size):
+        seg = prog.segments[idx[i]]
+        u = np.array([(xr[i] - seg.start) / seg.span])
+        for r, nu in enumerate(orders):
+            out[r, i] = seg.values(u, nu)[0]
+    return out
+
+
+@pytest.mark.parametrize("grouped,uniform", [(0, 0), (10**9, 0), (10**9, 10**9)])
+def test_every_evaluation_path_is_bit_identical(monkeypatch, grouped, uniform):
+    prog = _every_law_program()
+    monkeypatch.setattr(program_mod, "_GROUPED_MAX", grouped)
+    monkeypatch.setattr(program_mod, "_UNIFORM_MAX", uniform)
+    bp = prog.breakpoints
+    x = np.r_[np.random.default_rng(3).uniform(-1.0, 7.0, 600), bp, np.nextafter(bp, -9.0), np.nextafter(bp, 9.0)]
+    for xs in (x, x[:40], np.r_[x[:20], np.nan, np.inf]):
+        for orders in ((0, 1, 2, 3), (3, 0), (4,), (2,)):
+            with np.errstate(invalid="ignore"):
+                got = prog.evaluate(xs, orders)
+                ref = _reference(prog, xs, orders)
+            assert np.array_equal(got, ref, equal_nan=True)
+            assert np.array_equal(np.signbit(got), np.signbit(ref))
+
+
+def test_exact_analyses_are_computed_once():
+    prog = _every_law_program()
+    assert prog.peaks("exact") is prog.peaks("exact")
+    assert prog.junctions(internal=True) == prog.junctions(internal=True)
+
+
+@pytest.fixture(params=["tr", "or", "tf"])
+def geometry(request):
+    rows = [("cycloidal", 10, 30), ("dwell", 0, 30), ("poly345", 10, 30), ("dwell", 0, 30),
+            ("poly4567", -10, 30), ("dwell", 0, 30), ("cycloidal", -5, 30), ("dwell", 0, 30),
+            ("poly345", 10, 30), ("dwell", 0, 30), ("poly4567", -15, 30), ("dwell", 0, 30)]
+    if request.param == "tr":
+        return CamGeometry(TranslatingRoller(12.0, 8.0, 5.0), MotionProgram.from_segments(rows))
+    if request.param == "or":
+        half = [(law, lift / 2, span) for law, lift, span in rows]
+        return CamGeometry(OscillatingRoller(50.0, 8.0, 120.0, 90.0), MotionProgram.from_segments(half))
+    return CamGeometry(TranslatingFlat(10.0), MotionProgram.from_segments(rows))
+
+
+def test_merged_searches_equal_the_standalone_ones(geometry):
+    """check()'s batched searches give exactly the standalone results."""
+    c = geometry.profiles[0]
+    rep = check(geometry, pressure_angle_limit_deg=10.0, tool_radius_mm=30.0)
+    edges = c.breakpoints
+    s = rep.summary
+    if c.kind == "roller":
+        xa, pmax = extremum(lambda x: c.evaluate(x).pressure_angle, edges, maximize=True)
+        xb, pmin = extremum(lambda x: c.evaluate(x).pressure_angle, edges)
+        assert s["pressure_angle_deg"]["max"] == math.degrees(pmax)
+        assert s["pressure_angle_deg"]["min"] == math.degrees(pmin)
+        assert s["pressure_angle_deg"]["at_max_deg"] == math.degrees(xa)
+        lim = math.radians(10.0)
+        ranges = positive_ranges(lambda x: c.evaluate(x).pressure_angle - lim, edges, closed=c.closed)
+        found = [f for f in rep.findings if f.code == "PRESSURE_ANGLE_EXCEEDED" and f.limit > 0]
+        assert [(f.from_deg, f.to_deg) for f in found] == [(math.degrees(lo), math.degrees(hi))
+                                                           for lo, hi, _, _ in ranges]
+        assert [f.value for f in found] == [math.degrees(gw + lim) for _, _, _, gw in ranges]
+    else:
+        xa, rmin = extremum(lambda x: c.evaluate(x).rho, edges)
+        assert s["radius_of_curvature_mm"]["min_convex"] == rmin
+        assert s["radius_of_curvature_mm"]["at_deg"] == math.degrees(xa)
+        ranges = positive_ranges(lambda x: -c.evaluate(x).rho, edges, closed=c.closed)
+        found = [f for f in rep.findings if f.code == "UNDERCUT"]
+        assert [(f.from_deg, f.to_deg, f.value) for f in found] == [
+            (math.degrees(lo), math.degrees(hi), -gw) for lo, hi, _, gw in ranges]
+    assert s["base_radius_mm"] == extremum(lambda x: c.radius(x)[0], edges)[1]
