@@ -264,10 +264,12 @@ class DiscRollerContact(Contact):
             tx, ty = c1x - sg * cy, c1y + sg * cx                       # T = σ·J·C + C′
             ax = c2x - cx - 2 * sg * c1y                                # A2 = −C + 2σ·J·C′ + C″
             ay = c2y - cy + 2 * sg * c1x
-            inv = 1.0 / np.hypot(tx, ty)
-            ux, uy = tx * inv, ty * inv                                 # unit tangent
-            kpc = np.multiply(sg * (tx * ay - ty * ax), inv * inv * inv, out=kp[a:b])  # pitch curvature
-            nx, ny = sg * uy, -sg * ux                                  # n = −σ·J·t
+            speed = np.sqrt(tx * tx + ty * ty)  # |T| is far from overflow: no need for hypot's care
+            inv = 1.0 / speed
+            # n = −σ·J·t = σ·(ty, −tx)/|T|, pitch curvature κp = σ·(T × A2)/|T|³
+            nx, ny = tx * (-sg * inv), ty * (sg * inv)
+            nx, ny = ty * (sg * inv), nx
+            kpc = np.multiply(sg * (tx * ay - ty * ax), inv * inv * inv, out=kp[a:b])
             scale = 1.0 - rr * kpc
             with np.errstate(divide="ignore", invalid="ignore"):
                 kc = np.divide(kpc, scale, out=k[a:b])
@@ -275,11 +277,18 @@ class DiscRollerContact(Contact):
                 np.divide(1.0, kpc, out=rho_p[a:b])
             np.arctan2(-sg * (vx * ny - vy * nx), vx * nx + vy * ny, out=delta[a:b])
             c, s = _cos_sin(sg * x[a:b])
-            _rot_into(point, a, b, cx - rr * nx, cy - rr * ny, c, s)
-            _rot_into(point_d1, a, b, tx * scale, ty * scale, c, s)
-            _rot_into(normal, a, b, nx, ny, c, s)
-            _rot_into(tangent, a, b, ux, uy, c, s)
             _rot_into(pitch, a, b, cx, cy, c, s)
+            _rot_into(normal, a, b, nx, ny, c, s)
+            # rotation commutes with J: the rotated tangent is σ·J·(rotated normal), the profile point is
+            # the rotated pitch point − Rr·(rotated normal), and P′ = T·(1 − Rr·κp) = t·|T|·(1 − Rr·κp)
+            nrx, nry = normal[0, a:b], normal[1, a:b]
+            np.multiply(nry, -sg, out=tangent[0, a:b])
+            np.multiply(nrx, sg, out=tangent[1, a:b])
+            np.subtract(pitch[0, a:b], rr * nrx, out=point[0, a:b])
+            np.subtract(pitch[1, a:b], rr * nry, out=point[1, a:b])
+            f = speed * scale
+            np.multiply(tangent[0, a:b], f, out=point_d1[0, a:b])
+            np.multiply(tangent[1, a:b], f, out=point_d1[1, a:b])
         return ProfileSample(x, point.T, point_d1.T, normal.T, tangent.T, k, rho, pitch.T, kp, rho_p, delta, None,
                              arm)
 

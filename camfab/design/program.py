@@ -603,10 +603,22 @@ def _critical_points(seg: Segment, nu: int, lo: float, hi: float) -> list[float]
             return []
         r = np.polynomial.polynomial.polyroots(np.trim_zeros(c, "b")) if len(np.trim_zeros(c, "b")) > 1 else []
         return [float(z.real) for z in np.atleast_1d(r) if abs(z.imag) < 1e-9 and lo < z.real < hi]
-    if seg.law == "dwell":
+    if seg.law == "dwell" or seg.lift == 0:
         # constant: every point is a (non-strict) extremum, but none comes before the piece's
         # start, which is a candidate already with the same value — the peaks are unchanged
         return []
+    # a standard law's critical points in u do not depend on its lift or span: found once per law
+    key = (seg.law, nu, float(lo), float(hi), seg.lift > 0)
+    if key not in _LAW_CRITICAL:
+        _LAW_CRITICAL[key] = tuple(_law_critical_points(seg, nu, lo, hi))
+    return list(_LAW_CRITICAL[key])
+
+
+#: critical points (u) of the standard laws, keyed by (law, order, piece bounds, sign of the lift)
+_LAW_CRITICAL: dict = {}
+
+
+def _law_critical_points(seg: Segment, nu: int, lo: float, hi: float) -> list[float]:
     from scipy.optimize import brentq
 
     coeffs = getattr(LAWS[seg.law].shape, "coeffs", None)
