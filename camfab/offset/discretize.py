@@ -242,6 +242,14 @@ class _Surrogate:
         c = self.coef[:, i]
         return c[1] + u * (2 * c[2] + 3 * u * c[3])
 
+    def second_derivative(self, t, piece: int) -> np.ndarray:
+        """``d²P/dt²`` of the surrogate inside smooth piece ``piece``."""
+        t = np.asarray(t, dtype=float)
+        i = self._index(t, piece)
+        u = (t - self.x[i])[..., None]
+        c = self.coef[:, i]
+        return 2 * c[2] + 6 * u * c[3]
+
     def as_curve(self) -> ParametricCurve:
         return ParametricCurve(self.point, self.curve.breakpoints, self.curve.period, self.derivative)
 
@@ -977,18 +985,33 @@ def _fit(curve: ParametricCurve, tol: float, kind: str, verify: Callable[[np.nda
 # --------------------------------------------------------------------------------------
 #: model samples per arc of the free arc spline, and Lawson (minimax) iterations of its start
 _SPLINE_SAMPLES = 16
+#: the free spline's model deviation aims at this fraction of tol (less the surrogate error)
+_SPLINE_FILL = 0.97
+#: fewest model samples of one span
+_SPLINE_MIN_GRID = 129
+#: the first arc count tried is this multiple of the asymptotic estimate
+_EST_FACTOR = 1.0
+#: one arc fewer is tried while the predicted error (∝ 1/m³) stays below this multiple of the target
+_DOWN_SLACK = 1.2
 _LAWSON_ITERS = 8
 #: Gauss-Newton rounds equalising the arc errors (knots and curvatures together)
 _EQUI_ITERS = 8
-#: most arcs of one smooth piece fitted as a free spline (longer pieces use interpolating biarcs)
-_SPLINE_SPAN = 32
+#: most arcs of one free span: a longer smooth piece is cut into spans joined G1 at (surrogate)
+#: curve points with the curve's tangent, which keeps every linear system small
+_SPLINE_SPAN = 40
+#: a span is only fitted up to this many arcs (else interpolating biarcs are used)
+_SPAN_MAX_ARCS = 64
 #: relative lengths of the two end arcs at each clamped end of a piece (an LP over C¹ patterns:
 #: a clamped end then costs about half an arc instead of tripling the error of uniform arcs)
-_END_ARCS = (0.55, 0.95)
+_END_ARCS = (0.6, 1.0)
+#: further end-arc ratios tried at the smallest failing arc count (the optimum is not monotone in it)
+_END_ARCS_ALT = ((0.7, 1.1),)
+#: refits of the spans where the measured chain exceeds tol
+_SPAN_REFITS = 4
 
 
-def _span_model(sur: _Surrogate, piece: int, lo: float, hi: float, n_grid: int):
-    """Arc length, tangent angle and normal of the surrogate on ``[lo, hi]`` (one smooth piece)."""
+def _span_model(sur: _Surrogate, piece: int, lo: float, hi: float, n_grid: int, curvature: bool = False):
+    """Arc length, tangent angle (and curvature) of the surrogate on ``[lo, hi]`` (one smooth piece)."""
     t = np.linspace(lo, hi, n_grid)
     tm = 0.5 * (t[:-1] + t[1:])
     d = sur.derivative(t, piece)
@@ -996,12 +1019,34 @@ def _span_model(sur: _Surrogate, piece: int, lo: float, hi: float, n_grid: int):
     sp, spm = np.hypot(d[:, 0], d[:, 1]), np.hypot(dm[:, 0], dm[:, 1])
     s = np.concatenate([[0.0], np.cumsum(np.diff(t) / 6.0 * (sp[:-1] + 4 * spm + sp[1:]))])
     theta = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
-    return t, s, theta
+    if not curvature:
+        return t, s, theta
+    kappa = _cross(d, sur.second_derivative(t, piece)) / np.maximum(sp, 1e-300) ** 3
+    return t, s, theta, kappa
 
 
 def _cumtrapz(f: np.ndarray, s: np.ndarray) -> np.ndarray:
     ds = np.diff(s).reshape((-1,) + (1,) * (f.ndim - 1))
     return np.concatenate([np.zeros((1,) + f.shape[1:]), np.cumsum(0.5 * ds * (f[1:] + f[:-1]), axis=0)])
+
+
+def _cumhermite(f: np.ndarray, fp: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Cumulative integral of ``f`` (derivative ``fp``) on the grid ``s``: exact for piecewise cubics."""
+    ds = np.diff(s).reshape((-1,) + (1,) * (f.ndim - 1))
+    inc = 0.5 * ds * (f[1:] + f[:-1]) + ds * ds / 12.0 * (fp[:-1] - fp[1:])
+    return np.concatenate([np.zeros((1,) + f.shape[1:]), np.cumsum(inc, axis=0)])
+
+
+def _hermite_at(x: np.ndarray, s: np.ndarray, F: np.ndarray, f: np.ndarray, fp: np.ndarray) -> np.ndarray:
+    """``F(x) = ∫₀ˣ f`` between grid points: integral of the cubic Hermite interpolant of ``f``."""
+    i = np.clip(np.searchsorted(s, x, side="right") - 1, 0, s.size - 2)
+    h = s[i + 1] - s[i]
+    tau = np.clip((x - s[i]) / np.where(h > 0, h, 1.0), 0.0, 1.0)
+    t2, t3, t4 = tau * tau, tau ** 3, tau ** 4
+    w = (h * (tau - t3 + 0.5 * t4), h * h * (0.25 * t4 - 2.0 * t3 / 3.0 + 0.5 * t2),
+         h * (t3 - 0.5 * t4), h * h * (0.25 * t4 - t3 / 3.0))
+    return (F[i] + w[0][:, None] * f[i] + w[1][:, None] * fp[i] + w[2][:, None] * f[i + 1]
+            + w[3][:, None] * fp[i + 1])
 
 
 def _lawson(A: np.ndarray, b: np.ndarray, C: np.ndarray, dvec: np.ndarray, iters: int = _LAWSON_ITERS):
@@ -1047,29 +1092,48 @@ class _SpanModel:
     """
 
     def __init__(self, sur: _Surrogate, piece: int, lo: float, hi: float, n_grid: int):
-        _, s, theta = _span_model(sur, piece, lo, hi, n_grid)
+        _, s, theta, kappa = _span_model(sur, piece, lo, hi, n_grid, curvature=True)
         self.s, self.theta, self.L = s, theta, float(s[-1])
-        self.nrm = np.stack([-np.sin(theta), np.cos(theta)], axis=-1)
-        self.N = _cumtrapz(self.nrm, s)                                  # ∫ n ds
-        self.Dt = _cumtrapz((theta[0] - theta)[:, None] * self.nrm, s)   # (n, 2)
-        self.b = _dot(self.Dt, self.nrm)
-        self.M = _cumtrapz(s[:, None] * self.nrm, s)                     # ∫ s·n ds
-        self.nN, self.nM = _dot(self.nrm, self.N), _dot(self.nrm, self.M)
+        # every prefix integral is the exact integral of the cubic Hermite interpolant of its
+        # integrand (values and derivatives at the grid): knots fall between grid points, and
+        # linear interpolation there would cost O(h²·κ) -- of the order of tol at fine tolerances
+        tng = np.stack([np.cos(theta), np.sin(theta)], axis=-1)
+        nrm = np.stack([-np.sin(theta), np.cos(theta)], axis=-1)
+        dn = -kappa[:, None] * tng                                       # d n / ds
+        dth = (theta[0] - theta)[:, None]
+        self.nrm = nrm
+        self.n_fp = (nrm, dn)
+        self.m_fp = (s[:, None] * nrm, nrm + s[:, None] * dn)
+        self.N = _cumhermite(nrm, dn, s)                                 # ∫ n ds
+        self.Dt = _cumhermite(dth * nrm, -kappa[:, None] * nrm + dth * dn, s)
+        self.b = _dot(self.Dt, nrm)
+        self.M = _cumhermite(*self.m_fp, s)                              # ∫ s·n ds
+        self.nN, self.nM = _dot(nrm, self.N), _dot(nrm, self.M)
+        self._nm = (np.hstack([self.N, self.M]), np.hstack([nrm, self.m_fp[0]]), np.hstack([dn, self.m_fp[1]]))
+        self._last = (None, None)
+
+    def NM_at(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(N(x), M(x))`` between grid points (the last query is cached)."""
+        key = x.tobytes()
+        if self._last[0] != key:
+            v = _hermite_at(x, self.s, *self._nm)
+            self._last = (key, (v[:, :2], v[:, 2:]))
+        return self._last[1]
 
     def system(self, knots: np.ndarray):
         """``(A, C, d)`` of the knots: ``e = A k + b`` on the grid, ``C k = d`` closes the span."""
         ell = np.diff(knots)
         s, nrm = self.s, self.nrm
-        # V_j(s) = ∫ clip(s' - x_j, 0, ℓ_j)·n ds' from the prefix integrals N = ∫ n, M = ∫ s'·n
-        Nx = np.stack([np.interp(knots, s, self.N[:, 0]), np.interp(knots, s, self.N[:, 1])], axis=-1)
-        Mx = np.stack([np.interp(knots, s, self.M[:, 0]), np.interp(knots, s, self.M[:, 1])], axis=-1)
-        nNx, nMx = nrm @ Nx.T, nrm @ Mx.T                                   # (n, m + 1)
-        x0, x1 = knots[None, :-1], knots[None, 1:]
-        inside = (s[:, None] >= x0) & (s[:, None] <= x1)
-        after = s[:, None] > x1
-        nMu = np.where(inside, self.nM[:, None], np.where(after, nMx[:, 1:], nMx[:, :-1]))
-        nNu = np.where(inside, self.nN[:, None], np.where(after, nNx[:, 1:], nNx[:, :-1]))
-        A = (nMu - nMx[:, :-1]) - x0 * (nNu - nNx[:, :-1]) + np.where(after, ell * (self.nN[:, None] - nNx[:, 1:]), 0.0)
+        # V_j(s) = ∫ clip(s' - x_j, 0, ℓ_j)·n ds' from the prefix integrals N = ∫ n, M = ∫ s'·n:
+        # after arc j (s > x_{j+1}) n·V_j = n·W_j + ℓ_j·n·N(s), W_j = [M - x·N] from x_j to x_{j+1};
+        # inside it n·V_j = n·M(s) - x_j·n·N(s) - n·(M(x_j) - x_j·N(x_j)); before it 0
+        Nx, Mx = self.NM_at(knots)
+        G = Mx - knots[:, None] * Nx                                        # (m + 1, 2)
+        m = ell.size
+        A = nrm @ (G[1:] - G[:-1]).T + self.nN[:, None] * ell[None, :]
+        jj = np.clip(np.searchsorted(knots, s, side="right") - 1, 0, m - 1)
+        A[np.arange(m)[None, :] >= jj[:, None]] = 0.0
+        A[np.arange(s.size), jj] = self.nM - knots[jj] * self.nN - _dot(nrm, G[jj])
         Dk_end = (Mx[1:] - Mx[:-1]) - knots[:-1, None] * (Nx[1:] - Nx[:-1]) + ell[:, None] * (self.N[-1] - Nx[1:])
         scale = self.L / ell.size
         C = np.vstack([ell * scale, Dk_end.T])
@@ -1082,10 +1146,10 @@ class _SpanModel:
         Moving knot ``x_j`` by ``δ`` turns every later tangent by ``(k_{j-1} - k_j)·δ``.
         """
         xi = knots[1:-1]
-        Nx = np.stack([np.interp(xi, self.s, self.N[:, 0]), np.interp(xi, self.s, self.N[:, 1])], axis=-1)
+        Nx = self.NM_at(knots)[0][1:-1]
         jump = k[:-1] - k[1:]
-        W = (self.N[:, None, :] - Nx[None]) * (self.s[:, None] > xi[None, :])[..., None]
-        B = np.einsum("nji,ni->nj", W, self.nrm) * jump
+        B = (self.nN[:, None] - self.nrm @ Nx.T) * jump
+        B[self.s[:, None] <= xi[None, :]] = 0.0
         Bc = np.vstack([jump * (self.L / k.size), ((self.N[-1][None] - Nx) * jump[:, None]).T])
         return B, Bc
 
@@ -1165,14 +1229,14 @@ def _peak(e: np.ndarray) -> float:
     return float(max(ae.max(), (b + np.minimum(lift, b)).max() if j.size else 0.0))
 
 
-def _place_knots(s, density, m):
-    """``m`` arcs equidistributing ``density``, the two end arcs at each end shortened (:data:`_END_ARCS`)."""
+def _place_knots(s, density, m, ends=_END_ARCS):
+    """``m`` arcs equidistributing ``density``, the two end arcs at each end shortened (``ends``)."""
     w = np.ones(m)
     if m >= 4:
-        w[0] = w[-1] = _END_ARCS[0]
-        w[1] = w[-2] = _END_ARCS[1]
+        w[0] = w[-1] = ends[0]
+        w[1] = w[-2] = ends[1]
     elif m >= 2:
-        w[0] = w[-1] = _END_ARCS[0] if m == 3 else 1.0
+        w[0] = w[-1] = ends[0] if m == 3 else 1.0
     q = np.concatenate([[0.0], np.cumsum(w)]) / w.sum()
     cum = _cumtrapz(density, s)
     if not (cum[-1] > 0):
@@ -1183,43 +1247,76 @@ def _place_knots(s, density, m):
     return knots
 
 
+def _span_density(sur: _Surrogate, piece: int, lo: float, hi: float, target: float):
+    """``(t, s, density)``: arcs per unit length, ``(|κ'| / (124.7·target))^(1/3)`` (+ a turning bound)."""
+    t, s0, theta = _span_model(sur, piece, lo, hi, 257)
+    kappa = np.gradient(theta, s0)
+    dk = np.abs(np.gradient(kappa, s0))
+    return t, s0, (dk / (124.7 * target)) ** (1.0 / 3.0) + np.abs(kappa) / MAX_TURNING_RAD
+
+
 def _fit_span(sur: _Surrogate, piece: int, lo: float, hi: float, target: float):
-    """Fewest arcs (model) for the clamped span ``[lo, hi]``: ``(knots, k, theta0)`` or None.
+    """Fewest arcs (model) for the clamped span ``[lo, hi]``: ``(knots, k, theta0, error)`` or None.
 
     The arc count starts from the asymptotic estimate ``∫ (|κ'| / (124.7·target))^(1/3) ds``;
     every count gets knots equidistributing that density (end arcs shortened),
     then knots and curvatures are optimised together (:func:`_equioscillate`);
     the count goes down while the span still fits ``target`` and up until it does.
+    The optimum is not monotone in the count: at the smallest failing count other
+    end-arc ratios (:data:`_END_ARCS_ALT`) are tried when it failed narrowly.
     """
-    t, s0, theta = _span_model(sur, piece, lo, hi, 257)
-    kappa = np.gradient(theta, s0)
-    dk = np.abs(np.gradient(kappa, s0))
-    density = (dk / (124.7 * target)) ** (1.0 / 3.0) + np.abs(kappa) / MAX_TURNING_RAD
+    _, s0, density = _span_density(sur, piece, lo, hi, target)
     est = float(_cumtrapz(density, s0)[-1])
-    m = max(2, math.ceil(1.08 * est) + 1)
+    m = max(2, math.ceil(_EST_FACTOR * est))
     best = None
     tried: dict = {}
+    models: dict = {}
+
+    def attempt(m, ends=_END_ARCS, knots=None):
+        if m not in models:
+            models[m] = _SpanModel(sur, piece, lo, hi, max(_SPLINE_MIN_GRID, _SPLINE_SAMPLES * m + 1))
+        model = models[m]
+        if knots is None:
+            knots = _place_knots(model.s, np.interp(model.s, s0, density), m, ends)
+        err, knots, k = _equioscillate(model, knots)
+        ok = err <= target and np.all(np.abs(k * np.diff(knots)) < MAX_TURNING_RAD * 1.5)
+        return err, ok, (knots, k, model.theta[0], err)
+
     for _ in range(12):
         if m in tried:
             break
-        if m > _SPLINE_SPAN:
+        if m > _SPAN_MAX_ARCS:
             return None
-        model = _SpanModel(sur, piece, lo, hi, max(257, _SPLINE_SAMPLES * m + 1))
-        knots = _place_knots(model.s, np.interp(model.s, s0, density), m)
-        err, knots, k = _equioscillate(model, knots)
+        err, ok, fit = attempt(m)
         tried[m] = err
-        ok = err <= target and np.all(np.abs(k * np.diff(knots)) < MAX_TURNING_RAD * 1.5)
         if ok and (best is None or m < best[0].size - 1):
-            best = (knots, k, model.theta[0])
+            best = fit
         if ok:
             # one arc fewer raises the error by about (m / (m - 1))³: not worth trying beyond the target
-            if (m - 1) in tried or m <= 2 or err * (m / (m - 1)) ** 3 > target:
+            if (m - 1) in tried or m <= 2 or err * (m / (m - 1)) ** 3 > _DOWN_SLACK * target:
                 break
             m -= 1
         else:
             if best is not None and best[0].size - 1 == m + 1:
                 break
-            m = m + 1 if err < 1.6 * target else max(m + 1, math.ceil(m * (err / target) ** (1.0 / 3.0)))
+            jump = math.ceil(m * (err / target) ** (1.0 / 3.0)) - m  # (a single count may fail badly)
+            m = m + 1 if err < 1.6 * target else m + max(1, min(jump, math.ceil(0.1 * m) + 1))
+    if best is not None:
+        m = best[0].size - 2
+        if m >= 4 and m in tried and tried[m] <= 1.3 * target:
+            # warm start: the optimised knots of the fitting count less the joint of the smallest
+            # curvature jump (not an end arc), then other end-arc ratios
+            kb, kk = best[0], best[1]
+            jump = np.abs(np.diff(kk))[1:-1]
+            if jump.size:
+                j = 2 + int(np.argmin(jump))
+                err, ok, fit = attempt(m, knots=np.delete(kb, j))
+                if ok:
+                    return fit
+            for ends in _END_ARCS_ALT:
+                err, ok, fit = attempt(m, ends)
+                if ok:
+                    return fit
     return best
 
 
@@ -1267,47 +1364,90 @@ def _span_chain(p0, t0, p1, t1, theta0, knots, k):
     return S, TT2, K2, L2, S_next
 
 
-def _spline_chain(curve: ParametricCurve, sur: _Surrogate, target: float):
-    """A free G1 arc spline of the whole curve from the surrogate, or None."""
+def _spans(curve: ParametricCurve, sur: _Surrogate, target: float) -> list:
+    """``(piece, lo, hi)`` of every free span: each smooth piece, long ones cut into equal shares of arcs."""
     bp = curve.breakpoints
-    parts = []
-    pieces = []
+    out = []
     for p in range(bp.size - 1):
         lo, hi = float(bp[p]), float(bp[p + 1])
-        i0, i1 = sur.first[p], sur.first[p + 1]
-        p0 = sur.points[i0]
-        p1 = sur.points[i1] if i1 < sur.x.size - 1 else sur.points[0]
-        t0 = _unit(sur.coef[1, i0])
-        h = sur.x[i1] - sur.x[i1 - 1]
-        c = sur.coef[:, i1 - 1]
-        t1 = _unit(c[1] + h * (2 * c[2] + 3 * h * c[3]))
-        fit = _fit_span(sur, p, lo, hi, target)
-        if fit is None:
-            return None
-        knots, k, th0 = fit
-        ch = _span_chain(p0, t0, p1, t1, th0, knots, k)
-        if ch is None:
-            return None
-        parts.append(ch)
-        pieces.append(np.full(ch[0].shape[0], p))
-    cat = [np.concatenate([c[i] for c in parts]) for i in range(5)]
-    return Chain(*cat), np.concatenate(pieces)
+        t, s0, density = _span_density(sur, p, lo, hi, target)
+        cum = _cumtrapz(density, s0)
+        n = max(1, math.ceil(1.08 * float(cum[-1]) / _SPLINE_SPAN))
+        cuts = np.interp(cum[-1] * np.arange(n + 1) / n, cum, t) if n > 1 else np.array([lo, hi])
+        cuts[0], cuts[-1] = lo, hi
+        out += [(p, float(cuts[i]), float(cuts[i + 1])) for i in range(n)]
+    return out
+
+
+def _span_ends(sur: _Surrogate, piece: int, lo: float, hi: float):
+    """Points and unit tangents at both ends of a span: the exact samples at breakpoints."""
+    i0, i1 = sur.first[piece], sur.first[piece + 1]
+    ends = []
+    for t, i in ((lo, i0), (hi, i1)):
+        if t == sur.x[i]:
+            pt = sur.points[i] if i < sur.x.size - 1 else sur.points[0]
+        else:
+            pt = sur.point(np.array([t]), piece)[0]
+        ends.append((pt, _unit(sur.derivative(np.array([t]), piece)[0])))
+    return ends[0][0], ends[0][1], ends[1][0], ends[1][1]
+
+
+def _fit_span_chain(sur: _Surrogate, span, target: float):
+    """The exact G1 arcs of one span fitted to ``target`` and the model error, or None."""
+    piece, lo, hi = span
+    fit = _fit_span(sur, piece, lo, hi, target)
+    if fit is None:
+        return None
+    knots, k, th0, err = fit
+    p0, t0, p1, t1 = _span_ends(sur, piece, lo, hi)
+    chain = _span_chain(p0, t0, p1, t1, th0, knots, k)
+    return None if chain is None else (chain, err)
 
 
 def _fit_spline(curve: ParametricCurve, sur: tuple, tol: float):
-    """The free arc spline within ``tol`` (measured on the exact curve), or None."""
-    target = 0.84 * tol * (1.0 - MARGIN) - sur[1]  # the model is close, not exact: keep a reserve
-    for _ in range(3):
-        with np.errstate(invalid="ignore", divide="ignore"):
-            fit = _spline_chain(curve, sur[0], target)
-        if fit is None:
-            return None
-        chain, pieces = fit
-        merged = _merge_cocircular(chain, pieces)
-        measured = measure_deviation(merged, curve).max
-        if measured <= tol:
-            return merged, measured
-        target *= 0.9 * tol / measured
+    """The free arc spline within ``tol`` (measured on the exact curve), or None.
+
+    Spans are independent (their ends are fixed points with fixed tangents), so
+    when the measured chain exceeds ``tol`` only the span where the maximum
+    occurs is refitted, to a target lowered by the measured excess.
+    """
+    sur, sur_err = sur
+    target = _SPLINE_FILL * tol - sur_err
+    if not (target > 0):
+        return None
+    spans = _spans(curve, sur, target)
+    targets = [target] * len(spans)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        fits = [_fit_span_chain(sur, sp, target) for sp in spans]
+    if any(f is None for f in fits):
+        return None
+    parts, errs = [f[0] for f in fits], [f[1] for f in fits]
+    owner = np.array([sp[0] for sp in spans])
+    for _ in range(_SPAN_REFITS + 1):
+        cat = [np.concatenate([c[i] for c in parts]) for i in range(5)]
+        pieces = np.concatenate([np.full(c[0].shape[0], owner[j]) for j, c in enumerate(parts)])
+        merged = _merge_cocircular(Chain(*cat), pieces)
+        dev = measure_deviation(merged, curve)
+        if dev.max <= tol:
+            return merged, dev.max
+        # refit only the offending spans: the one holding the worst deviation and every span
+        # whose exact curve samples (16 per arc) lie farther than tol from the chain
+        counts = [c[0].shape[0] for c in parts]
+        t = np.concatenate([np.linspace(lo, hi, 16 * n + 1)[:-1] for (_, lo, hi), n in zip(spans, counts)])
+        d, _ = merged.distance(_points(curve, t))
+        worst = np.maximum.reduceat(d, np.concatenate([[0], np.cumsum(16 * np.array(counts))[:-1]]))
+        at = float(dev.at_param)
+        j = next((i for i, sp in enumerate(spans) if sp[1] <= at <= sp[2]), None)
+        if j is not None:
+            worst[j] = max(worst[j], dev.max)
+        for j in np.flatnonzero(worst > 0.99 * tol):
+            # the measured / model ratio of this span scales its next target
+            targets[j] = min(0.98 * targets[j], 0.97 * tol * errs[j] / worst[j])
+            with np.errstate(invalid="ignore", divide="ignore"):
+                fit = _fit_span_chain(sur, spans[j], targets[j])
+            if fit is None:
+                return None
+            parts[j], errs[j] = fit
     return None
 
 
@@ -1452,13 +1592,17 @@ def arcs(curve: ParametricCurve, *, tol: float = DEFAULT_EXPORT_TOL_MM) -> ArcDi
 
     First, a *free* (non-interpolating) G1 arc spline is tried: per smooth
     piece, clamped to the exact point and one-sided tangent at both
-    breakpoints, the arc curvatures minimise (Lawson minimax on a linear model
-    of the normal deviation) the deviation inside the ±tol band, knots are
-    re-spread by the per-arc error and the fewest arcs kept; the last two arcs
-    of a piece are the biarc closing it exactly.  It is used when it measures
-    within ``tol`` (else the interpolating biarcs above).  All fitting runs on
-    a Hermite surrogate of a few batched exact samples; only the
-    verification calls the exact curve again.
+    breakpoints (long pieces are cut into spans of about
+    :data:`_SPLINE_SPAN` arcs, joined G1 on the curve with its tangent),
+    knots and curvatures are optimised together on a linear model of the
+    normal deviation (its prefix integrals exact for cubic Hermite data, so
+    the model matches the built chain to a fraction of a percent) and the
+    fewest arcs kept; the last two arcs of a span are the biarc closing it
+    exactly.  The chain is measured on the exact curve; should it exceed
+    ``tol``, only the offending spans are refitted to a lower target.  It is
+    used when it measures within ``tol`` (else the interpolating biarcs
+    above).  All fitting runs on a Hermite surrogate of a few batched exact
+    samples; only the verification calls the exact curve again.
     """
     tol = validate_tol(tol)
     _check_closed(curve, tol)
