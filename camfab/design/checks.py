@@ -601,7 +601,7 @@ def _positive_ranges_multi(edges, closed: bool, k: int, ext=()):
         lo, hi, f0 = grid[il], grid[ih], v[i]
         tol = np.maximum(1e-9 * (hi - lo), 16 * np.finfo(float).eps * np.maximum(1.0, np.abs(hi)))
         mrows.append((lo, _neg(v[il]), grid[i], _neg(f0), hi, _neg(v[ih]), tol, np.full(ok.size, j)))
-        info.append((ok, lo, hi, f0))
+        info.append((ok, lo, hi, f0, v[il], v[ih]))
     rootss: list[dict] = [{} for _ in range(k)]
     A, FA, B, FB, Jb = (np.concatenate(t) for t in (A, FA, B, FB, Jb))
     ecols = plan.prepare(Vall, poff) if ext else None
@@ -610,8 +610,59 @@ def _positive_ranges_multi(edges, closed: bool, k: int, ext=()):
     mcols = [np.concatenate([r[q] for r in mrows]) for q in range(8)] if mrows else None
     vrow = np.r_[np.arange(k), plan.row].astype(np.intp)
     sgn = np.r_[np.full(k, -1.0), plan.sgn]
-    mres, rr = yield from _channel_solvers(nrows, (mcols, vrow, sgn) if mrows else None,
-                                           (A, FA, B, FB, Jb, vrow) if A.size else None)
+    # the maxima and the roots as two solvers in lockstep (each problem's steps are its own, so
+    # the results are those of one solver); once the roots are in, the worst-value searches of
+    # the ranges they give start alongside the maxima still being refined — speculatively: a
+    # refined maximum changes the ranges only when it adds sign changes, and then (checked
+    # below, the ranges recomputed with it) those searches are dropped and run again
+    live: dict = {}
+    if mrows:
+        live["m"] = _channel_solvers(nrows, (mcols, vrow, sgn), None)
+    if A.size:
+        live["r"] = _channel_solvers(nrows, None, (A, FA, B, FB, Jb, vrow))
+    res: dict = {"m": (None, None), "r": (None, None)}
+    req: dict = {}
+    for name in list(live):
+        try:
+            req[name] = np.asarray(next(live[name]), dtype=float).ravel()
+        except StopIteration as stop:
+            res[name] = stop.value
+            del live[name]
+    spec = None  # [specs, spans, generator, result, pending request]
+    nofill: tuple = ([None] * k, [None] * k)
+    while "m" in live or "r" in live:
+        if spec is None and "r" not in live:
+            if res["r"][1] is not None:
+                for a, b, x, j in zip(A.tolist(), B.tolist(), res["r"][1].tolist(), Jb.tolist()):
+                    rootss[j][(a, b)] = x
+            s0, p0 = _range_specs(k, edges, closed, step, ivs, grid, starts, sizes, inner, V, nofill, rootss)
+            spec = [s0, p0, None, [], None]
+            if s0:
+                spec[2], spec[3] = _extrema_steps(s0, nrows=nrows), None
+                try:
+                    req["s"] = np.asarray(next(spec[2]), dtype=float).ravel()
+                    live["s"] = spec[2]
+                except StopIteration as stop:
+                    spec[3] = stop.value
+        names = list(req)
+        parts = [req[n] for n in names]
+        Vr = np.asarray((yield np.concatenate(parts) if len(parts) > 1 else parts[0]), dtype=float)
+        Vr = Vr.reshape(nrows, -1)
+        off = 0
+        for n in names:
+            sz = req[n].size
+            try:
+                req[n] = np.asarray(live[n].send(Vr[:, off:off + sz]), dtype=float).ravel()
+            except StopIteration as stop:
+                del req[n], live[n]
+                if n == "s":
+                    spec[3] = stop.value
+                else:
+                    res[n] = stop.value
+            off += sz
+    if spec is not None and "s" in req:
+        spec[4] = req["s"]
+    mres, rr = res["m"][0], res["r"][1]
     if A.size:
         for a, b, x, j in zip(A.tolist(), B.tolist(), rr.tolist(), Jb.tolist()):
             rootss[j][(a, b)] = x
@@ -623,10 +674,15 @@ def _positive_ranges_multi(edges, closed: bool, k: int, ext=()):
     for j in range(k):
         if info[j] is None:
             continue
-        ok, lo, hi, f0 = info[j]
+        ok, lo, hi, f0, vl, vh = info[j]
         m = mcols[7] == j
         rx, rf = mres[0][m], mres[1][m]
-        for q in np.flatnonzero((-rf > f0) & (lo < rx) & (rx < hi)):
+        # a maximum is inserted only where it can change the sign changes: when its sign differs
+        # from that of a sample beside it (else the sign-change pairs, so the roots and the
+        # ranges, are those of the samples alone)
+        p = -rf > 0
+        matters = (p != (f0 > 0)) | (p != (vl > 0)) | (p != (vh > 0))
+        for q in np.flatnonzero((-rf > f0) & (lo < rx) & (rx < hi) & matters):
             mm = ok[q]
             if xs_ls[j] is None:
                 xs_ls[j] = {}
@@ -642,10 +698,49 @@ def _positive_ranges_multi(edges, closed: bool, k: int, ext=()):
                 if (xs[r], xs[r + 1]) not in rootss[j]:
                     A.append(xs[r]), FA.append(vv[r]), B.append(xs[r + 1]), FB.append(vv[r + 1]), Jb.append(j)
     if A:
+        if spec is not None and spec[2] is not None:  # new roots: the ranges may change
+            spec[2].close()
+            spec = None
         A, B, Jb = np.array(A), np.array(B), np.array(Jb, dtype=np.intp)
         _, rr = yield from _channel_solvers(nrows, None, (A, np.array(FA), B, np.array(FB), Jb, vrow))
         for a, b, x, j in zip(A.tolist(), B.tolist(), rr.tolist(), Jb.tolist()):
             rootss[j][(a, b)] = x
+    if spec is not None and not any(xs_ls):
+        specs, spans_l = spec[0], spec[1]  # the same samples and roots: the same ranges
+    else:
+        specs, spans_l = _range_specs(k, edges, closed, step, ivs, grid, starts, sizes, inner, V, (xs_ls, v_ls),
+                                      rootss)
+    if spec is not None and (specs is spec[0] or _same_specs(spec[0], spec[1], specs, spans_l)):
+        # the speculative searches were of exactly these ranges: their results
+        if spec[3] is None:
+            g2, x = spec[2], spec[4]
+            try:
+                while True:
+                    x = np.asarray(g2.send((yield x)), dtype=float).ravel()
+            except StopIteration as stop:
+                spec[3] = stop.value
+        found = spec[3]
+    else:
+        if spec is not None and spec[2] is not None:
+            spec[2].close()
+        found = (yield from _extrema_steps(specs, nrows=nrows)) if specs else []
+    out = []
+    for spans in spans_l:
+        res = []
+        for lo, hi, q, m in spans:
+            xw, gw = max(found[q:q + m], key=lambda t: t[1])
+            res.append((float(lo), float(hi), float(xw), float(gw)))
+        out.append(res)
+    return out + ext_out
+
+
+def _range_specs(k, edges, closed, step, ivs, grid, starts, sizes, inner, V, xs_ls, rootss):
+    """The ranges of :func:`_positive_ranges_multi` from the samples (with the inserted maxima
+    ``xs_ls``/``v_ls`` where any) and the refined roots: the worst-value searches (specs of
+    :func:`~.profile._extrema_steps`) and the spans ``(lo, hi, first search, searches)`` per function."""
+    xs_ls, v_ls = xs_ls
+    per0, per1 = edges[0], edges[-1]
+    nint = len(ivs)
     specs, spans_l = [], []
     tol = 1e-9 * max(per1 - per0, 1.0)
     for j in range(k):
@@ -696,15 +791,12 @@ def _positive_ranges_multi(edges, closed: bool, k: int, ext=()):
             spans.append((lo, hi, len(specs), len(subs)))
             specs += [(sub, True, step, j) for sub in subs]
         spans_l.append(spans)
-    found = (yield from _extrema_steps(specs, nrows=nrows)) if specs else []
-    out = []
-    for spans in spans_l:
-        res = []
-        for lo, hi, q, m in spans:
-            xw, gw = max(found[q:q + m], key=lambda t: t[1])
-            res.append((float(lo), float(hi), float(xw), float(gw)))
-        out.append(res)
-    return out + ext_out
+    return specs, spans_l
+
+
+def _same_specs(specs0, spans0, specs, spans) -> bool:
+    return spans0 == spans and len(specs0) == len(specs) and all(
+        a[3] == b[3] and a[2] == b[2] and np.array_equal(a[0], b[0]) for a, b in zip(specs0, specs))
 
 
 def _neg(y):

@@ -260,7 +260,8 @@ class DiscRollerContact(Contact):
                 arm = out[15]
                 arm[a:b] = xi
             # component arrays instead of (n, 2) column slices: this is the hot path
-            cx = cx + 0.0 * cy  # broadcast a scalar coordinate to the sample count
+            if not (isinstance(cx, np.ndarray) and cx.shape == cy.shape):
+                cx = cx + 0.0 * cy  # broadcast a scalar coordinate to the sample count
             tx, ty = c1x - sg * cy, c1y + sg * cx                       # T = σ·J·C + C′
             ax = c2x - cx - 2 * sg * c1y                                # A2 = −C + 2σ·J·C′ + C″
             ay = c2y - cy + 2 * sg * c1x
@@ -604,14 +605,13 @@ def _neighbours(P: np.ndarray, F: np.ndarray, j: np.ndarray):
     sample on each side (position, value), or the chosen sample itself where none."""
     r = np.arange(len(P))
     xj, fj = P[r, j], F[r, j]
-    left = P < xj[:, None]
-    li = np.argmax(np.where(left, P, -np.inf), axis=1)
-    hl = left.any(axis=1)
-    right = P > xj[:, None]
-    ri = np.argmin(np.where(right, P, np.inf), axis=1)
-    hr = right.any(axis=1)
-    return (np.where(hl, P[r, li], xj), np.where(hl, F[r, li], fj), xj, fj,
-            np.where(hr, P[r, ri], xj), np.where(hr, F[r, ri], fj))
+    xc = xj[:, None]
+    li = np.argmax(np.where(P < xc, P, -np.inf), axis=1)  # positions are finite
+    ri = np.argmin(np.where(P > xc, P, np.inf), axis=1)
+    pl, pr = P[r, li], P[r, ri]
+    hl, hr = pl < xj, pr > xj
+    return (np.where(hl, pl, xj), np.where(hl, F[r, li], fj), xj, fj,
+            np.where(hr, pr, xj), np.where(hr, F[r, ri], fj))
 
 
 def _bracket_min(a, fa, x, fx, b, fb, tol, *, rounds: int = 60):
@@ -691,12 +691,13 @@ def _bracket_root(a, fa, b, fb, *, xtol: float = 1e-14, rtol: float = 1e-15, rou
 def _candidates(grid: np.ndarray, starts: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Indices of local minima of v (NaN-free) within each interval of the concatenated grid
     (intervals start at ``starts``; the first and last sample of an interval compare one-sidedly)."""
-    first = np.zeros(v.size, dtype=bool)
-    first[starts] = True
-    last = np.roll(first, -1)
-    last[-1] = True
-    le_prev = np.r_[True, v[1:] <= v[:-1]] | first
-    le_next = np.r_[v[:-1] <= v[1:], True] | last
+    le_prev = np.empty(v.size, dtype=bool)
+    le_next = np.empty(v.size, dtype=bool)
+    np.less_equal(v[1:], v[:-1], out=le_prev[1:])
+    np.less_equal(v[:-1], v[1:], out=le_next[:-1])
+    le_prev[starts] = True  # the first sample of an interval (and of the grid)
+    le_next[starts[1:] - 1] = True  # the last one
+    le_next[-1] = True
     return np.flatnonzero(le_prev & le_next)
 
 
@@ -753,24 +754,47 @@ def _trials_multi(u, a, b, tol, bt, nb: int) -> np.ndarray:
     beyond its batch's ladder length being repeats of the estimate u."""
     w = b - a
     ratio = w / np.maximum(tol, 1e-300)
-    if nb == 1:
-        rmax = np.array([np.max(ratio)])
-    else:
-        rmax = np.full(nb, -np.inf)
-        np.maximum.at(rmax, bt, ratio)
+    n = u.size
     lad = -math.log(_LADDER)
-    Jb = np.array([int(min(max(math.ceil(math.log(max(r, 1.0)) / lad), 1), 8)) if r > -math.inf else 1
-                   for r in rmax.tolist()], dtype=np.intp)
-    Jr = Jb[bt]
-    jm = int(Jr.max())
-    steps = w[:, None] * _LADDER ** np.arange(1, jm + 1)[None, :]
-    if int(Jr.min()) < jm:
-        steps[np.arange(1, jm + 1)[None, :] > Jr[:, None]] = 0.0  # u ± 0 = u: a repeat
-    pts = np.concatenate([u[:, None], u[:, None] - steps, u[:, None] + steps,
-                          a[:, None] + w[:, None] * _QUARTERS[None, :]], axis=1)
-    return np.clip(pts, a[:, None], b[:, None])
+    if nb == 1 or n == 1:
+        r = float(np.max(ratio))
+        Jr = min(max(math.ceil(math.log(max(r, 1.0)) / lad), 1), 8)
+        jm = Jr = int(Jr)
+        steps = w[:, None] * _LADPOW[None, :jm]
+    else:
+        if n > 1 and bt[0] <= bt[-1] and not (bt[1:] < bt[:-1]).any():
+            # rows grouped by batch (the solvers' order): the largest ratio per group
+            cut = np.flatnonzero(bt[1:] != bt[:-1]) + 1
+            gmax = np.maximum.reduceat(ratio, np.r_[0, cut]) if cut.size else np.array([np.max(ratio)])
+            Jg = [int(min(max(math.ceil(math.log(max(r, 1.0)) / lad), 1), 8)) for r in gmax.tolist()]
+            jm = max(Jg)
+            Jr = np.repeat(np.array(Jg, dtype=np.intp), np.diff(np.r_[0, cut, n])) if min(Jg) < jm else None
+        else:
+            rmax = np.full(nb, -np.inf)
+            np.maximum.at(rmax, bt, ratio)
+            Jb = np.array([int(min(max(math.ceil(math.log(max(r, 1.0)) / lad), 1), 8)) if r > -math.inf else 1
+                           for r in rmax.tolist()], dtype=np.intp)
+            Jr = Jb[bt]
+            jm = int(Jr.max())
+            if int(Jr.min()) == jm:
+                Jr = None
+        steps = w[:, None] * _LADPOW[None, :jm]
+        if Jr is not None:
+            steps[_LADIDX[None, :jm] > Jr[:, None]] = 0.0  # u ± 0 = u: a repeat
+    pts = np.empty((n, 2 * jm + 4))
+    pts[:, 0] = u
+    uc = u[:, None]
+    np.subtract(uc, steps, out=pts[:, 1:jm + 1])
+    np.add(uc, steps, out=pts[:, jm + 1:2 * jm + 1])
+    np.add(a[:, None], w[:, None] * _QUARTERS[None, :], out=pts[:, 2 * jm + 1:])
+    # np.clip(pts, a, b) (every value is finite)
+    np.maximum(pts, a[:, None], out=pts)
+    return np.minimum(pts, b[:, None], out=pts)
 
 
+#: the ladder ratios r^j (j = 1…8) and their exponents
+_LADPOW = _LADDER ** np.arange(1, 9)
+_LADIDX = np.arange(1, 9)
 _QUARTERS = np.array([0.25, 0.5, 0.75])
 
 
@@ -850,7 +874,9 @@ class _ExtremaPlan:
         if ref.any():
             # the refined rows in the order prepare gave them
             act = np.asarray(self.act)
-            sel = np.flatnonzero(np.isin(owner, self.base + act))
+            mine = np.zeros(max(int(owner.max()), self.base + int(act.max())) + 1, dtype=bool)
+            mine[self.base + act] = True
+            sel = np.flatnonzero(mine[owner])
             fr = fr_all[sel]
             at[grp[ref], rank[ref], 1] = xr_all[sel]
             seq[grp[ref], rank[ref], 1] = np.where(np.isfinite(fr), fr, np.inf)

@@ -103,10 +103,36 @@ class Segment:
         """``nu``-th derivative of S with respect to ``x`` at local ``u``."""
         return self.du(u, nu) / self.span**nu
 
+    def value_at(self, u: float, nu: int) -> float:
+        """``values(np.array([u]), nu)[0]``, bit for bit, in Python floats (a standard law's
+        f⁽ᵛ⁾(u) is a constant of the law, taken once)."""
+        if self.coeffs is not None:  # Horner as horner(), operation for operation
+            c = self._dcoeffs[nu]
+            out = c[-1] + u * 0.0
+            for ci in c[-2::-1]:
+                out = ci + out * u
+        else:
+            out = self.lift * _law_value(self.law, u, nu)
+            if nu == 0:
+                out = out + self.s0
+        return out / self.span**nu
+
     def end_values(self, at_end: bool, n: int = 4) -> np.ndarray:
         """S, S′, S″, S‴ (per unit x) at the start (``at_end=False``) or end."""
-        u = np.array([1.0 if at_end else 0.0])
-        return np.array([self.values(u, k)[0] for k in range(n)])
+        u = 1.0 if at_end else 0.0
+        return np.array([self.value_at(u, k) for k in range(n)])
+
+
+#: f⁽ᵛ⁾(u) of the standard laws at single points, keyed by (law, u, ν): constants of the laws
+_LAW_VALUES: dict = {}
+
+
+def _law_value(law: str, u: float, nu: int) -> float:
+    key = (law, u, nu)
+    v = _LAW_VALUES.get(key)
+    if v is None:
+        v = _LAW_VALUES[key] = float(LAWS[law](np.array([u]), nu)[0])
+    return v
 
 
 def hermite_coefficients(
@@ -302,8 +328,8 @@ class MotionProgram:
             if internal:
                 for ub in seg.breaks:
                     lo, hi = np.nextafter(ub, -1.0), np.nextafter(ub, 2.0)
-                    left = np.array([seg.values(np.array([lo]), j)[0] for j in range(4)])
-                    right = np.array([seg.values(np.array([hi]), j)[0] for j in range(4)])
+                    left = np.array([seg.value_at(float(lo), j) for j in range(4)])
+                    right = np.array([seg.value_at(float(hi), j) for j in range(4)])
                     out.append(self._junction(seg.start + ub * seg.span, left, right, scale, tol, None))
         del n
         return sorted(out, key=lambda j: j.at)
@@ -652,13 +678,36 @@ def _law_critical_points(seg: Segment, nu: int, lo: float, hi: float) -> list[fl
 
 def _segment_candidates(seg: Segment, nu: int) -> tuple[np.ndarray, np.ndarray]:
     """Local coordinates u and values of every extremum candidate of S^(nu) in a segment."""
+    if seg.coeffs is None:
+        # a standard law's candidates u and f⁽ᵛ⁾ there depend only on the law and the sign of
+        # the lift: taken once; the values then as Segment.values computes them from f⁽ᵛ⁾
+        key = (seg.law, nu, (seg.lift > 0) - (seg.lift < 0))
+        hit = _LAW_CANDIDATES.get(key)
+        if hit is None:
+            u = _candidate_us(seg, nu)
+            f = LAWS[seg.law](u, nu)
+            u.setflags(write=False)
+            hit = _LAW_CANDIDATES[key] = (u, f)
+        u, f = hit
+        out = seg.lift * f
+        if nu == 0:
+            out = out + seg.s0
+        return u, out / seg.span**nu
+    u = _candidate_us(seg, nu)
+    return u, seg.values(u, nu)
+
+
+#: (u, f⁽ᵛ⁾(u)) of the extremum candidates of the standard laws, by (law, ν, sign of the lift)
+_LAW_CANDIDATES: dict = {}
+
+
+def _candidate_us(seg: Segment, nu: int) -> np.ndarray:
     us: list[float] = []
     for ua, ub in _pieces(seg):
         lo = np.nextafter(ua, 2.0) if ua > 0 else ua
         hi = np.nextafter(ub, -1.0) if ub < 1 else ub
         us += [lo, hi, *_critical_points(seg, nu, lo, hi)]
-    u = np.asarray(us)
-    return u, seg.values(u, nu)
+    return np.asarray(us, dtype=float)
 
 
 def _exact_peak(prog: MotionProgram, nu: int) -> Peak:

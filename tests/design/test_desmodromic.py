@@ -492,7 +492,11 @@ def _check_contact(g, k, x, h):
     speed = np.hypot(*d1.T)
     ok = (speed > 1e-3 * (1 + np.abs(s.point).max())) & (np.abs(s.rho) > 0.5)
     np.testing.assert_allclose(s.point_d1, d1, atol=1e-5 * (1 + np.abs(d1).max()))
-    assert np.all(np.abs((d1[ok] * s.normal[ok]).sum(1)) <= 1e-6 * speed.max())
+    # the central difference's own truncation error (h², estimated by Richardson from a 2h step) is allowed
+    # on top: near a small radius of curvature it exceeds the fixed bound (a hypothesis case: ρ = −1.14 mm)
+    d1_2h = (g.evaluate(x + 2 * h, k).point - g.evaluate(x - 2 * h, k).point) / (4 * h)
+    trunc = np.abs(((d1_2h - d1) * s.normal).sum(1)) / 3
+    assert np.all(np.abs((d1[ok] * s.normal[ok]).sum(1)) <= 1e-6 * speed.max() + 2 * trunc[ok])
     np.testing.assert_allclose(np.hypot(*s.normal.T), 1.0, atol=1e-13)
     np.testing.assert_allclose(s.tangent, c.sense * np.stack([-s.normal[:, 1], s.normal[:, 0]], 1), atol=1e-13)
     kfd = -(d2 * s.normal).sum(1) / speed**2

@@ -135,7 +135,9 @@ def test_exact_peaks_bound_dense_samples(rows):
         assert vals[k].max() <= pk.max + tol
         assert vals[k].min() >= pk.min - tol
         # dense samples come close to the exact extremes
-        slack = (x[1] - x[0]) * scale[k + 1] + tol
+        # (scale[k + 1] is itself a sampled maximum, which can fall short of the true one by
+        # O(its own grid step) — e.g. at a one-sided peak on a junction: allow 1 % for that)
+        slack = 1.01 * (x[1] - x[0]) * scale[k + 1] + tol
         assert pk.max - vals[k].max() <= slack
         assert vals[k].min() - pk.min <= slack
         # CAM-DAS 1° sampling never exceeds the exact extremes
