@@ -306,10 +306,51 @@ def _block(rows: int, n: int) -> np.ndarray:
     return np.empty((rows, n))
 
 
+# fdlibm's kernel polynomials for sin and cos on [−π/4, π/4] (k_sin.c, k_cos.c) and its two-part π/2
+_PIO2_1, _PIO2_1T = 1.57079632673412561417e+00, 6.07710050650619224932e-11
+_SIN_C = (1.58969099521155010221e-10, -2.50507602534068634195e-08, 2.75573137070700676789e-06,
+          -1.98412698298579493134e-04, 8.33333333332248946124e-03, -1.66666666666666324348e-01)
+_COS_C = (-1.13596475577881948265e-11, 2.08757232129817482790e-09, -2.75573143513906633035e-07,
+          2.48015872894767294178e-05, -1.38888888888741095749e-03, 4.16666666666666019037e-02)
+#: |x| below which the reduction x − k·π/2 is exact enough (k·_PIO2_1 exact for |k| < 2²⁰)
+_SINCOS_MAX = 1.0e5
+
+
 def _cos_sin(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(cos x, sin x)`` through one complex exponential (a single sincos per sample)."""
-    e = np.exp(x * 1j)
-    return e.real, e.imag
+    """``(cos x, sin x)`` to ~1 ulp, vectorised.
+
+    numpy's float64 sin/cos are scalar library calls on most builds, slower than these
+    ~40 elementwise operations: Cody–Waite reduction by π/2, fdlibm's minimax kernels,
+    quadrant selection.  Beyond ``_SINCOS_MAX`` (never a cam angle) a complex exponential.
+    """
+    x = np.asarray(x, dtype=float)
+    if x.size == 0 or not np.abs(x).max() < _SINCOS_MAX:  # also NaN / inf
+        e = np.exp(x * 1j)
+        return e.real, e.imag
+    k = np.rint(x * (2.0 / math.pi))
+    r = x - k * _PIO2_1
+    r -= k * _PIO2_1T
+    z = r * r
+    ps = _SIN_C[0] * z
+    for cf in _SIN_C[1:]:
+        ps += cf
+        ps *= z
+    ps *= r
+    sin_r = r + ps
+    pc = _COS_C[0] * z
+    for cf in _COS_C[1:]:
+        pc += cf
+        pc *= z
+    pc *= z
+    cos_r = 1.0 - 0.5 * z
+    cos_r += pc
+    q = k.astype(np.int64) & 3
+    odd = (q & 1).astype(bool)
+    c = np.where(odd, sin_r, cos_r)
+    s = np.where(odd, cos_r, sin_r)
+    c *= 1 - 2 * (((q + 1) >> 1) & 1)
+    s *= 1 - 2 * ((q >> 1) & 1)
+    return c, s
 
 
 def _rot_into(out: np.ndarray, a: int, b: int, x, y, c: np.ndarray, s: np.ndarray) -> None:
