@@ -1,7 +1,7 @@
 """Benchmark: accuracy versus run time of the CAD/CAM geometry for a real cam design.
 
-For tol in 1e-1 … 1e-6 mm on the built-in Ejemplo9RT (8 segments), IndexingPackaging and a typical
-12-segment roller cam (``typical_cam.py``, passes ``camfab check``): arc count and measured deviation of
+For tol in 1e-1 … 1e-6 mm on the built-in Ejemplo9RT (8 segments), IndexingPackaging, a typical
+12-segment roller cam (``typical_cam.py``, passes ``camfab check``) and the two reference cams: arc count and measured deviation of
 the profile, of the tool-centre path, and the wall time (best of ``--repeat``) of a whole arc-fitted DXF
 export (profile + pitch curve + circles + bore, written to bytes).
 
@@ -44,6 +44,10 @@ def _designs():
     from typical_cam import typical_geometry
 
     yield typical_geometry()
+    from typical_cam import REFERENCE, reference_geometry
+
+    for variant in REFERENCE:
+        yield reference_geometry(variant)
 
 
 def main(argv=None) -> None:

@@ -16,14 +16,15 @@ ROWS = [("cycloidal", 10, 30), ("dwell", 0, 30), ("poly345", -10, 30), ("dwell",
         ("poly345", 10, 30), ("dwell", 0, 30), ("poly4567", -10, 30), ("dwell", 0, 30)]
 
 
-def typical_spec(base_radius_mm: float = 60.0, roller_radius_mm: float = 10.0):
-    """The DesignSpec of the typical 12-segment roller cam."""
+def typical_spec(base_radius_mm: float = 60.0, roller_radius_mm: float = 10.0, lift_scale: float = 1.0,
+                 name: str = "typical12"):
+    """The DesignSpec of the typical 12-segment roller cam (lifts of ``ROWS`` times ``lift_scale``)."""
     return design_from_dict({
-        "name": "typical12",
+        "name": name,
         "cam": {"kind": "disc", "rotation": "cw", "omega_rad_s": 1.0},
         "follower": {"type": "roller", "motion": "translating", "base_radius_mm": base_radius_mm,
                      "roller_radius_mm": roller_radius_mm, "offset_mm": 0.0},
-        "motion": [{"law": law, "lift": float(h), "angle_deg": float(a)} for law, h, a in ROWS],
+        "motion": [{"law": law, "lift": float(h) * lift_scale, "angle_deg": float(a)} for law, h, a in ROWS],
         "manufacturing": {"thickness_mm": 10.0, "bore_mm": 20.0, "keyway": True, "tool_diameter_mm": 6.0,
                           "tolerance_mm": 0.001},
     })
@@ -32,4 +33,19 @@ def typical_spec(base_radius_mm: float = 60.0, roller_radius_mm: float = 10.0):
 def typical_geometry(**kw):
     """``(spec, CamGeometry)`` of the typical 12-segment roller cam."""
     spec = typical_spec(**kw)
+    return spec, geometry_from_spec(spec)
+
+
+#: the "reference" 12-segment roller cams of the issue's target ("a verified 1 µm profile with at most
+#: 72 arcs on a typical 12-segment roller cam (a uniform polyline needs ~720 vertices)"): the program
+#: of ``ROWS`` with scaled lifts, whose uniform-in-angle 1 µm polylines need 719 and 740 vertices (measured; ~720)
+REFERENCE = {
+    "rb40": dict(base_radius_mm=40.0, roller_radius_mm=8.0, lift_scale=0.5),
+    "rb50": dict(base_radius_mm=50.0, roller_radius_mm=8.0, lift_scale=0.4),
+}
+
+
+def reference_geometry(variant: str = "rb50"):
+    """``(spec, CamGeometry)`` of a reference cam of :data:`REFERENCE` (``"rb40"`` or ``"rb50"``)."""
+    spec = typical_spec(name=f"reference12_{variant}", **REFERENCE[variant])
     return spec, geometry_from_spec(spec)

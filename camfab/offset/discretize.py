@@ -19,7 +19,9 @@ maximisation of each distance) and refined until the measured worst deviation is
 below ``tol * (1 - margin)``; the result is then verified once more by the
 independent, global :func:`measure_deviation`.
 
-Every breakpoint is a vertex of the result, so no entity straddles a kink.
+Every breakpoint where the tangent jumps (a kink) is a vertex of the result, so no entity
+straddles a kink; polylines keep every breakpoint, arc chains may run across breakpoints where
+the curve is tangent continuous (the deviation is measured all the same).
 
 The geometry of a discretisation is a :class:`Chain`: entities given by start
 point, unit start tangent, signed curvature (0 for a line, > 0 for a
@@ -591,10 +593,12 @@ class ArcDiscretisation:
     Attributes
     ----------
     params : (m,) ndarray
-        Curve parameters (0 … ``period``) where the chain passes exactly through
-        ``P(params)``: every breakpoint is among them.  For a free arc spline
-        (see :func:`arcs`) they are the breakpoints only; for interpolating
-        biarcs every fitting node.
+        Curve parameters (0 … ``period``) where the chain passes through
+        ``P(params)`` with the curve's tangent (exactly at breakpoints, to the
+        surrogate's accuracy elsewhere).  For a free arc spline (see
+        :func:`arcs`) they are its span ends (every kink among them; G1
+        breakpoints may be crossed by arcs); for interpolating biarcs every
+        fitting node (every breakpoint).
     starts, ends : (n, 2) ndarray
         Entity end points; ``ends[i] == starts[i + 1]``.
     centres : (n, 2) ndarray
@@ -1008,21 +1012,43 @@ _END_ARCS = (0.6, 1.0)
 _END_ARCS_ALT = ((0.7, 1.1),)
 #: refits of the spans where the measured chain exceeds tol
 _SPAN_REFITS = 4
+#: relative lengths of the two end arcs at an end whose arc curvature is fixed (next to a dwell: the
+#: arc matches the curve to second order there, so it is kept shorter)
+_FIXED_END_ARCS = (0.35, 0.9)
+#: further fixed-end ratios tried at the smallest failing count (none: they rarely paid for their time)
+_FIXED_END_ARCS_ALT: tuple = ()
+#: a breakpoint whose one-sided tangents differ by less than this (radians) is G1 (arcs may run across it)
+_G1_RAD = 1e-6
 
 
-def _span_model(sur: _Surrogate, piece: int, lo: float, hi: float, n_grid: int, curvature: bool = False):
-    """Arc length, tangent angle (and curvature) of the surrogate on ``[lo, hi]`` (one smooth piece)."""
-    t = np.linspace(lo, hi, n_grid)
-    tm = 0.5 * (t[:-1] + t[1:])
-    d = sur.derivative(t, piece)
-    dm = sur.derivative(tm, piece)
-    sp, spm = np.hypot(d[:, 0], d[:, 1]), np.hypot(dm[:, 0], dm[:, 1])
-    s = np.concatenate([[0.0], np.cumsum(np.diff(t) / 6.0 * (sp[:-1] + 4 * spm + sp[1:]))])
-    theta = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
-    if not curvature:
-        return t, s, theta
-    kappa = _cross(d, sur.second_derivative(t, piece)) / np.maximum(sp, 1e-300) ** 3
-    return t, s, theta, kappa
+def _span_model(sur: _Surrogate, segs, n_grid: int, curvature: bool = False):
+    """Arc length, tangent angle (and curvature) of the surrogate along a span.
+
+    ``segs`` lists ``(piece, lo, hi)`` parameter ranges of consecutive smooth pieces joined G1; the
+    grid points are shared out by parameter length, every junction appearing twice (its one-sided
+    values: the curvature may jump there)."""
+    total = sum(hi - lo for _, lo, hi in segs)
+    ts, ss, ths, ks = [], [], [], []
+    s_off, th_off = 0.0, None
+    for piece, lo, hi in segs:
+        n = max(5, int(round(n_grid * (hi - lo) / total)) + 1) if len(segs) > 1 else n_grid
+        t = np.linspace(lo, hi, n)
+        tm = 0.5 * (t[:-1] + t[1:])
+        d = sur.derivative(t, piece)
+        dm = sur.derivative(tm, piece)
+        sp, spm = np.hypot(d[:, 0], d[:, 1]), np.hypot(dm[:, 0], dm[:, 1])
+        sv = s_off + np.concatenate([[0.0], np.cumsum(np.diff(t) / 6.0 * (sp[:-1] + 4 * spm + sp[1:]))])
+        theta = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
+        if th_off is not None:
+            theta = theta + TWO_PI * round((th_off - theta[0]) / TWO_PI)
+        ts.append(t)
+        ss.append(sv)
+        ths.append(theta)
+        if curvature:
+            ks.append(_cross(d, sur.second_derivative(t, piece)) / np.maximum(sp, 1e-300) ** 3)
+        s_off, th_off = float(sv[-1]), float(theta[-1])
+    out = (np.concatenate(ts), np.concatenate(ss), np.concatenate(ths))
+    return out + (np.concatenate(ks),) if curvature else out
 
 
 def _cumtrapz(f: np.ndarray, s: np.ndarray) -> np.ndarray:
@@ -1091,8 +1117,9 @@ class _SpanModel:
     point with its tangent (first order; the last two arcs are re-fitted exactly).
     """
 
-    def __init__(self, sur: _Surrogate, piece: int, lo: float, hi: float, n_grid: int):
-        _, s, theta, kappa = _span_model(sur, piece, lo, hi, n_grid, curvature=True)
+    def __init__(self, sur: _Surrogate, segs, n_grid: int, fixed=(None, None)):
+        _, s, theta, kappa = _span_model(sur, segs, n_grid, curvature=True)
+        self.fixed = fixed  # curvatures imposed on the first / last arc (None: free)
         self.s, self.theta, self.L = s, theta, float(s[-1])
         # every prefix integral is the exact integral of the cubic Hermite interpolant of its
         # integrand (values and derivatives at the grid): knots fall between grid points, and
@@ -1138,7 +1165,20 @@ class _SpanModel:
         scale = self.L / ell.size
         C = np.vstack([ell * scale, Dk_end.T])
         d = np.concatenate([[(self.theta[-1] - self.theta[0]) * scale], -self.Dt[-1]])
+        rows, vals = self._fixed_rows(m)
+        if rows.shape[0]:
+            C, d = np.vstack([C, rows]), np.concatenate([d, vals])
         return A, C, d
+
+    def _fixed_rows(self, m: int):
+        rows, vals = [], []
+        for j, kf in ((0, self.fixed[0]), (m - 1, self.fixed[1])):
+            if kf is not None:
+                r = np.zeros(m)
+                r[j] = self.L
+                rows.append(r)
+                vals.append(kf * self.L)
+        return np.array(rows).reshape(-1, m), np.array(vals)
 
     def knot_jacobian(self, knots: np.ndarray, k: np.ndarray):
         """Derivatives of ``e`` (grid) and of ``C k - d`` with respect to the interior knots.
@@ -1151,6 +1191,9 @@ class _SpanModel:
         B = (self.nN[:, None] - self.nrm @ Nx.T) * jump
         B[self.s[:, None] <= xi[None, :]] = 0.0
         Bc = np.vstack([jump * (self.L / k.size), ((self.N[-1][None] - Nx) * jump[:, None]).T])
+        n_fixed = self._fixed_rows(k.size)[0].shape[0]
+        if n_fixed:
+            Bc = np.vstack([Bc, np.zeros((n_fixed, xi.size))])
         return B, Bc
 
 
@@ -1229,14 +1272,16 @@ def _peak(e: np.ndarray) -> float:
     return float(max(ae.max(), (b + np.minimum(lift, b)).max() if j.size else 0.0))
 
 
-def _place_knots(s, density, m, ends=_END_ARCS):
-    """``m`` arcs equidistributing ``density``, the two end arcs at each end shortened (``ends``)."""
+def _place_knots(s, density, m, ends=_END_ARCS, ends_hi=None):
+    """``m`` arcs equidistributing ``density``, the two end arcs at each end scaled (``ends``, ``ends_hi``)."""
+    ends_hi = ends if ends_hi is None else ends_hi
     w = np.ones(m)
     if m >= 4:
-        w[0] = w[-1] = ends[0]
-        w[1] = w[-2] = ends[1]
+        w[0], w[1] = ends[0], ends[1]
+        w[-1], w[-2] = ends_hi[0], ends_hi[1]
     elif m >= 2:
-        w[0] = w[-1] = ends[0] if m == 3 else 1.0
+        if m == 3:
+            w[0], w[-1] = ends[0], ends_hi[0]
     q = np.concatenate([[0.0], np.cumsum(w)]) / w.sum()
     cum = _cumtrapz(density, s)
     if not (cum[-1] > 0):
@@ -1247,40 +1292,82 @@ def _place_knots(s, density, m, ends=_END_ARCS):
     return knots
 
 
-def _span_density(sur: _Surrogate, piece: int, lo: float, hi: float, target: float):
-    """``(t, s, density)``: arcs per unit length, ``(|κ'| / (124.7·target))^(1/3)`` (+ a turning bound)."""
-    t, s0, theta = _span_model(sur, piece, lo, hi, 257)
-    kappa = np.gradient(theta, s0)
-    dk = np.abs(np.gradient(kappa, s0))
-    return t, s0, (dk / (124.7 * target)) ** (1.0 / 3.0) + np.abs(kappa) / MAX_TURNING_RAD
+def _span_density(sur: _Surrogate, segs, target: float, n: int = 257):
+    """``(t, s, density)``: arcs per unit length, ``(|κ'| / (124.7·target))^(1/3)`` (+ a turning bound).
+
+    ``t`` holds the parameters of the grid and ``piece`` (4th value) their pieces."""
+    total = sum(hi - lo for _, lo, hi in segs)
+    ts, ss, ds, ps = [], [], [], []
+    s_off = 0.0
+    for seg in segs:
+        k = max(33, int(round(n * (seg[2] - seg[1]) / total))) if len(segs) > 1 else n
+        t, s0, theta = _span_model(sur, [seg], k)
+        kappa = np.gradient(theta, s0)
+        dk = np.abs(np.gradient(kappa, s0))
+        ts.append(t)
+        ss.append(s0 + s_off)
+        ds.append((dk / (124.7 * target)) ** (1.0 / 3.0) + np.abs(kappa) / MAX_TURNING_RAD)
+        ps.append(np.full(t.size, seg[0]))
+        s_off += float(s0[-1])
+    return np.concatenate(ts), np.concatenate(ss), np.concatenate(ds), np.concatenate(ps)
 
 
-def _fit_span(sur: _Surrogate, piece: int, lo: float, hi: float, target: float):
-    """Fewest arcs (model) for the clamped span ``[lo, hi]``: ``(knots, k, theta0, error)`` or None.
+@dataclass
+class _Span:
+    """A free span: consecutive smooth pieces joined G1, ``segs`` = ``[(piece, lo, hi), ...]``.
+
+    Its ends are clamped (point and tangent of the curve); ``fixed`` imposes the curvature of the
+    first / last arc (the span ends on a circular piece joined G1, e.g. a dwell: that arc continues
+    the circle and merges with its exact arcs).  ``exact`` holds the exact arcs of a span that is
+    one circular piece."""
+
+    segs: list
+    fixed: tuple = (None, None)
+    exact: Optional[tuple] = None
+    label: int = 0
+
+    def sample(self, n: int) -> np.ndarray:
+        total = sum(hi - lo for _, lo, hi in self.segs)
+        return np.concatenate([np.linspace(lo, hi, max(2, int(n * (hi - lo) / total)) + 1)[:-1]
+                               for _, lo, hi in self.segs])
+
+    def contains(self, t: float) -> bool:
+        return any(lo <= t <= hi for _, lo, hi in self.segs)
+
+
+def _fit_span(sur: _Surrogate, span: _Span, target: float):
+    """Fewest arcs (model) for a clamped span: ``(knots, k, error)`` or None.
 
     The arc count starts from the asymptotic estimate ``∫ (|κ'| / (124.7·target))^(1/3) ds``;
-    every count gets knots equidistributing that density (end arcs shortened),
+    every count gets knots equidistributing that density (end arcs shortened at clamped ends),
     then knots and curvatures are optimised together (:func:`_equioscillate`);
     the count goes down while the span still fits ``target`` and up until it does.
-    The optimum is not monotone in the count: at the smallest failing count other
-    end-arc ratios (:data:`_END_ARCS_ALT`) are tried when it failed narrowly.
+    The optimum is not monotone in the count: at the smallest failing count a warm start
+    and other end-arc ratios (:data:`_END_ARCS_ALT`) are tried when it failed narrowly.
     """
-    _, s0, density = _span_density(sur, piece, lo, hi, target)
+    _, s0, density, _ = _span_density(sur, span.segs, target)
     est = float(_cumtrapz(density, s0)[-1])
-    m = max(2, math.ceil(_EST_FACTOR * est))
+    n_fixed = sum(f is not None for f in span.fixed)
+    m_min = 2 + n_fixed
+    m = max(m_min, math.ceil(_EST_FACTOR * est))
     best = None
     tried: dict = {}
     models: dict = {}
 
-    def attempt(m, ends=_END_ARCS, knots=None):
+    def attempt(m, ends=_END_ARCS, knots=None, fixed_ends=_FIXED_END_ARCS):
         if m not in models:
-            models[m] = _SpanModel(sur, piece, lo, hi, max(_SPLINE_MIN_GRID, _SPLINE_SAMPLES * m + 1))
+            models[m] = _SpanModel(sur, span.segs, max(_SPLINE_MIN_GRID, _SPLINE_SAMPLES * m + 1), span.fixed)
         model = models[m]
         if knots is None:
-            knots = _place_knots(model.s, np.interp(model.s, s0, density), m, ends)
+            knots = _place_knots(model.s, np.interp(model.s, s0, density), m,
+                                 fixed_ends if span.fixed[0] is not None else ends,
+                                 fixed_ends if span.fixed[1] is not None else ends)
         err, knots, k = _equioscillate(model, knots)
-        ok = err <= target and np.all(np.abs(k * np.diff(knots)) < MAX_TURNING_RAD * 1.5)
-        return err, ok, (knots, k, model.theta[0], err)
+        free = np.ones(m, bool)
+        free[0] = span.fixed[0] is None
+        free[-1] = span.fixed[1] is None
+        ok = err <= target and np.all(np.abs(k * np.diff(knots))[free] < MAX_TURNING_RAD * 1.5)
+        return err, ok, (knots, k, err)
 
     for _ in range(12):
         if m in tried:
@@ -1293,7 +1380,7 @@ def _fit_span(sur: _Surrogate, piece: int, lo: float, hi: float, target: float):
             best = fit
         if ok:
             # one arc fewer raises the error by about (m / (m - 1))³: not worth trying beyond the target
-            if (m - 1) in tried or m <= 2 or err * (m / (m - 1)) ** 3 > _DOWN_SLACK * target:
+            if (m - 1) in tried or m <= m_min or err * (m / (m - 1)) ** 3 > _DOWN_SLACK * target:
                 break
             m -= 1
         else:
@@ -1303,7 +1390,7 @@ def _fit_span(sur: _Surrogate, piece: int, lo: float, hi: float, target: float):
             m = m + 1 if err < 1.6 * target else m + max(1, min(jump, math.ceil(0.1 * m) + 1))
     if best is not None:
         m = best[0].size - 2
-        if m >= 4 and m in tried and tried[m] <= 1.3 * target:
+        if m >= max(4, m_min) and m in tried and tried[m] <= 1.3 * target:
             # warm start: the optimised knots of the fitting count less the joint of the smallest
             # curvature jump (not an end arc), then other end-arc ratios
             kb, kk = best[0], best[1]
@@ -1313,49 +1400,75 @@ def _fit_span(sur: _Surrogate, piece: int, lo: float, hi: float, target: float):
                 err, ok, fit = attempt(m, knots=np.delete(kb, j))
                 if ok:
                     return fit
-            for ends in _END_ARCS_ALT:
-                err, ok, fit = attempt(m, ends)
+            alts = [(ends, _FIXED_END_ARCS) for ends in _END_ARCS_ALT] if n_fixed < 2 else []
+            alts += [(_END_ARCS, fe) for fe in _FIXED_END_ARCS_ALT] if n_fixed else []
+            for ends, fixed_ends in alts:
+                err, ok, fit = attempt(m, ends, fixed_ends=fixed_ends)
                 if ok:
                     return fit
     return best
 
 
-def _span_chain(p0, t0, p1, t1, theta0, knots, k):
-    """Exact G1 arcs of a span from ``(p0, t0)`` to ``(p1, t1)``: the planned arcs, closed by a biarc."""
+def _tanlen(kk, ll):
+    x = 0.5 * kk * ll
+    return ll / 2 if abs(x) < 1e-12 else math.tan(x) / kk
+
+
+def _span_chain(p0, t0, p1, t1, knots, k, fixed=(None, None)):
+    """Exact G1 arcs of a span from ``(p0, t0)`` to ``(p1, t1)``: the planned arcs, closed by a biarc.
+
+    The arcs before the closing biarc are laid forward from ``p0``; with a fixed last curvature the
+    last arc is laid backward from ``p1`` (the biarc closes the arcs before it).  Arcs turning more
+    than π/2 are cut into equal parts (co-circular parts merge again later)."""
     ell = np.diff(knots)
+    k = np.array(k, dtype=float)
+    if fixed[0] is not None:
+        k[0] = fixed[0]
+    if fixed[1] is not None:
+        k[-1] = fixed[1]
     m = ell.size
-    n_free = m - 2
-    ang = theta0 + np.concatenate([[0.0], np.cumsum(k * ell)])
+    j = m - 3 if fixed[1] is not None else m - 2  # the closing biarc is arcs j, j + 1
+    if j < (1 if fixed[0] is not None else 0):
+        return None
+    starts, tans, ks, ls = [p0], [t0], [], []
     base = math.atan2(t0[1], t0[0])
-    ang = ang - ang[0] + base
-    starts = [p0]
-    tans = [t0]
-    ks, ls = [], []
-    for i in range(n_free):
-        T = np.array([math.cos(ang[i]), math.sin(ang[i])]) if i else t0
-        e = _entity_point(starts[-1], T, k[i], ell[i])
+    ang = base + np.concatenate([[0.0], np.cumsum(k * ell)])
+    for i in range(j):
+        e = _entity_point(starts[-1], tans[-1], k[i], ell[i])
         ks.append(k[i])
         ls.append(ell[i])
         starts.append(e)
         tans.append(np.array([math.cos(ang[i + 1]), math.sin(ang[i + 1])]))
-    # closing biarc with the planned ratio of tangent lengths
-    def tanlen(kk, ll):
-        x = 0.5 * kk * ll
-        return ll / 2 if abs(x) < 1e-12 else math.tan(x) / kk
-    d1, d2 = tanlen(k[-2], ell[-2]), tanlen(k[-1], ell[-1])
+    # backward from p1: arcs j + 2 … m - 1
+    b_starts, b_tans = [], []
+    end_p, end_ang = p1, math.atan2(t1[1], t1[0])
+    for i in range(m - 1, j + 1, -1):
+        ang_s = end_ang - k[i] * ell[i]
+        tb = np.array([math.cos(end_ang), math.sin(end_ang)])
+        sp = _entity_point(end_p, -tb, -k[i], ell[i])
+        b_starts.insert(0, sp)
+        b_tans.insert(0, np.array([math.cos(ang_s), math.sin(ang_s)]))
+        end_p, end_ang = sp, ang_s
+    d1, d2 = _tanlen(k[j], ell[j]), _tanlen(k[j + 1], ell[j + 1])
     ratio = d1 / d2 if d1 > 0 and d2 > 0 else 1.0
-    bi = _biarc(starts[-1][None], tans[-1][None], p1[None], t1[None], np.array([ratio]))
+    tgt_t = np.array([math.cos(end_ang), math.sin(end_ang)])
+    bi = _biarc(starts[-1][None], tans[-1][None], end_p[None], tgt_t[None], np.array([ratio]))
     if not bi["valid"][0]:
-        bi = _biarc(starts[-1][None], tans[-1][None], p1[None], t1[None], np.array([1.0]))
+        bi = _biarc(starts[-1][None], tans[-1][None], end_p[None], tgt_t[None], np.array([1.0]))
         if not bi["valid"][0]:
             return None
-    s = np.array(starts[:n_free]).reshape(-1, 2)
-    T = np.array(tans[:n_free]).reshape(-1, 2)
-    S = np.concatenate([s, bi["s"][0]])
-    E = np.concatenate([np.array(starts[1:n_free + 1]).reshape(-1, 2), bi["e"][0]])
-    TT = np.concatenate([T, bi["T"][0]])
-    K = np.concatenate([np.array(ks), bi["k"][0]])
-    L = np.concatenate([np.array(ls), bi["ell"][0]])
+    S = np.concatenate([np.array(starts[:j]).reshape(-1, 2), bi["s"][0], np.array(b_starts).reshape(-1, 2)])
+    TT = np.concatenate([np.array(tans[:j]).reshape(-1, 2), bi["T"][0], np.array(b_tans).reshape(-1, 2)])
+    K = np.concatenate([np.array(ks), bi["k"][0], k[j + 2:]])
+    L = np.concatenate([np.array(ls), bi["ell"][0], ell[j + 2:]])
+    parts = np.maximum(1, np.ceil(np.abs(K * L) / (0.5 * math.pi))).astype(int)
+    if parts.max() > 1:  # cut long arcs (fixed dwell arcs) into parts
+        idx = np.repeat(np.arange(K.size), parts)
+        sub = np.arange(idx.size) - np.repeat(np.cumsum(parts) - parts, parts)
+        u = L[idx] * sub / parts[idx]
+        S = _entity_point(S[idx], TT[idx], K[idx], u)
+        TT = _rotate(TT[idx], K[idx] * u)
+        K = K[idx]
     # make every arc consistent with both its end points (ends[i] == starts[i + 1] exactly)
     S_next = np.concatenate([S[1:], [p1]])
     TT2, K2, L2, ok = _arc_from(S, TT, S_next)
@@ -1364,48 +1477,194 @@ def _span_chain(p0, t0, p1, t1, theta0, knots, k):
     return S, TT2, K2, L2, S_next
 
 
-def _spans(curve: ParametricCurve, sur: _Surrogate, target: float) -> list:
-    """``(piece, lo, hi)`` of every free span: each smooth piece, long ones cut into equal shares of arcs."""
+def _circle_pieces(curve: ParametricCurve, sur: _Surrogate, tol: float):
+    """``(g1, circ, k)``: tangent continuity at every piece start, circular pieces and their curvatures.
+
+    A piece is circular (or straight) when 17 exact samples lie within ``tol/1000`` (and 1e-10 of
+    its chord) of the circle through its samples 0, 4 and 8."""
     bp = curve.breakpoints
-    out = []
-    for p in range(bp.size - 1):
-        lo, hi = float(bp[p]), float(bp[p + 1])
-        t, s0, density = _span_density(sur, p, lo, hi, target)
+    n = bp.size - 1
+    lo, hi = bp[:-1], bp[1:]
+    idx = np.arange(n)
+    t_in = _unit(sur.derivative(lo, idx))
+    t_out = _unit(sur.derivative(hi, idx))
+    prev = np.roll(t_out, 1, axis=0)
+    g1 = np.abs(np.arctan2(_cross(prev, t_in), _dot(prev, t_in))) < _G1_RAD
+    tt = lo[:, None] + (hi - lo)[:, None] * np.linspace(0.0, 1.0, 17)
+    pts = _points(curve, tt)
+    # the tangent at the start of the circle through samples 0, 4, 8 (parallel to the line through
+    # their images under inversion about sample 0): independent of derivative errors
+    wb, wc = pts[:, 4] - pts[:, 0], pts[:, 8] - pts[:, 0]
+    d = wc / np.maximum(_dot(wc, wc), 1e-300)[:, None] - wb / np.maximum(_dot(wb, wb), 1e-300)[:, None]
+    t_in = _unit(np.where((_dot(d, wb) < 0)[:, None], -d, d))
+    _, k, _, valid = _arc_from(pts[:, 0], t_in, pts[:, 4])
+    w = pts - pts[:, :1]
+    x, y = _dot(w, t_in[:, None]), _cross(t_in[:, None], w)
+    kk = k[:, None]
+    radial = np.abs(kk * (x * x + y * y) - 2.0 * y) / (np.hypot(kk * x, 1.0 - kk * y) + 1.0)
+    chord = np.hypot(*(pts[:, -1] - pts[:, 0]).T)
+    circ = valid & (radial.max(axis=1) <= np.minimum(1e-3 * tol, 1e-10 * chord))
+    return g1, circ, k
+
+
+def _segments(curve: ParametricCurve, a: float, b: float, wrap: bool) -> list:
+    """``[(piece, lo, hi), ...]`` from parameter ``a`` forward to ``b`` (across the period when ``wrap``)."""
+    bp = curve.breakpoints
+    n = bp.size - 1
+    p = int(_piece_index(curve, np.array([a]))[0])
+    out, lo, laps = [], a, 0
+    for _ in range(2 * n + 2):
+        if laps == int(wrap) and b <= bp[p + 1] and not (laps == 0 and b < lo):
+            out.append((p, lo, b))
+            break
+        out.append((p, lo, float(bp[p + 1])))
+        p += 1
+        if p == n:
+            p, laps = 0, laps + 1
+        lo = float(bp[p])
+    return [sg for sg in out if sg[2] > sg[1]]
+
+
+def _spans(curve: ParametricCurve, sur: _Surrogate, target: float, tol: float, anchored: bool = True) -> list:
+    """The free spans (:class:`_Span`) in chain order.
+
+    Spans run between *anchors*: true corners (kept as vertices) and the middles of circular
+    pieces (dwells) between G1 junctions, so arcs run across the G1 breakpoints in between.
+    Without anchors (or with ``anchored`` false) every breakpoint is a span end.  Long stretches
+    are cut into equal shares of about :data:`_SPLINE_SPAN` arcs, joined G1 at (surrogate) curve
+    points with the curve's tangent.
+    """
+    bp = curve.breakpoints
+    n = bp.size - 1
+    g1, circ, _ = _circle_pieces(curve, sur, tol)
+    anchors: dict = {}   # t -> [k of the arc ending there, k of the arc leaving it, corner]
+    exact = {}
+    if anchored and n > 1:
+        for p in range(n):
+            if not g1[p]:
+                anchors[float(bp[p])] = [None, None, True]
+        for p in np.flatnonzero(circ):
+            arcs_p = _exact_arcs(curve, sur, int(p))
+            if arcs_p is None:
+                continue
+            exact[int(p)] = arcs_p
+            a0 = anchors.setdefault(float(bp[p]), [None, None, False])
+            a1 = anchors.setdefault(float(bp[p + 1]) % curve.period, [None, None, False])
+            if g1[p]:
+                a0[0] = float(arcs_p[2][0])
+            if g1[(p + 1) % n]:
+                a1[1] = float(arcs_p[2][-1])
+    if not anchors:
+        anchors = {float(t): [None, None, False] for t in bp[:-1]}
+    ts = sorted(anchors)
+    corners = [i for i, t in enumerate(ts) if anchors[t][2]]
+    if corners:
+        ts = ts[corners[0]:] + ts[:corners[0]]
+    out, label = [], -1
+    for i, a in enumerate(ts):
+        b = ts[(i + 1) % len(ts)]
+        if anchors[a][2] or label < 0:
+            label += 1
+        segs = _segments(curve, a, b, wrap=len(ts) == 1 or b <= a)
+        fixed = (anchors[a][1], anchors[b][0])
+        if len(segs) == 1 and segs[0][0] in exact and segs[0][1] == bp[segs[0][0]]:
+            out.append(_Span(segs, (None, None), exact[segs[0][0]], label))
+            continue
+        if not segs:
+            continue
+        t, s0, density, piece = _span_density(sur, segs, target)
         cum = _cumtrapz(density, s0)
-        n = max(1, math.ceil(1.08 * float(cum[-1]) / _SPLINE_SPAN))
-        cuts = np.interp(cum[-1] * np.arange(n + 1) / n, cum, t) if n > 1 else np.array([lo, hi])
-        cuts[0], cuts[-1] = lo, hi
-        out += [(p, float(cuts[i]), float(cuts[i + 1])) for i in range(n)]
+        m = max(1, math.ceil(1.08 * float(cum[-1]) / _SPLINE_SPAN))
+        if m == 1:
+            out.append(_Span(segs, fixed, None, label))
+            continue
+        # cut at equal shares of the density (never on a junction)
+        goal = cum[-1] * np.arange(1, m) / m
+        j = np.clip(np.searchsorted(cum, goal) - 1, 0, cum.size - 2)
+        j = np.where(piece[j] == piece[j + 1], j, j + 1)
+        j = np.clip(j, 0, cum.size - 2)
+        frac = np.clip((goal - cum[j]) / np.maximum(cum[j + 1] - cum[j], 1e-300), 0.0, 1.0)
+        cut_t, cut_p = t[j] + frac * (t[j + 1] - t[j]), piece[j]
+        pieces_segs, cur, ci = [], [], 0
+        for seg in segs:
+            lo = seg[1]
+            while ci < cut_t.size and cut_p[ci] == seg[0] and lo < cut_t[ci] < seg[2]:
+                cur.append((seg[0], lo, float(cut_t[ci])))
+                pieces_segs.append(cur)
+                cur, lo, ci = [], float(cut_t[ci]), ci + 1
+            cur.append((seg[0], lo, seg[2]))
+        pieces_segs.append(cur)
+        for q, sg in enumerate(pieces_segs):
+            f = (fixed[0] if q == 0 else None, fixed[1] if q == len(pieces_segs) - 1 else None)
+            out.append(_Span(sg, f, None, label))
     return out
 
 
-def _span_ends(sur: _Surrogate, piece: int, lo: float, hi: float):
+def _span_ends(sur: _Surrogate, span: _Span):
     """Points and unit tangents at both ends of a span: the exact samples at breakpoints."""
-    i0, i1 = sur.first[piece], sur.first[piece + 1]
     ends = []
-    for t, i in ((lo, i0), (hi, i1)):
-        if t == sur.x[i]:
-            pt = sur.points[i] if i < sur.x.size - 1 else sur.points[0]
-        else:
+    for piece, t in ((span.segs[0][0], span.segs[0][1]), (span.segs[-1][0], span.segs[-1][2])):
+        pt = None
+        for i in (sur.first[piece], sur.first[piece + 1]):
+            if t == sur.x[i]:
+                pt = sur.points[i] if i < sur.x.size - 1 else sur.points[0]
+        if pt is None:
             pt = sur.point(np.array([t]), piece)[0]
         ends.append((pt, _unit(sur.derivative(np.array([t]), piece)[0])))
     return ends[0][0], ends[0][1], ends[1][0], ends[1][1]
 
 
-def _fit_span_chain(sur: _Surrogate, span, target: float):
+def _exact_arcs(curve: ParametricCurve, sur: _Surrogate, p: int):
+    """Exact arcs (each turning ≤ π/2) of the circular piece ``p``: ``(S, T, K, L, E)`` or None."""
+    lo, hi = float(curve.breakpoints[p]), float(curve.breakpoints[p + 1])
+    span = _Span([(p, lo, hi)])
+    _, _, theta = _span_model(sur, span.segs, 33)
+    n = max(1, math.ceil(abs(theta[-1] - theta[0]) / (0.5 * math.pi)))
+    p0, t0, p1, _ = _span_ends(sur, span)
+    pts = np.concatenate([[p0], _points(curve, lo + (hi - lo) * np.arange(1, n) / n).reshape(-1, 2), [p1]])
+    S, TT, K, L = [], [], [], []
+    tan = t0
+    for i in range(n):
+        T, k, ell, ok = _arc_from(pts[i], tan, pts[i + 1])
+        if not ok:
+            return None
+        S.append(pts[i])
+        TT.append(T)
+        K.append(float(k))
+        L.append(float(ell))
+        tan = _rotate(T, k * ell)
+    return np.array(S), np.array(TT), np.array(K), np.array(L), pts[1:]
+
+
+def _fit_span_chain(curve: ParametricCurve, sur: _Surrogate, span: _Span, target: float):
     """The exact G1 arcs of one span fitted to ``target`` and the model error, or None."""
-    piece, lo, hi = span
-    fit = _fit_span(sur, piece, lo, hi, target)
+    if span.exact is not None:
+        return span.exact, 0.0
+    fit = _fit_span(sur, span, target)
     if fit is None:
         return None
-    knots, k, th0, err = fit
-    p0, t0, p1, t1 = _span_ends(sur, piece, lo, hi)
-    chain = _span_chain(p0, t0, p1, t1, th0, knots, k)
+    knots, k, err = fit
+    p0, t0, p1, t1 = _span_ends(sur, span)
+    chain = _span_chain(p0, t0, p1, t1, knots, k, span.fixed)
     return None if chain is None else (chain, err)
 
 
-def _fit_spline(curve: ParametricCurve, sur: tuple, tol: float):
-    """The free arc spline within ``tol`` (measured on the exact curve), or None.
+def _merge_wrap(chain: Chain, labels: np.ndarray) -> tuple[Chain, np.ndarray]:
+    """Roll the chain by one entity when its last and first entities lie on one circle (G1 joint)."""
+    if chain.n < 2 or labels[0] != labels[-1]:
+        return chain, labels
+    k, ell = chain.curvature, chain.length
+    tj = chain.end_tangent[-1]
+    g1 = abs(math.atan2(_cross(tj, chain.tangent[0]), _dot(tj, chain.tangent[0]))) < 1e-12
+    if not (g1 and abs(k[0] - k[-1]) * (ell[0] + ell[-1]) <= LINE_SWEEP_RAD):
+        return chain, labels
+    roll = lambda a: np.roll(a, 1, axis=0)  # noqa: E731
+    return Chain(*(roll(a) for a in (chain.start, chain.tangent, chain.curvature, chain.length, chain.end))), \
+        roll(labels)
+
+
+def _fit_spline(curve: ParametricCurve, sur: tuple, tol: float, anchored: bool = True):
+    """The free arc spline within ``tol`` (measured on the exact curve) and its span-end parameters, or None.
 
     Spans are independent (their ends are fixed points with fixed tangents), so
     when the measured chain exceeds ``tol`` only the span where the maximum
@@ -1415,36 +1674,39 @@ def _fit_spline(curve: ParametricCurve, sur: tuple, tol: float):
     target = _SPLINE_FILL * tol - sur_err
     if not (target > 0):
         return None
-    spans = _spans(curve, sur, target)
+    spans = _spans(curve, sur, target, tol, anchored)
     targets = [target] * len(spans)
     with np.errstate(invalid="ignore", divide="ignore"):
-        fits = [_fit_span_chain(sur, sp, target) for sp in spans]
+        fits = [_fit_span_chain(curve, sur, sp, target) for sp in spans]
     if any(f is None for f in fits):
         return None
     parts, errs = [f[0] for f in fits], [f[1] for f in fits]
-    owner = np.array([sp[0] for sp in spans])
+    params = np.unique(np.append([sp.segs[0][1] for sp in spans], curve.period))
     for _ in range(_SPAN_REFITS + 1):
         cat = [np.concatenate([c[i] for c in parts]) for i in range(5)]
-        pieces = np.concatenate([np.full(c[0].shape[0], owner[j]) for j, c in enumerate(parts)])
-        merged = _merge_cocircular(Chain(*cat), pieces)
+        labels = np.concatenate([np.full(c[0].shape[0], spans[j].label) for j, c in enumerate(parts)])
+        chain, labels = _merge_wrap(Chain(*cat), labels)
+        merged = _merge_cocircular(chain, labels)
         dev = measure_deviation(merged, curve)
         if dev.max <= tol:
-            return merged, dev.max
+            return merged, dev.max, params
         # refit only the offending spans: the one holding the worst deviation and every span
         # whose exact curve samples (16 per arc) lie farther than tol from the chain
         counts = [c[0].shape[0] for c in parts]
-        t = np.concatenate([np.linspace(lo, hi, 16 * n + 1)[:-1] for (_, lo, hi), n in zip(spans, counts)])
-        d, _ = merged.distance(_points(curve, t))
-        worst = np.maximum.reduceat(d, np.concatenate([[0], np.cumsum(16 * np.array(counts))[:-1]]))
+        t = [sp.sample(16 * n) for sp, n in zip(spans, counts)]
+        d, _ = merged.distance(_points(curve, np.concatenate(t)))
+        worst = np.maximum.reduceat(d, np.concatenate([[0], np.cumsum([x.size for x in t])[:-1]]))
         at = float(dev.at_param)
-        j = next((i for i, sp in enumerate(spans) if sp[1] <= at <= sp[2]), None)
+        j = next((i for i, sp in enumerate(spans) if sp.contains(at)), None)
         if j is not None:
             worst[j] = max(worst[j], dev.max)
         for j in np.flatnonzero(worst > 0.99 * tol):
+            if spans[j].exact is not None:
+                return None
             # the measured / model ratio of this span scales its next target
             targets[j] = min(0.98 * targets[j], 0.97 * tol * errs[j] / worst[j])
             with np.errstate(invalid="ignore", divide="ignore"):
-                fit = _fit_span_chain(sur, spans[j], targets[j])
+                fit = _fit_span_chain(curve, sur, spans[j], targets[j])
             if fit is None:
                 return None
             parts[j], errs[j] = fit
@@ -1590,18 +1852,23 @@ def arcs(curve: ParametricCurve, *, tol: float = DEFAULT_EXPORT_TOL_MM) -> ArcDi
     Consecutive co-circular arcs in one piece are merged, and the final chain
     is verified with :func:`measure_deviation`.
 
-    First, a *free* (non-interpolating) G1 arc spline is tried: per smooth
-    piece, clamped to the exact point and one-sided tangent at both
-    breakpoints (long pieces are cut into spans of about
-    :data:`_SPLINE_SPAN` arcs, joined G1 on the curve with its tangent),
+    First, a *free* (non-interpolating) G1 arc spline is tried, by spans
+    clamped to the exact point and one-sided tangent at their ends.  Spans
+    end at kinks and at circular pieces (dwells), whose exact arcs the
+    neighbouring spans continue: their arcs next to a dwell keep its
+    curvature and merge with it; G1 breakpoints in between are crossed by
+    arcs (without kinks or circular pieces every breakpoint ends a span).
+    Long spans are cut into spans of about :data:`_SPLINE_SPAN` arcs, joined
+    G1 on the curve with its tangent.  Per span
     knots and curvatures are optimised together on a linear model of the
     normal deviation (its prefix integrals exact for cubic Hermite data, so
     the model matches the built chain to a fraction of a percent) and the
-    fewest arcs kept; the last two arcs of a span are the biarc closing it
-    exactly.  The chain is measured on the exact curve; should it exceed
-    ``tol``, only the offending spans are refitted to a lower target.  It is
-    used when it measures within ``tol`` (else the interpolating biarcs
-    above).  All fitting runs on a Hermite surrogate of a few batched exact
+    fewest arcs kept; two arcs of a span (the last two, or the two before a
+    fixed-curvature last arc) are the biarc closing it exactly.  The chain is
+    measured on the exact curve; should it exceed ``tol``, only the offending
+    spans are refitted to a lower target.  It is used when it measures within
+    ``tol`` (else the same spline clamped at every breakpoint, else the
+    interpolating biarcs above).  All fitting runs on a Hermite surrogate of a few batched exact
     samples; only the verification calls the exact curve again.
     """
     tol = validate_tol(tol)
@@ -1626,9 +1893,10 @@ def arcs(curve: ParametricCurve, *, tol: float = DEFAULT_EXPORT_TOL_MM) -> ArcDi
     sur = _surrogate(curve, tol)
     fit_curve = sur[0].as_curve()
     spline = _fit_spline(curve, sur, tol)
+    if spline is None:
+        spline = _fit_spline(curve, sur, tol, anchored=False)
     if spline is not None:
-        chain, measured = spline
-        nodes = curve.breakpoints.copy()
+        chain, measured, nodes = spline
     else:
         nodes, _ = _fit(curve, tol, "biarc", lambda nodes: build(nodes)[1], sur)
         chain, measured = build(nodes)

@@ -61,9 +61,8 @@ def test_example_profiles_within_tol_and_g1(name, tol):
     assert_chain_consistent(res)
     # smooth profiles (no tangent kinks): the chain is G1 everywhere
     assert tangent_jumps(res).max() < 1e-7
-    # every breakpoint is a vertex, passed exactly
-    bp = curve.point(curve.breakpoints[:-1])
-    assert np.linalg.norm(bp[:, None] - res.starts[None], axis=-1).min(axis=1).max() < 1e-9
+    # the free spline (span ends only), not interpolating biarcs; arcs run across G1 breakpoints
+    assert res.params.size - 1 <= max(curve.breakpoints.size, res.n_entities // 3)
     assert np.all(np.abs(res.sweeps) < math.pi)
 
 
@@ -76,24 +75,47 @@ def test_pitch_curve_without_derivative_within_tol():
 
 
 def test_arc_counts_at_one_micron():
-    # free arc spline, exact (Hermite-integrated) linear model, knots and curvatures optimised jointly:
-    # 61 / 42 / 90 (the first free spline gave 67 / 53 / 100, interpolating biarcs 88 / 64 / 138)
+    # free arc spline; arcs run across G1 breakpoints, the arcs next to a dwell continue its circle
+    # (exact) and merge with it: 57 / 41 / 83 (clamped at every breakpoint: 61 / 42 / 90; the first
+    # free spline gave 67 / 53 / 100, interpolating biarcs 88 / 64 / 138)
     counts = {name: arcs(example(name)[1], tol=1e-3).n_entities
               for name in ("ejemplo9rt", "indexing_packaging", "typical12")}
-    assert counts["ejemplo9rt"] <= 64, counts
-    assert counts["indexing_packaging"] <= 45, counts
-    assert counts["typical12"] <= 93, counts
+    assert counts["ejemplo9rt"] <= 59, counts
+    assert counts["indexing_packaging"] <= 43, counts
+    assert counts["typical12"] <= 86, counts
 
 
-@pytest.mark.parametrize("tol, bounds", [(1e-4, (128, 92, 181)), (1e-5, (255, 190, 382))])
+def reference12(base, roller, scale):
+    """A reference 12-segment roller cam of benchmarks/typical_cam.py (lifts of ROWS × scale)."""
+    return geometry_from_spec(design_from_dict({
+        "name": "reference12", "cam": {"kind": "disc", "rotation": "cw", "omega_rad_s": 1.0},
+        "follower": {"type": "roller", "motion": "translating", "base_radius_mm": base,
+                     "roller_radius_mm": roller, "offset_mm": 0.0},
+        "motion": [{"law": law, "lift": float(h) * scale, "angle_deg": float(a)} for law, h, a in ROWS]}))
+
+
+@pytest.mark.parametrize("base, scale, bound", [(40.0, 0.5, 72), (50.0, 0.4, 65)])
+def test_reference_cams_at_one_micron(base, scale, bound):
+    """The issue's target: a verified 1 µm profile with at most 72 arcs on a 12-segment roller cam whose
+    uniform 1 µm polyline needs ~720 vertices (719 / 740 here, measured): 71 / 63 arcs."""
+    curve = profile_curve(reference12(base, 8.0, scale).profiles[0])
+    res = arcs(curve, tol=1e-3)
+    assert res.n_entities <= bound
+    assert check_arcs(res, Dense(curve)) <= 1e-3
+    assert res.max_deviation <= 1e-3
+    assert_chain_consistent(res)
+    assert tangent_jumps(res).max() < 1e-7
+
+
+@pytest.mark.parametrize("tol, bounds", [(1e-4, (123, 87, 177)), (1e-5, (248, 184, 372))])
 def test_free_spline_at_fine_tolerances(tol, bounds):
     # long pieces are cut into spans (G1 joints with the curve's tangent): the free spline still
-    # covers 0.1 µm and 10 nm (124 / 88 / 176 and 248 / 184 / 371 arcs; biarcs gave 176 / 130 / 278
+    # covers 0.1 µm and 10 nm (120 / 84 / 173 and 243 / 180 / 365 arcs; biarcs gave 176 / 130 / 278
     # and 360 / 262 / 546)
     for name, bound in zip(("ejemplo9rt", "indexing_packaging", "typical12"), bounds):
         _, curve, dense = example(name)
         res = arcs(curve, tol=tol)
-        np.testing.assert_array_equal(res.params, curve.breakpoints)  # the free spline, not biarcs
+        assert res.params.size - 1 <= max(curve.breakpoints.size, res.n_entities // 3)  # the free spline, not biarcs
         assert res.n_entities <= bound, (name, res.n_entities)
         assert check_arcs(res, dense) <= tol
 
@@ -106,16 +128,16 @@ def test_overshooting_span_is_refitted_alone(monkeypatch):
     calls = []
     fit_span = d._fit_span
 
-    def spy(sur, piece, lo, hi, target):
-        calls.append(piece)
-        return fit_span(sur, piece, lo, hi, target)
+    def spy(sur, span, target):
+        calls.append(id(span))
+        return fit_span(sur, span, target)
 
-    monkeypatch.setattr(d, "_SPLINE_FILL", 1.15)
+    monkeypatch.setattr(d, "_SPLINE_FILL", 1.3)
     monkeypatch.setattr(d, "_fit_span", spy)
     res = arcs(curve, tol=1e-3)
-    np.testing.assert_array_equal(res.params, curve.breakpoints)  # still the free spline
+    assert res.params.size - 1 <= max(curve.breakpoints.size, res.n_entities // 3)  # still the free spline
     assert check_arcs(res, dense) <= 1e-3
-    n_spans = curve.breakpoints.size - 1
+    n_spans = len(set(calls))
     assert n_spans < len(calls) < 2 * n_spans  # some spans were refitted, not all
     assert tangent_jumps(res).max() < 1e-7
 

@@ -198,12 +198,22 @@ def test_arcs_within_tol(name, tol):
     assert measured <= tol
     assert res.max_deviation <= tol
     assert res.max_deviation == pytest.approx(measured, rel=0.02, abs=2e-8)
-    # every breakpoint is a vertex of the chain
-    assert np.isin(curve.breakpoints, res.params).all()
-    bp_points = curve.point(curve.breakpoints[:-1])
-    gaps = np.linalg.norm(bp_points[:, None] - res.starts[None], axis=-1).min(axis=1)
-    assert gaps.max() < 1e-9
+    # every true kink (tangent jump) among the breakpoints is a vertex of the chain; arcs may run
+    # across G1 breakpoints
+    kinks = [t for t in curve.breakpoints[:-1] if kink_angle(curve, t) > 1e-3]
+    if kinks:
+        kink_points = curve.point(np.array(kinks))
+        gaps = np.linalg.norm(kink_points[:, None] - res.starts[None], axis=-1).min(axis=1)
+        assert gaps.max() < 1e-9
     assert_chain_consistent(res)
+
+
+def kink_angle(curve: ParametricCurve, t: float) -> float:
+    """Angle between the one-sided tangents of the exact curve at ``t`` (finite differences)."""
+    h = 1e-7 * curve.period
+    p = curve.point(np.mod(np.array([t - 2 * h, t - h, t, t + h, t + 2 * h]), curve.period))
+    a, b = 3 * p[2] - 4 * p[1] + p[0], -3 * p[2] + 4 * p[3] - p[4]
+    return abs(math.atan2(a[0] * b[1] - a[1] * b[0], a @ b))
 
 
 def assert_chain_consistent(res: ArcDiscretisation):
