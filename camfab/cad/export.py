@@ -63,8 +63,20 @@ def cam_shapes(geometry, *, tol: float, with_pitch: bool = True) -> CamShapes:
         curves.append(curve)
         pc = pitch_curve(c) if with_pitch and c.roller_radius > 0 else None
         if pc is not None:
-            pitch.append(_loop(arcs(pc, tol=tol)))
+            pitch.append(_pitch_loop(profiles[-1], c.roller_radius, pc, tol))
     return CamShapes(tuple(profiles), tuple(devs), tuple(pitch), tuple(curves), tol)
+
+
+def _pitch_loop(profile: BulgeLoop, roller_radius: float, pitch, tol: float) -> BulgeLoop:
+    """The pitch curve's arcs: the profile's arc chain offset by the roller radius (exact for a G1 chain:
+    concentric arcs), kept when its deviation from the exact pitch curve, measured, is within ``tol``;
+    otherwise (or for a chain with corners) a fit of its own."""
+    loop = profile.offset_g1(roller_radius)
+    if loop is not None:
+        rows = np.column_stack([loop.points, loop.bulges])
+        if float(measure_deviation(rows, pitch).max) <= tol:
+            return loop
+    return _loop(arcs(pitch, tol=tol))
 
 
 def _plate(spec) -> PlateSpec:

@@ -100,6 +100,38 @@ class BulgeLoop:
             out.append(centre + r * np.column_stack([np.cos(ang), np.sin(ang)]))
         return np.concatenate(out)
 
+    def offset_g1(self, distance: float, *, angle_tol: float = 1e-9) -> "BulgeLoop | None":
+        """The loop offset outward by ``distance`` (inward if negative), exactly, or None.
+
+        For a tangent-continuous chain the offset of every arc is the concentric arc with the
+        same sweep and of every line the parallel line, so the offset loop is the vertices moved
+        along their common normal with the bulges unchanged.  Returns None when the loop has a
+        corner (tangent jump above ``angle_tol`` rad) or an arc would shrink to radius ≤ 0.
+        """
+        p, q = self.points, np.roll(self.points, -1, axis=0)
+        d = q - p
+        chord = np.hypot(d[:, 0], d[:, 1])
+        th = 4 * np.arctan(self.bulges)
+        u = d / chord[:, None]
+        c, s = np.cos(-th / 2), np.sin(-th / 2)  # start tangent = chord turned back by half the sweep
+        t0 = np.column_stack([u[:, 0] * c - u[:, 1] * s, u[:, 0] * s + u[:, 1] * c])
+        c, s = np.cos(th / 2), np.sin(th / 2)  # end tangent = chord turned on by half the sweep
+        t1 = np.column_stack([u[:, 0] * c - u[:, 1] * s, u[:, 0] * s + u[:, 1] * c])
+        t_in = np.roll(t1, 1, axis=0)  # tangent arriving at each vertex
+        if np.any(np.abs(t_in[:, 0] * t0[:, 1] - t_in[:, 1] * t0[:, 0]) > angle_tol) or np.any(
+                (t_in * t0).sum(1) <= 0):
+            return None
+        ccw = self.area() > 0
+        sign = 1.0 if ccw else -1.0  # outward = right of the direction of travel on a ccw loop
+        normal = sign * np.column_stack([t0[:, 1], -t0[:, 0]])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            radius = np.where(th != 0, chord / (2 * np.abs(np.sin(th / 2))), np.inf)
+        # an arc turning the loop's way (convex) grows by the distance, the other way shrinks
+        grow = np.where(np.sign(th) == sign, 1.0, -1.0)
+        if np.any((th != 0) & (radius + grow * distance <= 0)):
+            return None
+        return BulgeLoop(p + distance * normal, self.bulges.copy())
+
     @staticmethod
     def _centre(p0, p1, bulge):
         th = 4 * math.atan(bulge)

@@ -207,3 +207,22 @@ def test_dxf_spline_flavour_is_exact_nurbs_of_the_arcs(tol):
     rows = np.column_stack([loop.points, loop.bulges])
     assert Chain.from_bulges(rows).distance(pts)[0].max() < 1e-9
     assert measure_deviation(pts, profile_curve(geom.profiles[0])).max <= tol
+
+
+@pytest.mark.parametrize("name", sorted(DESIGNS))
+@pytest.mark.parametrize("tol", [1e-2, 1e-3, 1e-4])
+def test_dxf_pitch_curve_read_back_within_tol(name, tol):
+    from camfab.offset.cutter import pitch_curve
+
+    spec = DESIGNS[name]()
+    geom = geometry_from_spec(spec)
+    pc = pitch_curve(geom.profiles[0])
+    if pc is None or geom.profiles[0].roller_radius == 0:
+        pytest.skip("no roller: no pitch curve layer")
+    (art,) = build_artifacts(spec, geom, ["dxf"], tol=tol)
+    doc = ezdxf.read(io.StringIO(art.data.decode()))
+    (pl,) = doc.modelspace().query("LWPOLYLINE[layer=='PITCH_CURVE']")
+    rows = np.array(list(pl.get_points("xyb")))
+    assert measure_deviation(rows, pc).max <= tol
+    pts = Chain.from_bulges(rows).sample(40)[0]  # an independent check: dense points on the drawn arcs
+    assert _points_to_curve(pts, pc) <= tol + 1e-6

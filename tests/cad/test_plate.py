@@ -87,3 +87,29 @@ def test_step_solid_valid_volume_and_reimport(tmp_path):
         assert back.Volume() == pytest.approx(exact, rel=1e-6)
         bb = back.BoundingBox()
         assert (bb.xmin, bb.xmax) == (pytest.approx(-30.0), pytest.approx(30.0))
+
+
+# ---------------------------------------------------------------------------
+# exact offsets of G1 bulge loops (the pitch curve drawn from the profile's arcs)
+@pytest.mark.parametrize("reverse", [False, True], ids=["ccw", "cw"])
+@pytest.mark.parametrize("d", [-5.0, 2.5])
+def test_offset_of_a_g1_loop_is_exact(reverse, d):
+    st = _stadium()
+    loop = BulgeLoop(st.points[::-1].copy(), -np.roll(st.bulges[::-1], -1)) if reverse else st
+    off = loop.offset_g1(d)
+    # every vertex of the offset stadium lies at distance d outside the original (radius 15 + d)
+    pts = off.flatten(1e-6)
+    x, y = pts[:, 0], pts[:, 1]
+    cx = np.where(x > 0, 15.0, -15.0)
+    dist = np.where(np.abs(x) <= 15 + 1e-9, np.abs(y), np.hypot(x - cx, y))
+    assert np.allclose(dist, 15 + d, atol=1e-9)
+    # Steiner: area grows by d·perimeter + π d² (signed by orientation)
+    per = 60 + 2 * math.pi * 15
+    assert abs(off.area()) == pytest.approx(abs(loop.area()) + d * per + math.pi * d * d, rel=1e-12)
+
+
+def test_offset_refuses_corners_and_vanishing_arcs():
+    square = BulgeLoop(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]), np.zeros(4))
+    assert square.offset_g1(0.1) is None  # corners need rounding arcs
+    assert _stadium().offset_g1(-15.0) is None  # the half circles would shrink to radius 0
+    assert _regular_arc_loop(10.0).offset_g1(-9.0).area() == pytest.approx(math.pi, rel=1e-12)
