@@ -209,7 +209,7 @@ def test_dxf_spline_flavour_is_exact_nurbs_of_the_arcs(tol):
     assert measure_deviation(pts, profile_curve(geom.profiles[0])).max <= tol
 
 
-@pytest.mark.parametrize("name", sorted(DESIGNS))
+@pytest.mark.parametrize("name", ["ejemplo9rt", "oscillating"])  # the roller designs (flat faces have no pitch)
 @pytest.mark.parametrize("tol", [1e-2, 1e-3, 1e-4])
 def test_dxf_pitch_curve_read_back_within_tol(name, tol):
     from camfab.offset.cutter import pitch_curve
@@ -217,8 +217,6 @@ def test_dxf_pitch_curve_read_back_within_tol(name, tol):
     spec = DESIGNS[name]()
     geom = geometry_from_spec(spec)
     pc = pitch_curve(geom.profiles[0])
-    if pc is None or geom.profiles[0].roller_radius == 0:
-        pytest.skip("no roller: no pitch curve layer")
     (art,) = build_artifacts(spec, geom, ["dxf"], tol=tol)
     doc = ezdxf.read(io.StringIO(art.data.decode()))
     (pl,) = doc.modelspace().query("LWPOLYLINE[layer=='PITCH_CURVE']")
