@@ -122,7 +122,7 @@ def test_free_spline_at_fine_tolerances(tol, bounds):
 
 def test_overshooting_span_is_refitted_alone(monkeypatch):
     """A model target above tol makes spans overshoot: only they are refitted, the result stays within tol."""
-    import camfab.offset.discretize as d
+    import camfab.offset.arcspline as d
 
     _, curve, dense = example("typical12")
     calls = []
