@@ -195,6 +195,16 @@ def title_fields(spec, report, layout: SheetLayout) -> dict[str, str]:
             "sheet": "1 / 1", "checked": ""}
 
 
+def _verdict_note(report) -> str:
+    errors = [x for x in report.findings if x.severity == "error"]
+    verdict = f"Check verdict: {report.verdict}"
+    if errors:
+        verdict += " — " + "; ".join(sorted({x.code for x in errors}))
+    elif report.verdict == "not_for_high_speed":
+        verdict += " — jerk discontinuity, not for high speeds"
+    return verdict
+
+
 def notes_text(spec, geometry, report, shapes, layout: SheetLayout) -> list[str]:
     """The numbered notes (one string per note)."""
     m, f = spec.manufacturing, spec.follower
@@ -219,12 +229,7 @@ def notes_text(spec, geometry, report, shapes, layout: SheetLayout) -> list[str]
         fol += f", offset {f.offset_mm:g} mm"
     radius_word = "roller-centre distance (pitch radius)" if f.type != "flat" else "face distance"
     dev = max(shapes.profile_deviation) if shapes.profile_deviation else 0.0
-    errors = [x for x in report.findings if x.severity == "error"]
-    verdict = f"Check verdict: {report.verdict}"
-    if errors:
-        verdict += " — " + "; ".join(sorted({x.code for x in errors}))
-    elif report.verdict == "not_for_high_speed":
-        verdict += " — jerk discontinuity, not for high speeds"
+    verdict = _verdict_note(report)
     return [
         f"Material: {m.material or 'to be specified'}.",
         f"Plate thickness {m.thickness_mm:g} mm; {bore}.",
@@ -471,12 +476,7 @@ def plate_notes(spec, geometry, report, shapes, layout: SheetLayout) -> list[str
     top = geometry.radius_extremes().max
     slide = "LEFT" if spec.cam.direction == "left" else "RIGHT"
     start = "left" if spec.cam.direction == "left" else "right"
-    errors = [x for x in report.findings if x.severity == "error"]
-    verdict = f"Check verdict: {report.verdict}"
-    if errors:
-        verdict += " — " + "; ".join(sorted({x.code for x in errors}))
-    elif report.verdict == "not_for_high_speed":
-        verdict += " — jerk discontinuity, not for high speeds"
+    verdict = _verdict_note(report)
     return [
         f"Material: {m.material or 'to be specified'}.",
         f"Plate thickness {m.thickness_mm:g} mm; length {c.period:g} mm; no bore (sliding plate).",
@@ -523,7 +523,8 @@ def _plate_view(msp, spec, geometry, shapes, layout: SheetLayout, box) -> None:
     dims = [  # overall length under the plate; S = 0 height at the left end; highest point at the right end
         dict(base=(at(x0, y0)[0], at(x0, y0)[1] - 8.0), p1=at(x0, y0), p2=at(x1, y0)),
         dict(base=(at(x0, 0)[0] - 8.0, at(x0, 0)[1]), p1=at(x0, y0), p2=at(x0, h), angle=90.0),
-        dict(base=(at(x1, 0)[0] + 8.0, at(x1, 0)[1]), p1=at(x1, y0), p2=at(_x_of_top(geometry), y1), angle=90.0),
+        dict(base=(at(x1, 0)[0] + 8.0, at(x1, 0)[1]), p1=at(x1, y0), p2=at(_x_of_top(geometry), y1),
+             angle=90.0),
     ]
     for kw in dims:
         dim = msp.add_linear_dim(dimstyle="CAMFAB", override=dict(over), dxfattribs=attrs, **kw)

@@ -530,6 +530,27 @@ def _face(c: Contact, tag, to_user, margin, summary):
 
 
 # ---------------------------------------------------------------------------
+def _merged_ranges(raw: list[list[float]], edges: np.ndarray, closed: bool, tol: float):
+    """Ranges ``[from, to]`` (in order) merged where they meet at a breakpoint, joined across the period end
+    of a closed curve, snapped to the period ends within ``tol``; yields ``(lo, hi, subs)`` with ``subs`` the
+    breakpoint grids of the one or two (wrapping) pieces of each range."""
+    per0, per1 = edges[0], edges[-1]
+    merged: list[list[float]] = []
+    for r in raw:
+        if merged and abs(r[0] - merged[-1][1]) < tol:
+            merged[-1][1] = r[1]
+        else:
+            merged.append(r)
+    if closed and len(merged) > 1 and merged[0][0] - per0 < tol and per1 - merged[-1][1] < tol:
+        last = merged.pop()
+        merged[0][0] = last[0]
+    for lo, hi in merged:
+        lo = per0 if lo - per0 < tol else lo
+        hi = per1 if per1 - hi < tol else hi
+        parts = [(lo, hi)] if lo <= hi else [(lo, per1), (per0, hi)]
+        yield lo, hi, [np.unique(np.r_[a, edges[(edges > a) & (edges < b)], b]) for a, b in parts]
+
+
 def positive_ranges(g: Callable[[np.ndarray], np.ndarray], edges, *, closed: bool = True,
                     step: float | None = None) -> list[tuple[float, float, float, float]]:
     """Ranges where ``g > 0``, ends located by root refinement.
@@ -771,23 +792,7 @@ def _range_specs(k, edges, closed, step, ivs, grid, starts, sizes, inner, V, xs_
                     start = None
             if start is not None:
                 raw.append([start, b])
-        merged: list[list[float]] = []
-        for r in raw:
-            if merged and abs(r[0] - merged[-1][1]) < tol:
-                merged[-1][1] = r[1]
-            else:
-                merged.append(r)
-        if closed and len(merged) > 1 and merged[0][0] - per0 < tol and per1 - merged[-1][1] < tol:
-            last = merged.pop()
-            merged[0][0] = last[0]
-        for lo, hi in merged:
-            lo = per0 if lo - per0 < tol else lo
-            hi = per1 if per1 - hi < tol else hi
-            parts = [(lo, hi)] if lo <= hi else [(lo, per1), (per0, hi)]
-            if len(parts) == 1:
-                subs = [np.unique(np.r_[lo, edges[(edges > lo) & (edges < hi)], hi])]
-            else:
-                subs = [np.unique(np.r_[a, edges[(edges > a) & (edges < b)], b]) for a, b in parts]
+        for lo, hi, subs in _merged_ranges(raw, edges, closed, tol):
             spans.append((lo, hi, len(specs), len(subs)))
             specs += [(sub, True, step, j) for sub in subs]
         spans_l.append(spans)
@@ -858,26 +863,10 @@ def _positive_ranges_steps(edges, *, closed: bool = True, step: float | None = N
                 start = None
         if start is not None:
             raw.append([start, b])
-    merged: list[list[float]] = []
     tol = 1e-9 * max(per1 - per0, 1.0)
-    for r in raw:
-        if merged and abs(r[0] - merged[-1][1]) < tol:
-            merged[-1][1] = r[1]
-        else:
-            merged.append(r)
-    if closed and len(merged) > 1 and merged[0][0] - per0 < tol and per1 - merged[-1][1] < tol:
-        last = merged.pop()
-        merged[0][0] = last[0]
     # the worst value of every range, all searched at once
     spans, jobs = [], []
-    for lo, hi in merged:
-        lo = per0 if lo - per0 < tol else lo
-        hi = per1 if per1 - hi < tol else hi
-        parts = [(lo, hi)] if lo <= hi else [(lo, per1), (per0, hi)]
-        if len(parts) == 1:
-            subs = [np.unique(np.r_[lo, edges[(edges > lo) & (edges < hi)], hi])]
-        else:
-            subs = [np.unique(np.r_[a, edges[(edges > a) & (edges < b)], b]) for a, b in parts]
+    for lo, hi, subs in _merged_ranges(raw, edges, closed, tol):
         spans.append((lo, hi, len(jobs), len(subs)))
         jobs += [_extremum_steps(sub, maximize=True, step=step) for sub in subs]
     found = yield from _gather(jobs)

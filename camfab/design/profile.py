@@ -1167,12 +1167,16 @@ class CamGeometry:
 
     # ---- extremes and area --------------------------------------------
     def radius_extremes(self, profile: int = 0) -> Extremes:
-        """DMIN/DMAX: extremes of the profile's distance from the cam centre (mm)."""
-        c = self.profiles[profile]
-        edges = c.breakpoints
-        lo = extremum(lambda x: c.radius(x)[0], edges)
-        hi = extremum(lambda x: c.radius(x)[0], edges, maximize=True)
-        return Extremes(lo[1], lo[0], hi[1], hi[0])
+        """DMIN/DMAX: extremes of the profile's distance from the cam centre (mm); found once per
+        profile (the geometry is immutable), as the summaries, drawings and reports each ask for them."""
+        memo = self.__dict__.setdefault("_radius_extremes", {})
+        if profile not in memo:
+            c = self.profiles[profile]
+            edges = c.breakpoints
+            lo = extremum(lambda x: c.radius(x)[0], edges)
+            hi = extremum(lambda x: c.radius(x)[0], edges, maximize=True)
+            memo[profile] = Extremes(lo[1], lo[0], hi[1], hi[0])
+        return memo[profile]
 
     @property
     def min_radius(self) -> float:

@@ -544,6 +544,14 @@ class _Tables:
                 v /= self.spanpow(nu)[k] if nu < 6 else seg.span**nu
             out[row, sel] = v
 
+    def _lifted(self, v: np.ndarray, si: np.ndarray, orders) -> np.ndarray:
+        """Rows of a normalised law (per order) scaled by the segments' lifts, S0 added to the ν = 0 row."""
+        v = self.lift[si] * v
+        for row, nu in enumerate(orders):
+            if nu == 0:
+                v[row] += self.s0[si]
+        return v
+
     def grouped(self, xr: np.ndarray, idx: np.ndarray, orders, out: np.ndarray, uniform: bool = False) -> None:
         """``out`` = the orders at every xr (segment indices idx), one pass per kind (with
         ``uniform``, one for all dwells, polynomial and single-term trigonometric laws: fewest
@@ -567,33 +575,18 @@ class _Tables:
             u = (xr[sel] - self.start[si]) / self.span[si]
             if kind == _UNIFORM:  # dwells, polynomial and single-term trigonometric laws, every order at once
                 C, amp, w, ph, D = self.uniform(orders)
-                c = C[:, si, :]
-                v = c[:, :, -1] + u * 0.0
-                for j in range(c.shape[2] - 2, -1, -1):
-                    v = c[:, :, j] + v * u
+                v = _horner_per_sample(C[:, si, :], u)
                 # the law's own order of operations: trig term first, then what it adds (p)
                 v = amp[:, si] * np.sin(w[si] * u + ph[:, si]) + v
-                v = self.lift[si] * v
-                for row, nu in enumerate(orders):
-                    if nu == 0:
-                        v[row] += self.s0[si]
+                v = self._lifted(v, si, orders)
                 v /= D[:, si]  # 1 for ν = 0: exact
                 out[:, sel] = v
                 continue
             if kind in (_LAWPOLY, _POLY, _TRIG):  # every order at once
                 C, D = self.stacked(orders)
-                if kind == _TRIG:
-                    v = trig_rows(shape, orders, u)
-                else:
-                    c = C[:, si, :]
-                    v = c[:, :, -1] + u * 0.0
-                    for j in range(c.shape[2] - 2, -1, -1):
-                        v = c[:, :, j] + v * u
+                v = trig_rows(shape, orders, u) if kind == _TRIG else _horner_per_sample(C[:, si, :], u)
                 if kind != _POLY:
-                    v = self.lift[si] * v
-                    for row, nu in enumerate(orders):
-                        if nu == 0:
-                            v[row] += self.s0[si]
+                    v = self._lifted(v, si, orders)
                 v /= D[:, si]  # 1 for ν = 0: exact
                 out[:, sel] = v
                 continue
@@ -601,10 +594,7 @@ class _Tables:
                 lift = self.lift[si]
             for row, nu in enumerate(orders):
                 if kind == _POLY:
-                    c = self.coef(nu)[si]
-                    v = c[:, -1] + u * 0.0
-                    for j in range(c.shape[1] - 2, -1, -1):
-                        v = c[:, j] + v * u
+                    v = _horner_per_sample(self.coef(nu)[si], u)
                 else:
                     v = lift * shape(u, nu)
                     if nu == 0:
@@ -612,6 +602,14 @@ class _Tables:
                 if nu != 0:
                     v /= self.spanpow(nu)[si] if nu < 6 else np.array([s.span**nu for s in self.segs])[si]
                 out[row, sel] = v
+
+
+def _horner_per_sample(c: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """Σ c[..., j]·uʲ by Horner, with per-sample coefficients ``c`` (…, n, degree + 1)."""
+    v = c[..., -1] + u * 0.0
+    for j in range(c.shape[-1] - 2, -1, -1):
+        v = c[..., j] + v * u
+    return v
 
 
 # ---------------------------------------------------------------------------

@@ -220,22 +220,21 @@ class _Surrogate:
             return np.clip(i, 0, self.x.size - 2)
         return np.clip(i, self.first[piece], self.first[piece + 1] - 1)
 
-    def point(self, t, piece=None) -> np.ndarray:
+    def _local(self, t, piece):
+        """Offset ``u`` of ``t`` in its cubic and that cubic's coefficients (``t`` wrapped into the
+        period unless a ``piece`` is given)."""
         t = np.asarray(t, dtype=float)
         if piece is None:
             t = np.where((t < 0) | (t > self.curve.period), np.mod(t, self.curve.period), t)
         i = self._index(t, piece)
-        u = (t - self.x[i])[..., None]
-        c = self.coef[:, i]
+        return (t - self.x[i])[..., None], self.coef[:, i]
+
+    def point(self, t, piece=None) -> np.ndarray:
+        u, c = self._local(t, piece)
         return c[0] + u * (c[1] + u * (c[2] + u * c[3]))
 
     def derivative(self, t, piece=None) -> np.ndarray:
-        t = np.asarray(t, dtype=float)
-        if piece is None:
-            t = np.where((t < 0) | (t > self.curve.period), np.mod(t, self.curve.period), t)
-        i = self._index(t, piece)
-        u = (t - self.x[i])[..., None]
-        c = self.coef[:, i]
+        u, c = self._local(t, piece)
         return c[1] + u * (2 * c[2] + 3 * u * c[3])
 
     def second_derivative(self, t, piece: int) -> np.ndarray:

@@ -401,3 +401,19 @@ def test_analytic_geometry_matches_finite_differences(design):
     # minimum distance from the cam centre (or above the bottom edge) is the base radius (height)
     base = mech.base_height_mm if isinstance(mech, TranslatingCamRoller) else mech.base_radius_mm
     assert g.radius_extremes().min == pytest.approx(base, abs=1e-8)
+
+
+def test_cos_sin_kernels_match_the_library_to_an_ulp():
+    """The profile's own cos/sin (fdlibm kernels on numpy arrays) agree with numpy's to ~1 ulp, and
+    fall back to the library beyond their reduction range and for NaN/inf."""
+    from camfab.design.profile import _SINCOS_MAX, _cos_sin
+
+    rng = np.random.default_rng(7)
+    x = np.concatenate([rng.uniform(-20, 20, 200_000), rng.uniform(-_SINCOS_MAX, _SINCOS_MAX, 50_000),
+                        np.arange(-64, 65) * (np.pi / 4), [0.0, 1e-300, -1e-12]])
+    c, s = _cos_sin(x)
+    assert np.abs(c - np.cos(x)).max() <= 2.3e-16 and np.abs(s - np.sin(x)).max() <= 2.3e-16
+    big = np.array([2 * _SINCOS_MAX, np.nan, np.inf])
+    with np.errstate(invalid="ignore"):
+        c, s = _cos_sin(big)
+    assert c[0] == pytest.approx(np.cos(big[0]), abs=1e-12) and np.isnan(c[1:]).all()
