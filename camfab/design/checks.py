@@ -269,7 +269,8 @@ class _Shared:
         for idx in groups.values():
             c = jobs[idx[0]][0]
             parts = [req[i] for i in idx]
-            sample = c.evaluate(np.concatenate(parts) if len(parts) > 1 else parts[0])
+            # every extractor reads a frame-independent quantity: the fixed-frame sample skips the rotation
+            sample = c.evaluate_fixed(np.concatenate(parts) if len(parts) > 1 else parts[0])
             memo: dict = {}
             off = 0
             for i in idx:

@@ -131,6 +131,9 @@ class _Second:
     def evaluate(self, phi) -> ProfileSample:
         return _mirror(self._inner.evaluate(phi))
 
+    def evaluate_fixed(self, phi) -> ProfileSample:
+        return _mirror(self._inner.evaluate_fixed(phi))
+
 
 class SecondTranslatingFlatContact(_Second, TranslatingFlatContact):
     """Lower face of a double translating flat follower (args of :class:`TranslatingFlatContact`)."""

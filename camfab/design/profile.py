@@ -211,6 +211,13 @@ class Contact:
     def evaluate(self, phi) -> ProfileSample:  # pragma: no cover - abstract
         raise NotImplementedError
 
+    def evaluate_fixed(self, phi) -> ProfileSample:
+        """The same sample in the fixed (follower) frame: where the contact is in the machine at
+        each φ — the cam-frame sample rotated back by −σφ.  Quantities that do not depend on the
+        frame (curvatures, pressure angle, face position, |point|, point × point′) are those of
+        :meth:`evaluate`, to rounding; the checks use this form, which skips the rotation."""
+        return self.evaluate(phi)
+
     def _S(self, phi) -> tuple[np.ndarray, np.ndarray]:
         x = np.atleast_1d(np.asarray(phi, dtype=float))
         return x, self.motion.evaluate(x, (0, 1, 2))
@@ -244,6 +251,12 @@ class DiscRollerContact(Contact):
         return C[:, 0], C[:, 1], C1[:, 0], C1[:, 1], C2[:, 0], C2[:, 1], v[:, 0], v[:, 1], arm
 
     def evaluate(self, phi) -> ProfileSample:
+        return self._evaluate(phi, True)
+
+    def evaluate_fixed(self, phi) -> ProfileSample:
+        return self._evaluate(phi, False)
+
+    def _evaluate(self, phi, rotate: bool) -> ProfileSample:
         x, S = self._S(phi)
         n = x.size
         sg, rr = self.sense, self.roller_radius
@@ -262,24 +275,33 @@ class DiscRollerContact(Contact):
             # component arrays instead of (n, 2) column slices: this is the hot path
             if not (isinstance(cx, np.ndarray) and cx.shape == cy.shape):
                 cx = cx + 0.0 * cy  # broadcast a scalar coordinate to the sample count
-            tx, ty = c1x - sg * cy, c1y + sg * cx                       # T = σ·J·C + C′
-            ax = c2x - cx - 2 * sg * c1y                                # A2 = −C + 2σ·J·C′ + C″
+            # (σ = ±1 is applied by choosing the operation or the sign of one factor: exact, and
+            # no extra pass over the arrays)
+            tx, ty = (c1x - cy, c1y + cx) if sg > 0 else (c1x + cy, c1y - cx)  # T = σ·J·C + C′
+            ax = c2x - cx - 2 * sg * c1y                                        # A2 = −C + 2σ·J·C′ + C″
             ay = c2y - cy + 2 * sg * c1x
             speed = np.sqrt(tx * tx + ty * ty)  # |T| is far from overflow: no need for hypot's care
-            inv = 1.0 / speed
+            inv = np.divide(sg, speed)  # σ/|T|
             # n = −σ·J·t = σ·(ty, −tx)/|T|, pitch curvature κp = σ·(T × A2)/|T|³
-            nx, ny = tx * (-sg * inv), ty * (sg * inv)
-            nx, ny = ty * (sg * inv), nx
-            kpc = np.multiply(sg * (tx * ay - ty * ax), inv * inv * inv, out=kp[a:b])
+            nx = ty * inv
+            ny = np.negative(tx * inv)
+            inv3 = inv * inv
+            inv3 *= inv  # σ³/|T|³ = σ/|T|³
+            kpc = np.multiply(tx * ay - ty * ax, inv3, out=kp[a:b])
             scale = 1.0 - rr * kpc
             with np.errstate(divide="ignore", invalid="ignore"):
                 kc = np.divide(kpc, scale, out=k[a:b])
                 np.divide(1.0, kc, out=rho[a:b])
                 np.divide(1.0, kpc, out=rho_p[a:b])
-            np.arctan2(-sg * (vx * ny - vy * nx), vx * nx + vy * ny, out=delta[a:b])
-            c, s = _cos_sin(sg * x[a:b])
-            _rot_into(pitch, a, b, cx, cy, c, s)
-            _rot_into(normal, a, b, nx, ny, c, s)
+            # δ = atan2(−σ·(v × n), v·n)
+            cr = vy * nx - vx * ny if sg > 0 else vx * ny - vy * nx
+            np.arctan2(cr, vx * nx + vy * ny, out=delta[a:b])
+            if rotate:
+                c, s = _cos_sin(sg * x[a:b])
+                _rot_into(pitch, a, b, cx, cy, c, s)
+                _rot_into(normal, a, b, nx, ny, c, s)
+            else:
+                pitch[0, a:b], pitch[1, a:b], normal[0, a:b], normal[1, a:b] = cx, cy, nx, ny
             # rotation commutes with J: the rotated tangent is σ·J·(rotated normal), the profile point is
             # the rotated pitch point − Rr·(rotated normal), and P′ = T·(1 − Rr·κp) = t·|T|·(1 − Rr·κp)
             nrx, nry = normal[0, a:b], normal[1, a:b]
@@ -295,7 +317,7 @@ class DiscRollerContact(Contact):
 
 
 #: samples per chunk of the elementwise geometry (64 KiB per float64 temporary)
-_CHUNK = 8192
+_CHUNK = 16384
 
 
 def _block(rows: int, n: int) -> np.ndarray:
@@ -314,6 +336,8 @@ _COS_C = (-1.13596475577881948265e-11, 2.08757232129817482790e-09, -2.7557314351
           2.48015872894767294178e-05, -1.38888888888741095749e-03, 4.16666666666666019037e-02)
 #: |x| below which the reduction x − k·π/2 is exact enough (k·_PIO2_1 exact for |k| < 2²⁰)
 _SINCOS_MAX = 1.0e5
+#: cos and sin of q·π/2 for the quadrant q = 0…3
+_QUAD_COS, _QUAD_SIN = np.array([1.0, 0.0, -1.0, 0.0]), np.array([0.0, 1.0, 0.0, -1.0])
 
 
 def _cos_sin(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -344,12 +368,14 @@ def _cos_sin(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     pc *= z
     cos_r = 1.0 - 0.5 * z
     cos_r += pc
-    q = k.astype(np.int64) & 3
-    odd = (q & 1).astype(bool)
-    c = np.where(odd, sin_r, cos_r)
-    s = np.where(odd, cos_r, sin_r)
-    c *= 1 - 2 * (((q + 1) >> 1) & 1)
-    s *= 1 - 2 * ((q >> 1) & 1)
+    # quadrant q = k mod 4: cos x = a·cos r − b·sin r, sin x = b·cos r + a·sin r with (a, b) the
+    # quadrant's (cos, sin) of q·π/2 (0 or ±1, so the result is exactly ±cos r or ±sin r)
+    q = k.astype(np.intp) & 3
+    a, b = _QUAD_COS.take(q), _QUAD_SIN.take(q)
+    c = cos_r * a
+    c -= sin_r * b
+    s = cos_r * b
+    s += sin_r * a
     return c, s
 
 
@@ -437,6 +463,12 @@ class DiscFlatContact(Contact):
         raise NotImplementedError
 
     def evaluate(self, phi) -> ProfileSample:
+        return self._evaluate(phi, True)
+
+    def evaluate_fixed(self, phi) -> ProfileSample:
+        return self._evaluate(phi, False)
+
+    def _evaluate(self, phi, rotate: bool) -> ProfileSample:
         x, S = self._S(phi)
         n = x.size
         sg = self.sense
@@ -463,12 +495,16 @@ class DiscFlatContact(Contact):
             np.arctan2(-sg * (vx * ny - vy * nx), vx * nx + vy * ny, out=delta[a:b])
             with np.errstate(divide="ignore"):
                 np.divide(1.0, rc, out=k[a:b])
-            c, sn = _cos_sin(sg * x[a:b])
             wr = w * rc
-            _rot_into(point, a, b, px, py, c, sn)
-            _rot_into(point_d1, a, b, -ny * wr, nx * wr, c, sn)
-            _rot_into(normal, a, b, nx, ny, c, sn)
-            _rot_into(tangent, a, b, -sg * ny, sg * nx, c, sn)
+            if rotate:
+                c, sn = _cos_sin(sg * x[a:b])
+                _rot_into(point, a, b, px, py, c, sn)
+                _rot_into(point_d1, a, b, -ny * wr, nx * wr, c, sn)
+                _rot_into(normal, a, b, nx, ny, c, sn)
+                _rot_into(tangent, a, b, -sg * ny, sg * nx, c, sn)
+            else:
+                point[0, a:b], point[1, a:b], point_d1[0, a:b], point_d1[1, a:b] = px, py, -ny * wr, nx * wr
+                normal[0, a:b], normal[1, a:b], tangent[0, a:b], tangent[1, a:b] = nx, ny, -sg * ny, sg * nx
         return ProfileSample(x, point.T, point_d1.T, normal.T, tangent.T, k, rho, None, None, None, delta, pos, arm)
 
 

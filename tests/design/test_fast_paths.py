@@ -89,27 +89,28 @@ def geometry(request):
 def test_merged_searches_equal_the_standalone_ones(geometry):
     """check()'s batched searches give exactly the standalone results."""
     c = geometry.profiles[0]
+    ev = c.evaluate_fixed  # check() reads frame-independent values from the unrotated sample
     rep = check(geometry, pressure_angle_limit_deg=10.0, tool_radius_mm=30.0)
     edges = c.breakpoints
     s = rep.summary
     if c.kind == "roller":
-        xa, pmax = extremum(lambda x: c.evaluate(x).pressure_angle, edges, maximize=True)
-        xb, pmin = extremum(lambda x: c.evaluate(x).pressure_angle, edges)
+        xa, pmax = extremum(lambda x: ev(x).pressure_angle, edges, maximize=True)
+        xb, pmin = extremum(lambda x: ev(x).pressure_angle, edges)
         assert s["pressure_angle_deg"]["max"] == math.degrees(pmax)
         assert s["pressure_angle_deg"]["min"] == math.degrees(pmin)
         assert s["pressure_angle_deg"]["at_max_deg"] == math.degrees(xa)
         lim = math.radians(10.0)
-        ranges = positive_ranges(lambda x: c.evaluate(x).pressure_angle - lim, edges, closed=c.closed)
+        ranges = positive_ranges(lambda x: ev(x).pressure_angle - lim, edges, closed=c.closed)
         found = [f for f in rep.findings if f.code == "PRESSURE_ANGLE_EXCEEDED" and f.limit > 0]
         assert [(f.from_deg, f.to_deg) for f in found] == [(math.degrees(lo), math.degrees(hi))
                                                            for lo, hi, _, _ in ranges]
         assert [f.value for f in found] == [math.degrees(gw + lim) for _, _, _, gw in ranges]
     else:
-        xa, rmin = extremum(lambda x: c.evaluate(x).rho, edges)
+        xa, rmin = extremum(lambda x: ev(x).rho, edges)
         assert s["radius_of_curvature_mm"]["min_convex"] == rmin
         assert s["radius_of_curvature_mm"]["at_deg"] == math.degrees(xa)
-        ranges = positive_ranges(lambda x: -c.evaluate(x).rho, edges, closed=c.closed)
+        ranges = positive_ranges(lambda x: -ev(x).rho, edges, closed=c.closed)
         found = [f for f in rep.findings if f.code == "UNDERCUT"]
         assert [(f.from_deg, f.to_deg, f.value) for f in found] == [
             (math.degrees(lo), math.degrees(hi), -gw) for lo, hi, _, gw in ranges]
-    assert s["base_radius_mm"] == extremum(lambda x: c.radius(x)[0], edges)[1]
+    assert s["base_radius_mm"] == extremum(lambda x: np.hypot(*ev(x).point.T), edges)[1]

@@ -16,7 +16,7 @@ from camfab.design.profile import CamGeometry, integrate
 from camfab.design.program import MotionProgram
 from camfab.errors import SpecError
 
-from ..conftest import EJEMPLO9RT, EJEMPLO11RO
+from ..conftest import EJEMPLO9RT, EJEMPLO11RO, EXAMPLES
 
 DEG = math.pi / 180
 E1 = MotionProgram.from_segments([("simple_harmonic", 50, 180), ("simple_harmonic", -50, 180)])
@@ -417,3 +417,28 @@ def test_cos_sin_kernels_match_the_library_to_an_ulp():
     with np.errstate(invalid="ignore"):
         c, s = _cos_sin(big)
     assert c[0] == pytest.approx(np.cos(big[0]), abs=1e-12) and np.isnan(c[1:]).all()
+
+
+@pytest.mark.parametrize("name", sorted(p.stem for p in EXAMPLES.glob("*.toml")))
+def test_fixed_frame_sample_is_the_cam_frame_sample_turned_back(name):
+    """``evaluate_fixed`` (what the checks read) is the cam-frame sample rotated by −σφ, so every
+    frame-independent quantity agrees to rounding — for every example, conjugate second profiles
+    (mirrored contacts) included."""
+    from camfab.design.assemble import geometry_from_spec
+    from camfab.design.spec import load_design
+
+    g = geometry_from_spec(load_design(EXAMPLES / f"{name}.toml"))
+    x = np.linspace(0.0, g.period, 1001) if not g.closed else np.linspace(-1.0, 7.5, 1001)
+    for c in g.profiles:
+        cam, fix = c.evaluate(x), c.evaluate_fixed(x)
+        turn = (lambda v: v) if not c.closed else (lambda v: _rot(v, -c.sense * x))  # noqa: E731
+        for f in ("point", "point_d1", "normal", "tangent", "pitch"):
+            a, b = getattr(cam, f), getattr(fix, f)
+            if a is None:
+                assert b is None
+                continue
+            np.testing.assert_allclose(turn(a), b, rtol=0, atol=1e-14 * (1 + np.abs(a).max()))
+        for f in ("curvature", "curvature_pitch", "pressure_angle", "face_position", "arm_angle"):
+            a, b = getattr(cam, f), getattr(fix, f)
+            assert (a is None and b is None) or np.array_equal(a, b, equal_nan=True), f
+        np.testing.assert_allclose(np.hypot(*fix.point.T), np.hypot(*cam.point.T), rtol=1e-14)
