@@ -212,12 +212,30 @@ def format_check(spec, report) -> str:
     if face:
         rows.append(("Face length left / right (mm)", _num(face.get("left")), _num(face.get("right")),
                      "minimum face length on each side to keep contact"))
+    dyn = d.get("dynamics")
+    if dyn:
+        cf = dyn["contact_force_n"]
+        low = codes & {"FOLLOWER_JUMP", "CONTACT_FORCE_BELOW_SAFETY", "SELF_LOCKING"}
+        rows.append(("Contact force (N)", _num(cf["max"]), _num(cf["min"]),
+                     "below the safety force or jumping: see findings" if low else
+                     f"never below the safety force ({dyn['safety_force_n']:g} N)"))
+        key, label = (("drive_torque_nm", "Drive torque (N·m)") if "drive_torque_nm" in dyn
+                      else ("drive_force_n", "Drive force (N)"))
+        rows.append((label, _num(dyn[key]["max"]), _num(dyn[key]["min"]),
+                     f"work per cycle {dyn['work_per_cycle_j']:.4g} J, mean power {dyn['mean_power_w']:.4g} W"))
+        rows.append(("Camshaft bearing force (N)", _num(dyn["bearing_force_n"]["max"]), "--", ""))
     width = max(len(r[0]) for r in rows) + 2
     out = [f"{spec.name}: {_VERDICT_TEXT[report.verdict]}", ""]
     out.append(f"{'Concept':<{width}}{'Maximum':>13}{'Minimum':>13}  Comments")
     out += [f"{a:<{width}}{b:>13}{c:>13}  {e}" for a, b, c, e in rows]
     extra = [(k, d.get(k)) for k in ("base_radius_mm", "max_radius_mm", "area_mm2", "initial_arm_angle_deg")]
     out += [""] + [f"{k}: {v:.6g}" for k, v in extra if v is not None]
+    if dyn:
+        pre, jump = dyn["preload_needed"], dyn["jump_speed"]
+        out.append(f"spring preload for the safety force: {pre['value']:.6g} {pre['unit']} (worst at "
+                   f"{pre['at_deg']:.2f})")
+        out.append("jump speed: " + ("none (the follower never leaves the cam)" if jump["value"] is None else
+                                     f"{jump['value']:.6g} {jump['unit']} (first at {jump['at_deg']:.2f})"))
     if report.findings:
         out += ["", "Findings:"]
         out += [f"  [{f.severity}] {f.code}: {f.message}" for f in report.findings]

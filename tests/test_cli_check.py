@@ -92,3 +92,26 @@ def test_flat_face_reports_face_lengths(tmp_path, capsys):
 def test_valve_example_runs(capsys):
     code, d = _json(capsys, "valve_exhaust_ej1")
     assert code == 0 and d["verdict"] == "not_for_high_speed"
+
+
+def test_check_dynamics_json_table_and_exit_code(tmp_path, capsys):
+    """A [dynamics] section adds the "dynamics" object and the force rows; a spring too weak for the
+    speed makes the follower jump: FOLLOWER_JUMP, verdict unacceptable, exit code 1."""
+    code, d = _json(capsys, "valve_exhaust_ej1")
+    assert code == 0 and d["dynamics"]["contact_force_n"]["min"] >= 100.0
+    assert set(d["dynamics"]) >= {"contact_force_n", "safety_force_n", "bearing_force_n", "drive_torque_nm",
+                                  "work_per_cycle_j", "mean_power_w", "preload_needed", "jump_speed"}
+    code, d = _json(capsys, "ejemplo9rt")
+    assert d["dynamics"] is None
+    text = (EXAMPLES / "valve_exhaust_ej1.toml").read_text().replace("spring_preload_n = 250.0",
+                                                                      "spring_preload_n = 20.0")
+    text = text.replace('file = "valve_recon_ej1.csv"', f'file = "{EXAMPLES / "valve_recon_ej1.csv"}"')
+    p = tmp_path / "weak.toml"
+    p.write_text(text)
+    code, d = _json(capsys, str(p))
+    assert code == 1 and d["verdict"] == "unacceptable"
+    codes = {f["code"] for f in d["findings"]}
+    assert "CONTACT_FORCE_BELOW_SAFETY" in codes
+    assert main(["check", str(p)]) == 1
+    out = capsys.readouterr().out
+    assert "Contact force (N)" in out and "jump speed:" in out and "spring preload for the safety force" in out

@@ -6,20 +6,23 @@ CLI and the exporters never repeat the mapping.
 from __future__ import annotations
 
 import dataclasses
+import math
 
 from ..errors import SpecError
 from .checks import Report, check
+from .dynamics import DynamicsReport, Loads, analyse_dynamics
 from .motion_report import Finding
 from .mechanisms import OscillatingFlat, OscillatingRoller, TranslatingCamRoller, TranslatingFlat, TranslatingRoller
 from .profile import CamGeometry
 from .desmodromic import (ConjugateOscillatingFlat, ConjugateOscillatingRoller, ConjugateTranslatingFlat,
                           ConjugateTranslatingRoller, ConstantDiameterCam, ConstantWidthCam, desmodromic_geometry)
-from .spec import DesignSpec
+from .spec import DesignSpec, DynamicsSpec
 
 DESMODROMIC = (ConjugateTranslatingFlat, ConjugateTranslatingRoller, ConjugateOscillatingFlat,
                ConjugateOscillatingRoller, ConstantWidthCam, ConstantDiameterCam)
 
-__all__ = ["mechanism_from_spec", "geometry_from_spec", "check_design", "knot_findings"]
+__all__ = ["mechanism_from_spec", "geometry_from_spec", "check_design", "knot_findings", "loads_from_spec",
+           "dynamics_of"]
 
 
 def mechanism_from_spec(spec: DesignSpec):
@@ -77,10 +80,34 @@ def check_design(spec: DesignSpec, *, tool_radius_mm: float | None = None) -> Re
                    allow_acceleration_jump=spec.cam.kind in ("constant_width", "constant_diameter"),
                    tool_radius_mm=tool_radius_mm, face_margin_mm=spec.face_margin_mm,
                    name=spec.name, speed=spec.speed)
-    knots = knot_findings(spec)
-    if knots:
-        report = dataclasses.replace(report, findings=tuple(report.findings) + tuple(knots))
+    extra = knot_findings(spec)
+    if spec.dynamics is not None:
+        dyn = dynamics_of(spec, geom)
+        report = dataclasses.replace(report, summary={**report.summary, "dynamics": dyn.summary})
+        extra = list(dyn.findings) + extra
+    if extra:
+        report = dataclasses.replace(report, findings=tuple(report.findings) + tuple(extra))
     return report
+
+
+def loads_from_spec(d: DynamicsSpec) -> Loads:
+    """``[dynamics]`` (units in the key names) → :class:`Loads` in SI units of the follower's
+    coordinate (m, or rad for an arm)."""
+    per_deg = 180.0 / math.pi  # N·m per degree → per radian
+    if d.motion == "oscillating":
+        return Loads(d.inertia, d.spring_rate * per_deg, d.spring_preload, d.damping * per_deg, d.external,
+                     d.friction_coefficient, d.safety_force_n)
+    return Loads(d.inertia, d.spring_rate * 1e3, d.spring_preload, d.damping, d.external,
+                 d.friction_coefficient, d.safety_force_n)
+
+
+def dynamics_of(spec: DesignSpec, geometry: CamGeometry | None = None) -> DynamicsReport:
+    """Contact force, jump, drive torque and work of a design with a ``[dynamics]`` section."""
+    if spec.dynamics is None:
+        raise ValueError(f"{spec.name} has no [dynamics] section")
+    geom = geometry if geometry is not None else geometry_from_spec(spec)
+    return analyse_dynamics(geom, loads_from_spec(spec.dynamics), spec.speed,
+                            preload_unit=spec.dynamics.preload_unit)
 
 
 def knot_findings(spec: DesignSpec) -> list[Finding]:

@@ -367,7 +367,7 @@ def _extent(geometry: CamGeometry, summary):
 
 def _empty_summary() -> dict[str, Any]:
     return {"pressure_angle_deg": None, "radius_of_curvature_mm": None, "face_length_mm": None,
-            "base_radius_mm": None, "max_radius_mm": None, "area_mm2": None}
+            "base_radius_mm": None, "max_radius_mm": None, "area_mm2": None, "dynamics": None}
 
 
 def _where(to_user, x) -> float:

@@ -1091,7 +1091,7 @@ def extremum(f: Callable[[np.ndarray], np.ndarray], edges, *, maximize: bool = F
 _GAUSS20 = np.polynomial.legendre.leggauss(20)
 
 
-def _integrate_steps(edges, *, rtol: float = 1e-11):
+def _integrate_steps(edges, *, rtol: float = 1e-11, atol: float = 0.0):
     """Generator form of :func:`integrate`."""
     xg, wg = _GAUSS20
     edges = np.asarray(edges, dtype=float)
@@ -1116,16 +1116,17 @@ def _integrate_steps(edges, *, rtol: float = 1e-11):
         v = yield np.concatenate([pl.ravel(), pr.ravel()])
         ql = hl * (v[:pl.size].reshape(pl.shape) @ wg)
         qr = hr * (v[pl.size:].reshape(pr.shape) @ wg)
-        ok = np.abs(ql + qr - whole) <= rtol * scale * (todo[:, 1] - todo[:, 0]) / span + 1e-300
+        ok = np.abs(ql + qr - whole) <= (rtol * scale + atol) * (todo[:, 1] - todo[:, 0]) / span + 1e-300
         total += float((ql + qr)[ok].sum())
         todo = np.concatenate([left[~ok], right[~ok]])
         whole = np.concatenate([ql[~ok], qr[~ok]])
     return total + float(whole.sum())
 
 
-def integrate(f: Callable[[np.ndarray], np.ndarray], edges, *, rtol: float = 1e-11) -> float:
-    """∫ f between breakpoints by adaptive 20-point Gauss–Legendre (vectorised: one call of f per pass)."""
-    return _run(f, _integrate_steps(edges, rtol=rtol))
+def integrate(f: Callable[[np.ndarray], np.ndarray], edges, *, rtol: float = 1e-11, atol: float = 0.0) -> float:
+    """∫ f between breakpoints by adaptive 20-point Gauss–Legendre (vectorised: one call of f per pass).
+    Error target ``rtol·|∫f| + atol``: give ``atol`` where the integral may cancel to ~0."""
+    return _run(f, _integrate_steps(edges, rtol=rtol, atol=atol))
 
 
 # ---------------------------------------------------------------------------

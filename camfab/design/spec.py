@@ -28,6 +28,7 @@ __all__ = [
     "SegmentSpec",
     "ManufacturingSpec",
     "OutputsSpec",
+    "DynamicsSpec",
     "DesignSpec",
     "load_design",
     "design_from_dict",
@@ -42,7 +43,7 @@ ROTATIONS = ("cw", "ccw")
 POSTS = ("linuxcnc", "fanuc", "grbl")
 
 _TOP_KEYS = ("name", "description", "cam", "follower", "motion", "motion_table", "manufacturing",
-             "outputs", "checks")
+             "outputs", "checks", "dynamics")
 _CAM_KEYS = ("kind", "rotation", "direction", "speed_rpm", "omega_rad_s", "speed_mm_s")
 _FOLLOWER_FLOATS = ("base_radius_mm", "roller_radius_mm", "offset_mm", "pivot_distance_mm",
                     "arm_length_mm", "face_offset_mm", "follower_distance_mm",
@@ -54,6 +55,11 @@ _MFG_KEYS = ("thickness_mm", "bore_mm", "keyway", "hub_diameter_mm", "hub_length
              "tool_diameter_mm", "tolerance_mm", "material")
 _OUTPUT_KEYS = ("dxf", "step", "stl", "gcode", "report", "xlsx", "drawing", "lift_table")
 _CHECK_KEYS = ("pressure_angle_limit_deg", "face_margin_mm")
+#: [dynamics] keys by follower motion (the units are in the names) and for both
+_DYN_TRANSLATING = ("mass_kg", "spring_rate_n_per_mm", "spring_preload_n", "damping_n_s_per_m", "external_force_n")
+_DYN_OSCILLATING = ("inertia_kg_m2", "spring_rate_nm_per_deg", "spring_preload_nm", "damping_nm_s_per_deg",
+                    "external_torque_nm")
+_DYN_COMMON = ("friction_coefficient", "safety_force_n")
 
 
 @dataclass(frozen=True, slots=True)
@@ -138,6 +144,32 @@ class OutputsSpec:
     lift_table: bool = False
 
 
+@dataclass(frozen=True, slots=True)
+class DynamicsSpec:
+    """``[dynamics]``: the spring-loaded follower's mass, spring, damper and loads.
+
+    Translating followers (and translating cams): ``mass_kg`` (required), ``spring_rate_n_per_mm``,
+    ``spring_preload_n`` (the spring force at S = 0), ``damping_n_s_per_m``, ``external_force_n``
+    (a constant load pressing the follower onto the cam, e.g. its weight).  Oscillating followers:
+    ``inertia_kg_m2`` (about the pivot, required), ``spring_rate_nm_per_deg``, ``spring_preload_nm``,
+    ``damping_nm_s_per_deg``, ``external_torque_nm``.  Both: ``friction_coefficient`` (sliding
+    contacts: knife edges and flat faces) and ``safety_force_n`` (the smallest acceptable contact
+    force).  The fields of the other motion are None."""
+
+    motion: str
+    inertia: float
+    spring_rate: float = 0.0
+    spring_preload: float = 0.0
+    damping: float = 0.0
+    external: float = 0.0
+    friction_coefficient: float = 0.0
+    safety_force_n: float = 0.0
+
+    @property
+    def preload_unit(self) -> str:
+        return "N·m" if self.motion == "oscillating" else "N"
+
+
 @dataclass(frozen=True)
 class DesignSpec:
     """A validated design (immutable).  Build with :func:`load_design` or :func:`design_from_dict`."""
@@ -154,6 +186,7 @@ class DesignSpec:
     source: str | None = None
     base_dir: str | None = None
     face_margin_mm: float = 0.0
+    dynamics: DynamicsSpec | None = None
 
     @property
     def is_translating_cam(self) -> bool:
@@ -225,9 +258,10 @@ def design_from_dict(data: Mapping[str, Any], *, source: str | None = None,
     v.keys(checks, _CHECK_KEYS, "checks")
     pa = v.number(checks, "pressure_angle_limit_deg", "checks", None, lo=0.0, hi=90.0, lo_open=True, hi_open=True)
     margin = v.number(checks, "face_margin_mm", "checks", 0.0, lo=0.0, hi=1e4)
+    dyn = _dynamics(v, data, cam, fol)
     spec = DesignSpec(name.strip() if isinstance(name, str) else "cam", cam, fol, motion, table, mfg, out,
                       pa, str(data.get("description", "")), source,
-                      str(base_dir) if base_dir is not None else None, margin)
+                      str(base_dir) if base_dir is not None else None, margin, dyn)
     if not v.problems:
         try:
             spec.program()
@@ -471,6 +505,45 @@ def _manufacturing(v: _Validator, t: Mapping[str, Any], fol: FollowerSpec,
     if m.keyway and m.bore_mm == 0:
         v.add("manufacturing.keyway", True, "a keyway needs a bore", "set bore_mm or keyway = false")
     return m
+
+
+def _dynamics(v: _Validator, data: Mapping[str, Any], cam: CamSpec, fol: FollowerSpec) -> DynamicsSpec | None:
+    if "dynamics" not in data:
+        return None
+    t = _table(v, data, "dynamics")
+    osc = fol.motion == "oscillating" and cam.kind != "translating"
+    own, other = (_DYN_OSCILLATING, _DYN_TRANSLATING) if osc else (_DYN_TRANSLATING, _DYN_OSCILLATING)
+    kind = "an oscillating" if osc else "a translating"
+    for k in t:
+        if k in other:
+            v.add(f"dynamics.{k}", t[k], f"is for {'translating' if osc else 'oscillating'} followers",
+                  f"{kind} follower takes: " + ", ".join(own))
+    v.keys({k: t[k] for k in t if k not in other}, own + _DYN_COMMON, "dynamics")
+    if cam.kind in ("conjugate", "constant_width", "constant_diameter"):
+        v.add("dynamics", "...", f"a {cam.kind.replace('_', '-')} cam drives its follower both ways (form "
+              "closure): it cannot jump, and there is no spring to size", "remove the [dynamics] section")
+        return None
+    if not cam.speed_given:
+        key = "speed_mm_s" if cam.kind == "translating" else "speed_rpm"
+        v.add(f"cam.{key}", None, "dynamics needs the cam speed", f"add {key} = ... to [cam]")
+    big = 1e9
+    m = v.number(t, own[0], "dynamics", None, lo=0.0, lo_open=True, hi=big,
+                 fix=f"give the {'arm inertia about its pivot' if osc else 'moving mass'} (> 0)")
+    if own[0] not in t:
+        v.add(f"dynamics.{own[0]}", None, "is required",
+              f"add {own[0]} = ... ({'the arm and roller about the pivot' if osc else 'follower, spring share and attached parts'})")
+    rate = v.number(t, own[1], "dynamics", 0.0, lo=0.0, hi=big)
+    pre = v.number(t, own[2], "dynamics", 0.0, lo=-big, hi=big)
+    damp = v.number(t, own[3], "dynamics", 0.0, lo=0.0, hi=big)
+    ext = v.number(t, own[4], "dynamics", 0.0, lo=-big, hi=big)
+    mu = v.number(t, "friction_coefficient", "dynamics", 0.0, lo=0.0, hi=2.0)
+    fs = v.number(t, "safety_force_n", "dynamics", 0.0, lo=0.0, hi=big)
+    if mu and fol.type == "roller" and (fol.roller_radius_mm or 0.0) > 0:
+        v.add("dynamics.friction_coefficient", mu, "a roller rolls on the cam (no sliding friction is modelled)",
+              "remove friction_coefficient, or model a knife edge or flat face")
+    if m is None:
+        return None
+    return DynamicsSpec("oscillating" if osc else "translating", m, rate, pre, damp, ext, mu, fs)
 
 
 def _outputs(v: _Validator, t: Mapping[str, Any]) -> OutputsSpec:

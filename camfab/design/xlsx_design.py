@@ -20,6 +20,11 @@ Workbook format
     of text.  Units, speed and degree come from the ``motion_table.*`` keys of
     the ``design`` sheet, exactly as in TOML.
 
+The ``[dynamics]`` section is key/value rows of the ``design`` sheet too
+(``dynamics.mass_kg``, ``dynamics.spring_rate_n_per_mm``, … or
+``dynamics.inertia_kg_m2``, … for an oscillating follower), validated like
+the TOML section.
+
 Cell values: numbers, text and booleans as Excel stores them.  Text that
 reads as a number (``35`` or ``35,5``) or as a boolean (``true``/``false``,
 any case) is converted, except for the free-text keys ``name``,
@@ -41,9 +46,10 @@ from typing import Any
 
 from ..errors import Problem, SpecError
 from ..units import RPM
-from .spec import DesignSpec, design_from_dict
+from .spec import _DYN_OSCILLATING, _DYN_TRANSLATING, DesignSpec, DynamicsSpec, design_from_dict
 
-__all__ = ["load_design_xlsx", "design_to_xlsx", "design_rows", "SEGMENT_COLUMNS", "KNOT_COLUMNS"]
+__all__ = ["load_design_xlsx", "design_to_xlsx", "design_rows", "dynamics_items", "SEGMENT_COLUMNS",
+           "KNOT_COLUMNS"]
 
 SEGMENT_COLUMNS = ("law", "lift", "angle_deg", "length_mm", "shape")
 KNOT_COLUMNS = ("angle", "s", "v", "a", "j")
@@ -287,6 +293,13 @@ def _num(v: Any) -> Any:
     return v
 
 
+def dynamics_items(d: DynamicsSpec) -> list[tuple[str, float]]:
+    """The ``[dynamics]`` keys (as in the TOML file, units in the names) and values of a spec."""
+    own = _DYN_OSCILLATING if d.motion == "oscillating" else _DYN_TRANSLATING
+    vals = (d.inertia, d.spring_rate, d.spring_preload, d.damping, d.external)
+    return [*zip(own, vals), ("friction_coefficient", d.friction_coefficient), ("safety_force_n", d.safety_force_n)]
+
+
 def design_rows(spec: DesignSpec) -> tuple[list[tuple[str, Any]], list[dict[str, Any]] | None,
                                                      list[list[Any]] | None]:
     """The ``design`` key/value rows, the ``motion`` segments and the ``knots`` rows of a spec.
@@ -316,7 +329,7 @@ def design_rows(spec: DesignSpec) -> tuple[list[tuple[str, Any]], list[dict[str,
     kv += [("follower.type", f.type), ("follower.motion", f.motion)]
     for name in ("base_radius_mm", "roller_radius_mm", "offset_mm", "pivot_distance_mm", "arm_length_mm",
                  "face_offset_mm", "follower_distance_mm", "second_roller_radius_mm", "follower_angle_deg",
-                 "cam_length_mm", "base_height_mm", "width_mm"):
+                 "cam_length_mm", "base_height_mm", "width_mm", "rise_deg"):
         v = getattr(f, name)
         if v is not None:
             kv.append((f"follower.{name}", _num(v)))
@@ -337,6 +350,8 @@ def design_rows(spec: DesignSpec) -> tuple[list[tuple[str, Any]], list[dict[str,
     if spec.pressure_angle_limit_deg is not None:
         kv.append(("checks.pressure_angle_limit_deg", _num(spec.pressure_angle_limit_deg)))
     kv.append(("checks.face_margin_mm", _num(spec.face_margin_mm)))
+    if spec.dynamics is not None:
+        kv += [(f"dynamics.{k}", _num(v)) for k, v in dynamics_items(spec.dynamics)]
     segs = knots = None
     if spec.motion is not None:
         span = "length_mm" if spec.is_translating_cam else "angle_deg"

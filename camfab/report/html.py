@@ -1,4 +1,4 @@
-"""The HTML report of one design: plots, conclusions, findings, inputs and an animation.
+"""The HTML report of one design: plots, conclusions, follower dynamics, findings, inputs and an animation.
 
 :func:`render_report` returns the files of a report directory as
 ``{relative path: bytes}`` — ``report.html`` plus ``plots/<name>.png`` and
@@ -21,10 +21,10 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ._common import (VERDICT_CLASS, VERDICT_TEXT, axis_of, conclusions_rows, fmt, key_values, mechanism_text,
-                      range_text)
+from ._common import (VERDICT_CLASS, VERDICT_TEXT, _cell, axis_of, conclusions_rows, fmt, fmt_at, key_values,
+                      mechanism_text, range_text)
 
-__all__ = ["render_report", "write_files", "template_environment", "report_context", "PLOT_TEXT"]
+__all__ = ["render_report", "write_files", "template_environment", "report_context", "dynamics_rows", "PLOT_TEXT"]
 
 #: file stem → (title, caption) of every report plot
 PLOT_TEXT = {
@@ -41,7 +41,16 @@ PLOT_TEXT = {
                        "Angle between the line of action and the follower's motion; red beyond the limit."),
     "face_position": ("Flat-face contact position",
                       "Where the cam touches the face; the green band is the face length needed."),
+    "dynamics": ("Follower dynamics",
+                 "Contact force between cam and follower (spring, inertia, damping and loads at the design "
+                 "speed) against the safety force; red bands: the follower leaves the cam, orange: below the "
+                 "safety force, purple: self-locking. Below: the drive torque (drive force of a translating "
+                 "cam) that keeps the speed constant."),
 }
+#: finding codes of the follower dynamics (the contact-force row of the dynamics table)
+_DYNAMICS_CODES = (("SELF_LOCKING", "Friction wedges the follower: see the findings"),
+                   ("FOLLOWER_JUMP", "The follower leaves the cam (N < 0): see the findings"),
+                   ("CONTACT_FORCE_BELOW_SAFETY", "Below the safety force {fs:g} N: see the findings"))
 _SEVERITY_ORDER = {"error": 0, "warning": 1, "info": 2}
 
 
@@ -119,7 +128,65 @@ def _highlights(spec, report) -> list[str]:
     face = d.get("face_length_mm")
     if face and face.get("left") is not None:
         out.append(f"Face length needed {fmt(face['left'])} mm left and {fmt(face['right'])} mm right of the stem")
+    cf = (d.get("dynamics") or {}).get("contact_force_n")
+    if cf:
+        out.append(f"Smallest contact force {fmt(cf['min'])} N at {fmt_at(cf['at_min_deg'], xu.strip())} "
+                   f"(safety force {d['dynamics']['safety_force_n']:g} N)")
     return out
+
+
+def _row(concept: str, mx: dict, mn: dict, comment: str, status: str = "ok") -> dict[str, Any]:
+    return {"concept": concept, "max": mx, "min": mn, "comment": comment, "status": status}
+
+
+def dynamics_rows(spec, report) -> list[dict[str, Any]]:
+    """The follower-dynamics table (rows as :func:`~camfab.report._common.conclusions_rows`: ``concept``,
+    ``max`` and ``min`` cells, ``comment``, ``status``); single values sit in the ``max`` cell.
+    Empty without a ``dynamics`` summary."""
+    dyn = report.summary.get("dynamics")
+    if not dyn:
+        return []
+    xu = "°" if report.x_unit == "deg" else "mm"
+    fs, codes, none = dyn["safety_force_n"], report.codes(), _cell(None)
+    cf = dyn["contact_force_n"]
+    bad = next((text.format(fs=fs) for code, text in _DYNAMICS_CODES if code in codes), None)
+    ok_text = f"Never below the safety force {fs:g} N" if fs > 0 else "The follower stays on the cam"
+    rows = [_row("Contact force (N)", _cell(cf["max"], cf["at_max_deg"], xu), _cell(cf["min"], cf["at_min_deg"], xu),
+                 bad or ok_text, "bad" if bad else "ok"),
+            _row("Safety force (N)", _cell(fs), none, "Smallest acceptable contact force (design input)")]
+    b = dyn["bearing_force_n"]
+    rows.append(_row("Bearing force (N)", _cell(b["max"], b["at_max_deg"], xu), none,
+                     "Largest load on the camshaft bearings" if report.x_unit == "deg"
+                     else "Largest load on the plate's guides"))
+    torque = "drive_torque_nm" in dyn
+    t = dyn["drive_torque_nm" if torque else "drive_force_n"]
+    rows.append(_row("Drive torque (N·m)" if torque else "Drive force (N)", _cell(t["max"], t["at_max_deg"], xu),
+                     _cell(t["min"], t["at_min_deg"], xu),
+                     f"{'Torque' if torque else 'Force'} that keeps the speed constant (negative: the follower "
+                     "drives the cam)"))
+    rows.append(_row("Work per cycle (J)", _cell(dyn["work_per_cycle_j"]), none,
+                     "Energy lost to damping and friction in one cycle"))
+    rows.append(_row("Mean power (W)", _cell(dyn["mean_power_w"]), none, "Mean drive power at the design speed"))
+    return rows + _limit_rows(spec, dyn, xu)
+
+
+def _limit_rows(spec, dyn: dict[str, Any], xu: str) -> list[dict[str, Any]]:
+    """The preload-needed and jump-speed rows of :func:`dynamics_rows` (bad when the design misses them)."""
+    fs, none, rows = dyn["safety_force_n"], _cell(None), []
+    pre, have = dyn["preload_needed"], spec.dynamics.spring_preload if spec.dynamics is not None else None
+    short = have is not None and not have >= pre["value"] - 1e-9 * max(1.0, abs(pre["value"]))
+    rows.append(_row(f"Preload needed ({pre['unit']})", _cell(pre["value"], pre["at_deg"], xu), none,
+                     f"Spring preload that keeps the contact force ≥ {fs:g} N"
+                     + (f" (the design has {have:g} {pre['unit']})" if have is not None else ""),
+                     "bad" if short else "ok"))
+    js = dyn["jump_speed"]
+    design = spec.speed * 30 / math.pi if xu == "°" else spec.speed
+    cell = _cell(js["value"], js["at_deg"], xu) if js["value"] is not None else {**none, "text": "never"}
+    slow = js["value"] is not None and js["value"] <= design
+    rows.append(_row(f"Jump speed ({js['unit']})", cell, none,
+                     f"Speed at which the contact force first falls to {fs:g} N (design: {design:.6g} "
+                     f"{js['unit']})", "bad" if slow else "ok"))
+    return rows
 
 
 def _inputs(spec) -> list[dict[str, Any]]:
@@ -142,6 +209,10 @@ def _inputs(spec) -> list[dict[str, Any]]:
                else "default (30° translating, 35° oscillating)"), ("face_margin_mm", f"{spec.face_margin_mm:g}")]
     groups = [{"title": "Cam", "rows": cam}, {"title": "Follower", "rows": fol},
               {"title": "Manufacturing", "rows": mfg}, {"title": "Checks", "rows": checks}]
+    if spec.dynamics is not None:
+        from ..design.xlsx_design import dynamics_items
+
+        groups.append({"title": "Dynamics", "rows": [(k, f"{v:g}") for k, v in dynamics_items(spec.dynamics)]})
     if spec.motion_table is not None:
         groups.append({"title": "Knot table", "rows": [(k, json.dumps(v) if isinstance(v, dict) else str(v))
                                                        for k, v in spec.motion_table.items() if k != "rows"]})
@@ -173,6 +244,7 @@ def report_context(spec, geometry, report, plots: list[dict], anim: dict) -> dic
         "verdict": report.verdict, "verdict_text": VERDICT_TEXT[report.verdict],
         "verdict_class": VERDICT_CLASS[report.verdict], "counts": counts, "highlights": _highlights(spec, report),
         "rows": conclusions_rows(spec, report), "key_values": key_values(report),
+        "dynamics_rows": dynamics_rows(spec, report),
         "findings": [{"code": f.code, "severity": f.severity, "where": range_text(f, xu), "message": f.message}
                      for f in findings],
         "plots": plots, "plots_by_name": {p["name"]: p for p in plots}, "inputs": _inputs(spec),

@@ -1,5 +1,5 @@
 """Report figures (matplotlib): S-V-A-J, profile, radius of curvature, pressure
-angle and flat-face contact position.
+angle, flat-face contact position and (designs with ``[dynamics]``) follower dynamics.
 
 Every function returns a :class:`matplotlib.figure.Figure` built without pyplot:
 the figure gets its own Agg canvas, so no global backend is switched and
@@ -22,16 +22,20 @@ from typing import Any
 
 import numpy as np
 
-from ._common import CURVATURE_CODES, Axis, axis_of, finding_spans, fmt, sample_grid
+from ._common import CURVATURE_CODES, Axis, axis_of, finding_spans, fmt, fmt_at, sample_grid
 
 __all__ = ["svaj_figure", "profile_figure", "curvature_figure", "pressure_angle_figure", "face_position_figure",
-           "report_figures", "figure_bytes", "new_figure", "plot_style", "SVAJ_UNITS"]
+           "dynamics_figure", "report_figures", "figure_bytes", "new_figure", "plot_style", "SVAJ_UNITS"]
 
 #: (quantity, colour) of the four motion diagrams
 _SVAJ = (("S", "#1f77b4"), ("V", "#2ca02c"), ("A", "#ff7f0e"), ("J", "#d62728"))
 #: unit suffixes of S, V, A, J for a lift unit
 SVAJ_UNITS = {"S": "{u}", "V": "{u}/s", "A": "{u}/s²", "J": "{u}/s³"}
 _BAD = "#d62728"
+#: finding codes shaded on the dynamics figure: (codes, colour, label)
+_DYNAMICS_SHADES = ((("FOLLOWER_JUMP",), _BAD, "follower jumps (N < 0)"),
+                    (("CONTACT_FORCE_BELOW_SAFETY",), "#ff7f0e", "below the safety force"),
+                    (("SELF_LOCKING",), "#9467bd", "self-locking (friction wedges the follower)"))
 _N = 1441
 _RC = {"font.size": 9, "axes.titlesize": 10, "axes.labelsize": 9, "legend.fontsize": 8, "axes.grid": True,
        "grid.alpha": 0.35, "grid.linewidth": 0.6, "svg.hashsalt": "camfab", "svg.fonttype": "path",
@@ -408,11 +412,103 @@ def face_position_figure(spec, geometry, report, *, n: int = _N):
     return fig
 
 
+def _finite_view(v: np.ndarray, clip: bool) -> tuple[np.ndarray, float]:
+    """``v`` with non-finite values blanked, and the largest |value| shown; with ``clip``
+    (self-locking: N → ±∞ where the lever vanishes) the values far beyond the bulk of the curve
+    are blanked too, so the view stays readable."""
+    out = np.where(np.isfinite(v), v, np.nan)
+    lim = math.inf
+    if clip and np.isfinite(out).any():
+        lim = 4.0 * float(np.nanpercentile(np.abs(out), 90))
+        out[np.abs(out) > lim] = np.nan
+    return out, lim
+
+
+def _mark_extremes(ax, ext: dict | None, unit: str, xu: str, colour: str, lim: float = math.inf) -> None:
+    """Dots and labels at the exact min/max of a ``{min, max, at_min_deg, at_max_deg}`` summary
+    (those beyond ±``lim``, off the view, are left out)."""
+    if not ext:
+        return
+    for key, at, va in (("max", "at_max_deg", "bottom"), ("min", "at_min_deg", "top")):
+        v, x = ext.get(key), ext.get(at)
+        if v is None or x is None or not abs(v) <= lim:
+            continue
+        ax.plot([x], [v], "o", color=colour, ms=3.5)
+        ax.annotate(f"{_short(v)} {unit} at {fmt_at(x, xu)}", (x, v), xytext=(5, 4 if va == "bottom" else -4),
+                    textcoords="offset points", fontsize=7, va=va, color=colour)
+
+
+def dynamics_figure(spec, geometry, report, *, n: int = _N):
+    """Contact force and drive torque (drive force of a translating cam) against the cam angle.
+
+    Top panel: the contact force N with the zero line and the safety force, the ranges of the
+    ``FOLLOWER_JUMP``, ``CONTACT_FORCE_BELOW_SAFETY`` and ``SELF_LOCKING`` findings shaded and the
+    exact extremes of ``report.summary["dynamics"]`` marked.  Bottom panel: the drive torque (N·m),
+    or the drive force (N) along the travel of a translating cam.
+
+    Parameters
+    ----------
+    spec : DesignSpec
+        With a ``[dynamics]`` section.
+    geometry : CamGeometry
+    report : Report
+        From :func:`camfab.design.assemble.check_design` (its ``dynamics`` summary and findings).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from ..design.assemble import loads_from_spec
+    from ..design.dynamics import ContactDynamics
+
+    if spec.dynamics is None:
+        raise ValueError(f"{spec.name} has no [dynamics] section")
+    prog = spec.program()
+    axis = axis_of(prog)
+    c = geometry.profiles[0]
+    x = sample_grid(c.period, c.breakpoints, n)
+    sm = ContactDynamics(c, loads_from_spec(spec.dynamics), spec.speed).evaluate(x)
+    dyn = report.summary.get("dynamics") or {}
+    locking = bool(report.by_code("SELF_LOCKING"))
+    xu, fs = axis.unit, spec.dynamics.safety_force_n
+    drive_key, drive_label = (("drive_torque_nm", "drive torque T (N·m)") if geometry.closed
+                              else ("drive_force_n", "drive force (N)"))
+    with plot_style():
+        fig = new_figure(9.0, 6.4)
+        ax, ax2 = fig.subplots(2, 1, sharex=True, height_ratios=(3, 2))
+        force, lim = _finite_view(sm.contact_force, locking)
+        ax.plot(x * axis.scale, force, color="C0", label="contact force N")
+        ax.axhline(0.0, color="0.1", lw=0.9, label="N = 0 (jump limit)")
+        if fs > 0:
+            ax.axhline(fs, color=_BAD, lw=1.0, ls="--", label=f"safety force {fs:g} N")
+        for codes, colour, label in _DYNAMICS_SHADES:
+            shade(ax, finding_spans(report.findings, codes, axis), color=colour, label=label)
+        _mark_extremes(ax, dyn.get("contact_force_n"), "N", xu, "0.1", lim)
+        ax.set_ylabel("contact force N (N)")
+        ax.set_title("Contact force", loc="left", fontsize=9)
+        ax.margins(y=0.15)
+        drive, lim = _finite_view(sm.drive, locking)
+        ax2.plot(x * axis.scale, drive, color="C2", label=drive_label)
+        ax2.axhline(0.0, color="0.2", lw=0.6)
+        _mark_extremes(ax2, dyn.get(drive_key), "N·m" if geometry.closed else "N", xu, "0.1", lim)
+        ax2.set_ylabel(drive_label)
+        ax2.set_title("Drive torque" if geometry.closed else "Drive force", loc="left", fontsize=9)
+        ax2.margins(y=0.15)
+        for a in (ax, ax2):
+            boundaries(a, prog, axis)
+            a.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+        x_axis(ax2, axis)
+        speed = (f"{spec.speed * 30 / math.pi:.4g} rpm" if axis.closed else f"{spec.speed:.4g} mm/s")
+        fig.suptitle(f"{spec.name}: follower dynamics at {speed}", fontsize=11)
+    return fig
+
+
 def report_figures(spec, geometry, report) -> dict[str, Any]:
     """The figures of one design's report, by file stem, in reading order.
 
     ``pressure_angle`` is included when some follower has a pressure angle that varies
-    (rollers, oscillating faces); ``face_position`` when a follower is a flat face.
+    (rollers, oscillating faces); ``face_position`` when a follower is a flat face; ``dynamics``
+    when the design has a ``[dynamics]`` section.
     """
     figs: dict[str, Any] = {"svaj": svaj_figure(spec, spec.program()),
                             "profile": profile_figure(spec, geometry, report),
@@ -422,4 +518,6 @@ def report_figures(spec, geometry, report) -> dict[str, Any]:
         figs["pressure_angle"] = pressure_angle_figure(spec, geometry, report)
     if "flat" in kinds:
         figs["face_position"] = face_position_figure(spec, geometry, report)
+    if spec.dynamics is not None:
+        figs["dynamics"] = dynamics_figure(spec, geometry, report)
     return figs

@@ -49,6 +49,15 @@ angle range.  Sheet ``Lift table``: cam angle, follower lift and the
 follower radius (roller centre or face distance from the cam centre) at
 ``lift_step_deg``, 0 up to (not including) 360°.
 
+Sheet ``Dynamics`` (designs with a ``[dynamics]`` section only): row 1 the
+headings, then one row per angle of the CAM-DAS grid (0 … 360° inclusive at
+``step_deg``; travel in mm, 0 … the cam length, for a translating cam):
+angle, contact force (N), friction force (N), bearing force (N), drive torque
+(N·m; drive force in N along the travel for a translating cam) and drive
+power (W) at the design speed (empty where infinite: a self-locking
+follower).  The dynamics summary (extremes, work per cycle, mean power,
+preload needed, jump speed) is in the ``Summary`` block of ``Checks``.
+
 The bytes are deterministic: the workbook properties carry a fixed date and
 the zip entries a fixed timestamp.
 """
@@ -67,7 +76,8 @@ import numpy as np
 from ..errors import Problem, SpecError
 
 __all__ = ["CAMDAS_COLUMNS", "FIXED_DATE", "LiftTable", "camdas_workbook", "camdas_columns", "conclusions",
-           "fixed_zip", "geometry_rows", "lift_table", "sample_params", "type_text", "verdict_sentence"]
+           "dynamics_columns", "dynamics_summary_rows", "fixed_zip", "geometry_rows", "lift_table", "sample_params",
+           "type_text", "verdict_sentence"]
 
 #: the date written into the workbook properties (deterministic output)
 FIXED_DATE = datetime.datetime(2000, 1, 1, 0, 0, 0)
@@ -218,6 +228,52 @@ def camdas_columns(spec, geometry, *, step_deg: float = 1.0, profile: int = 0) -
 
 
 # ---------------------------------------------------------------------------
+# follower dynamics
+def dynamics_columns(spec, geometry, *, step_deg: float = 1.0) -> tuple[list[str], list[np.ndarray]]:
+    """Headings and columns of the ``Dynamics`` sheet (the CAM-DAS angle grid; see the module notes).
+
+    Returns
+    -------
+    headings : list of str
+    columns : list of (n,) float arrays
+        Angle (deg, or travel in mm), contact, friction and bearing force (N), drive torque (N·m) or
+        drive force (N), power (W); NaN where not finite.
+    """
+    from ..design.assemble import loads_from_spec
+    from ..design.dynamics import ContactDynamics
+
+    if spec.dynamics is None:
+        raise ValueError(f"{spec.name} has no [dynamics] section")
+    x = sample_params(geometry, step_deg)
+    sm = ContactDynamics(geometry.profiles[0], loads_from_spec(spec.dynamics), spec.speed).evaluate(x)
+    head = ["Cam angle (deg)" if geometry.closed else "Cam travel (mm)", "Contact force (N)", "Friction force (N)",
+            "Bearing force (N)", "Drive torque (N·m)" if geometry.closed else "Drive force (N)", "Power (W)"]
+    cols = [geometry.to_user(x), sm.contact_force, sm.friction_force, sm.bearing_force, sm.drive, sm.power]
+    return head, [np.where(np.isfinite(c), c, np.nan) for c in cols]
+
+
+def dynamics_summary_rows(report) -> list[tuple[str, Any, str, float | None]]:
+    """The dynamics summary of ``report`` as ``(label, value, unit, at)`` rows ([] without dynamics).
+    ``at`` is the cam angle in degrees (travel in mm); a jump speed that is never reached is "never"."""
+    d = report.summary.get("dynamics")
+    if not d:
+        return []
+    cf, b = d["contact_force_n"], d["bearing_force_n"]
+    torque = "drive_torque_nm" in d
+    t, tu = (d["drive_torque_nm"], "N·m") if torque else (d["drive_force_n"], "N")
+    word = "drive torque" if torque else "drive force"
+    pre, js = d["preload_needed"], d["jump_speed"]
+    return [("Minimum contact force", cf["min"], "N", cf["at_min_deg"]),
+            ("Maximum contact force", cf["max"], "N", cf["at_max_deg"]),
+            ("Safety force", d["safety_force_n"], "N", None),
+            ("Maximum bearing force", b["max"], "N", b["at_max_deg"]),
+            (f"Minimum {word}", t["min"], tu, t["at_min_deg"]), (f"Maximum {word}", t["max"], tu, t["at_max_deg"]),
+            ("Work per cycle", d["work_per_cycle_j"], "J", None), ("Mean power", d["mean_power_w"], "W", None),
+            ("Preload needed", pre["value"], pre["unit"], pre["at_deg"]),
+            ("Jump speed", js["value"] if js["value"] is not None else "never", js["unit"], js["at_deg"])]
+
+
+# ---------------------------------------------------------------------------
 # the lift table
 @dataclass(frozen=True)
 class LiftTable:
@@ -262,7 +318,8 @@ def lift_table(spec, geometry, step_deg: float = 10.0, *, profile: int = 0) -> L
 # ---------------------------------------------------------------------------
 # the workbook
 def camdas_workbook(spec, geometry, report, *, step_deg: float = 1.0, lift_step_deg: float = 10.0) -> bytes:
-    """The xlsx workbook: ``CAM-DAS`` sheet(s), ``Checks`` and ``Lift table`` (see the module notes).
+    """The xlsx workbook: ``CAM-DAS`` sheet(s), ``Checks``, ``Lift table`` and, for designs with
+    ``[dynamics]``, ``Dynamics`` (see the module notes).
 
     Parameters
     ----------
@@ -296,6 +353,8 @@ def camdas_workbook(spec, geometry, report, *, step_deg: float = 1.0, lift_step_
                       step_deg, k)
     _checks_sheet(wb.create_sheet("Checks"), spec, report)
     _lift_sheet(wb.create_sheet("Lift table"), lift_table(spec, geometry, lift_step_deg), geometry)
+    if spec.dynamics is not None:
+        _dynamics_sheet(wb.create_sheet("Dynamics"), *dynamics_columns(spec, geometry, step_deg=step_deg))
     wb.properties.creator = "camfab"
     wb.properties.title = spec.name
     wb.properties.created = FIXED_DATE
@@ -421,6 +480,18 @@ def _checks_sheet(ws, spec, report) -> None:
         if s.get(key) is not None:
             row += 1
             ws.cell(row, 1, label), ws.cell(row, 2, _fmt(s[key])), ws.cell(row, 3, unit)
+    dyn = dynamics_summary_rows(report)
+    if dyn:
+        row += 2
+        ws.cell(row, 1, "Dynamics").font = bold
+        x = "deg" if report.x_unit == "deg" else "mm"
+        for col, text in enumerate(("Quantity", "Value", "Unit", f"At ({x})"), 1):
+            ws.cell(row + 1, col, text).font = bold
+        row += 1
+        for label, value, unit, at in dyn:
+            row += 1
+            for col, v in enumerate((label, _fmt(value), unit, _fmt(at)), 1):
+                ws.cell(row, col, v)
     row += 2
     ws.cell(row, 1, "Findings").font = bold
     row += 1
@@ -445,4 +516,16 @@ def _lift_sheet(ws, table: LiftTable, geometry) -> None:
         ws.cell(1, col, text).font = bold
     for i, (a, s, r) in enumerate(zip(table.angle, table.lift, table.radius)):
         ws.cell(2 + i, 1, float(a)), ws.cell(2 + i, 2, float(s)), ws.cell(2 + i, 3, float(r))
+    ws.freeze_panes = "A2"
+
+
+def _dynamics_sheet(ws, head: list[str], cols: list[np.ndarray]) -> None:
+    from openpyxl.styles import Font
+
+    bold = Font(bold=True)
+    for col, text in enumerate(head, 1):
+        ws.cell(1, col, text).font = bold
+    data = np.column_stack(cols)
+    for values in data.tolist():  # openpyxl writes cell by cell; NaN → empty cell
+        ws.append([v if math.isfinite(v) else None for v in values])
     ws.freeze_panes = "A2"

@@ -88,7 +88,10 @@ def test_round_trip_toml_example(tmp_path):
     base_design(follower={"type": "knife", "motion": "translating", "base_radius_mm": 40.0, "offset_mm": 3.0},
                 motion=[{"law": "simple_harmonic", "lift": 10.0, "angle_deg": 180.0},
                         {"law": "simple_harmonic", "lift": -10.0, "angle_deg": 180.0}]),
-], ids=["osc-roller", "flat-osc", "translating-cam", "knife"])
+    {k: v for k, v in base_design(cam={"kind": "constant_width", "speed_rpm": 60.0},
+                                  follower={"type": "flat", "motion": "translating", "base_radius_mm": 30.0,
+                                            "width_mm": 80.0, "rise_deg": 150.0}).items() if k != "motion"},
+], ids=["osc-roller", "flat-osc", "translating-cam", "knife", "constant-width-rise"])
 def test_round_trip_variants(tmp_path, design):
     spec = design_from_dict(design)
     back = load_design_xlsx(_write(tmp_path, design_to_xlsx(spec)))

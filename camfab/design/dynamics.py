@@ -1,0 +1,301 @@
+"""Follower dynamics of force-closed (spring-loaded) cams: contact force, jump, drive torque.
+
+Kinetostatics at constant cam speed (``spec/valve-case-and-textbook.md`` §3.9 items 5–6): the
+motion is imposed, so every force follows from S, S′, S″ and the exact geometry; nothing is
+integrated in time and the follower is rigid.
+
+Model (one generalised coordinate q of the follower: its travel in m, or its arm angle in rad)
+-----------------------------------------------------------------------------------------------
+The cam must supply the generalised force that the follower's inertia, spring, damper and
+external load ask for::
+
+    G = M·q̈ + F₀ + k·q + c·q̇ + F_ext          (q = q(S): q = S/1000 m, or S·π/180 rad)
+
+with q̇ = q′·ṡ, q̈ = q″·ṡ² (ṡ = ω in rad/s, or the travel speed of a translating cam); F₀ is the
+spring preload at S = 0 and F_ext a constant load, both pressing the follower onto the cam.
+The cam touches the follower at P (fixed frame) with the outward unit normal n; the contact
+force on the follower is ``N·n + f`` — f the sliding friction (knife edges and flat faces:
+f = μN along the sliding velocity of the cam past the follower; a roller is taken to roll
+without slip, f = 0).  With w the velocity of the follower's point of force per unit q̇ (the roller
+centre, or the follower's material point at P), virtual work gives::
+
+    N = G / D,   D = n·w + μ·v̂·w      (rollers: D = |w|·cos δ, δ the pressure angle)
+
+* ``N < 0``: the spring cannot keep the follower on the cam — it **jumps** (``FOLLOWER_JUMP``);
+  ``N`` below the user's safety force: ``CONTACT_FORCE_BELOW_SAFETY``;
+* ``D ≤ 0``: the friction wedges the follower — no contact force can move it (``SELF_LOCKING``).
+
+The force on the cam is −(N·n + f) at P; the drive torque that keeps ω constant is
+``T = σ·(P × F_cam)`` (σ = +1 cw), and ``T·ω = G·q̇ + μN·|v_rel|`` (power balance, tested).  A
+translating cam needs the drive force along its travel instead.  Work per cycle ∮T dφ is the
+energy lost to damping and friction (0 without them).
+
+Design helpers: the preload that keeps N ≥ the safety force everywhere (N is linear in F₀),
+and the speed at which the follower starts to jump (N ≥ F_s is a quadratic in the speed at every
+angle; D does not depend on the speed).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..units import DEG, RPM
+from .motion_report import Finding
+from .profile import CamGeometry, Contact, extremum, integrate
+
+__all__ = ["Loads", "DynamicsSample", "DynamicsReport", "ContactDynamics", "analyse_dynamics"]
+
+
+@dataclass(frozen=True)
+class Loads:
+    """The follower's dynamic data in SI units of its coordinate q (m, or rad for an arm).
+
+    Attributes
+    ----------
+    inertia : float
+        M: moving mass (kg) or the arm's moment of inertia about its pivot (kg·m²), > 0.
+    spring_rate : float
+        k: N/m or N·m/rad, ≥ 0.
+    preload : float
+        F₀ at S = 0: N or N·m (presses the follower onto the cam when > 0).
+    damping : float
+        c: N·s/m or N·m·s/rad, ≥ 0.
+    external : float
+        Constant load pressing the follower onto the cam (weight, process force): N or N·m.
+    friction_coefficient : float
+        μ ≥ 0 of the sliding contact (knife edges and flat faces).
+    safety_force_n : float
+        Smallest acceptable contact force (N), ≥ 0.
+    """
+
+    inertia: float
+    spring_rate: float = 0.0
+    preload: float = 0.0
+    damping: float = 0.0
+    external: float = 0.0
+    friction_coefficient: float = 0.0
+    safety_force_n: float = 0.0
+
+
+@dataclass(frozen=True)
+class DynamicsSample:
+    """Forces at n parameter values (arrays (n,); SI units)."""
+
+    phi: np.ndarray
+    required: np.ndarray        # G: generalised force the cam must supply (N or N·m)
+    lever: np.ndarray           # D: generalised force per newton of contact force (1 or m)
+    contact_force: np.ndarray   # N (newtons), along the cam's outward normal
+    friction_force: np.ndarray  # μN (N; signed like N, which is < 0 only where the follower jumps), 0 for rollers
+    bearing_force: np.ndarray   # |N·n + f| (N): the load on the camshaft bearings
+    drive: np.ndarray           # drive torque (N·m), or drive force along the travel (N) of a translating cam
+    power: np.ndarray           # drive power (W)
+
+
+class ContactDynamics:
+    """Forces on one contact of a cam.
+
+    Parameters
+    ----------
+    contact : Contact
+        A single-follower contact (translating or oscillating roller, knife edge or flat face,
+        or a translating cam's roller).
+    loads : Loads
+    speed : float
+        ω (rad/s), or the travel speed (mm/s) of a translating cam; > 0.
+    """
+
+    def __init__(self, contact: Contact, loads: Loads, speed: float):
+        if not speed > 0:
+            raise ValueError("speed must be > 0")
+        self.contact, self.loads, self.speed = contact, loads, float(speed)
+        self.xi0 = getattr(contact, "xi0", None)
+        self.oscillating = self.xi0 is not None
+        self.pivot = np.array([contact.m, 0.0]) if self.oscillating else None
+        #: q per unit of S: m per mm, or rad per degree
+        self.q_per_s = DEG if self.oscillating else 1e-3
+        self.sliding = contact.kind == "flat" or contact.roller_radius == 0.0
+
+    # ---- kinematics -------------------------------------------------------------------
+    def _kinematics(self, x):
+        """S, S′, S″, the fixed-frame sample, w (per unit q̇, m) and the cam surface velocity at P
+        (m/s) at parameters x."""
+        c = self.contact
+        x = np.atleast_1d(np.asarray(x, dtype=float))
+        S = np.asarray(c.motion.evaluate(x, (0, 1, 2)), dtype=float)
+        s = c.evaluate_fixed(x)
+        where = s.pitch if (c.kind == "roller" and not self.sliding) else s.point  # point of force, mm
+        if self.oscillating:  # ξ grows clockwise: d r/dξ = −J·(r − pivot)
+            rel = (where - self.pivot) * 1e-3
+            w = np.stack([rel[:, 1], -rel[:, 0]], axis=1)
+        else:
+            w = np.broadcast_to(np.array([0.0, 1.0]), (x.size, 2))
+        if c.closed:  # a cam turning at ω_z = −σω carries its surface point P along ω_z·J·P
+            wz = -c.sense * self.speed
+            p = s.point * 1e-3
+            u = np.stack([-wz * p[:, 1], wz * p[:, 0]], axis=1)
+        else:  # the plate slides at −χ·v (χ = −σ: the follower runs along +x on the plate for "left")
+            u = np.zeros((x.size, 2))
+            u[:, 0] = c.sense * self.speed * 1e-3
+        return x, S, s, w, u
+
+    def evaluate(self, x) -> DynamicsSample:
+        """Forces, torque and power at parameters x (radians, or mm of travel)."""
+        L = self.loads
+        x, S, s, w, u = self._kinematics(x)
+        rate, k = self.speed, self.q_per_s
+        q, qd, qdd = k * S[0], k * S[1] * rate, k * S[2] * rate * rate
+        G = L.inertia * qdd + L.preload + L.spring_rate * q + L.damping * qd + L.external
+        n = s.normal
+        D = n[:, 0] * w[:, 0] + n[:, 1] * w[:, 1]
+        vhat = np.zeros_like(u)
+        if self.sliding and L.friction_coefficient > 0:
+            rel = u - w * qd[:, None]  # the cam's surface past the follower's point (m/s)
+            speed = np.hypot(rel[:, 0], rel[:, 1])
+            moving = speed > 0
+            vhat[moving] = rel[moving] / speed[moving, None]
+            D = D + L.friction_coefficient * (vhat[:, 0] * w[:, 0] + vhat[:, 1] * w[:, 1])
+        with np.errstate(divide="ignore", invalid="ignore"):  # D = 0: wedged (N infinite), see SELF_LOCKING
+            N = G / D
+            f = (L.friction_coefficient * N)[:, None] * vhat
+            F = -(N[:, None] * n + f)  # on the cam, at P
+        P = s.point * 1e-3
+        if self.contact.closed:
+            drive = self.contact.sense * (P[:, 0] * F[:, 1] - P[:, 1] * F[:, 0])
+            power = drive * rate
+        else:  # drive force along the plate's motion (velocity u)
+            drive = -F[:, 0] * np.sign(u[:, 0])
+            power = drive * np.abs(u[:, 0])
+        return DynamicsSample(x, G, D, N, L.friction_coefficient * N * (vhat != 0).any(axis=1),
+                              np.hypot(F[:, 0], F[:, 1]), drive, power)
+
+    # ---- design helpers -----------------------------------------------------------------
+    def _speed_terms(self, x):
+        """(a, b, e, D) with (N − F_s)·D = a·ṡ² + b·ṡ + e at parameters x (D does not depend on ṡ)."""
+        L = self.loads
+        S = np.asarray(self.contact.motion.evaluate(np.atleast_1d(np.asarray(x, dtype=float)), (0, 1, 2)))
+        D = self.evaluate(x).lever
+        k = self.q_per_s
+        a = L.inertia * k * S[2]
+        b = L.damping * k * S[1]
+        e = L.preload + L.spring_rate * k * S[0] + L.external - L.safety_force_n * D
+        return a, b, e, D
+
+    def jump_speed(self, x) -> np.ndarray:
+        """Per parameter x: the smallest speed (rad/s, or mm/s) at which N falls below the safety
+        force there — the smallest positive root of a·ṡ² + b·ṡ + e; inf where it never does, 0
+        where it already does at rest (or the follower is wedged, D ≤ 0)."""
+        a, b, e, D = self._speed_terms(x)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            disc = b * b - 4 * a * e
+            sq = np.sqrt(np.maximum(disc, 0.0))
+            qq = -0.5 * (b + np.copysign(sq, b))  # stable roots qq/a and e/qq
+            roots = np.stack([qq / a, e / qq, -e / b])  # the last: the linear case a = 0
+        quad = (a != 0) & (disc >= 0)
+        ok = np.stack([quad, quad, (a == 0) & (b < 0)]) & np.isfinite(roots) & (roots >= 0)
+        r = np.min(np.where(ok, roots, np.inf), axis=0)
+        return np.where((e < 0) | ~(D > 0), 0.0, r)
+
+    def needed_preload(self, x) -> np.ndarray:
+        """Per parameter x: the preload F₀ (N or N·m) that makes N equal the safety force there."""
+        sm = self.evaluate(x)
+        return self.loads.preload + self.loads.safety_force_n * sm.lever - sm.required
+
+
+@dataclass(frozen=True)
+class DynamicsReport:
+    """Summary and findings of :func:`analyse_dynamics` (user units: N, N·m, J, W, rpm, degrees)."""
+
+    summary: dict[str, Any]
+    findings: tuple[Finding, ...]
+
+
+def _x_user(c: Contact, x: float) -> float:
+    return math.degrees(x) if c.closed else x
+
+
+def analyse_dynamics(geometry: CamGeometry, loads: Loads, speed: float, *, preload_unit: str = "N") -> DynamicsReport:
+    """Contact force, jump, bearing load, drive torque and work per cycle of a force-closed cam.
+
+    Every extreme is exact (refined between the motion's breakpoints); ranges are located by
+    root refinement.  ``speed`` is ω (rad/s), or mm/s for a translating cam.
+    """
+    from .checks import positive_ranges
+
+    if len(geometry.profiles) != 1:
+        raise ValueError("dynamics applies to a single spring-loaded follower (not to form-closed cams)")
+    c = geometry.profiles[0]
+    dyn = ContactDynamics(c, loads, speed)
+    edges = c.breakpoints
+    closed = c.closed
+    ev = dyn.evaluate
+
+    def ext(fn, maximize=False):
+        at, val = extremum(lambda x: fn(ev(x)), edges, maximize=maximize)
+        return float(val), _x_user(c, at)
+
+    nmin, at_nmin = ext(lambda s: s.contact_force)
+    nmax, at_nmax = ext(lambda s: s.contact_force, True)
+    bmax, at_bmax = ext(lambda s: s.bearing_force, True)
+    tmin, at_tmin = ext(lambda s: s.drive)
+    tmax, at_tmax = ext(lambda s: s.drive, True)
+    dmin, at_dmin = ext(lambda s: s.lever)
+    # the work may cancel to 0 (no damping, no friction): an absolute target of 1e-12 of the
+    # largest |drive| over the cycle
+    span = float(edges[-1] - edges[0])
+    work = integrate(lambda x: ev(x).drive, edges, atol=1e-12 * max(abs(tmin), abs(tmax)) * span)
+    work *= 1.0 if closed else 1e-3
+    cycle_s = (2 * math.pi / speed) if closed else c.period / speed
+    at_pre, pre = extremum(lambda x: dyn.needed_preload(x), edges, maximize=True)
+    with np.errstate(invalid="ignore"):  # the per-angle jump speed is +inf where N never drops
+        at_jump, r_jump = extremum(lambda x: dyn.jump_speed(x), edges)
+    fs = loads.safety_force_n
+    summary: dict[str, Any] = {
+        "contact_force_n": {"min": nmin, "max": nmax, "at_min_deg": at_nmin, "at_max_deg": at_nmax},
+        "safety_force_n": fs,
+        "bearing_force_n": {"max": bmax, "at_max_deg": at_bmax},
+        ("drive_torque_nm" if closed else "drive_force_n"): {"min": tmin, "max": tmax, "at_min_deg": at_tmin,
+                                                              "at_max_deg": at_tmax},
+        "work_per_cycle_j": work,
+        "mean_power_w": work / cycle_s,
+        "preload_needed": {"value": float(pre), "unit": preload_unit, "at_deg": _x_user(c, at_pre)},
+        "jump_speed": _speed_user(r_jump, closed, _x_user(c, at_jump)),
+    }
+    findings: list[Finding] = []
+    unit = "deg" if closed else "mm"
+    speed_txt = _speed_text(speed, closed)
+    if dmin <= 0:
+        for lo, hi, xw, gw in positive_ranges(lambda x: -ev(x).lever, edges, closed=closed):
+            findings.append(Finding(
+                "SELF_LOCKING", "error", _x_user(c, lo), _x_user(c, hi), float(-gw), 0.0,
+                f"friction wedges the follower from {_x_user(c, lo):.2f} to {_x_user(c, hi):.2f} {unit}: no contact "
+                "force can move it (μ too high for the pressure angle there); lower the friction coefficient or "
+                "the pressure angle (larger base radius)"))
+    fix = (f"raise the spring preload to at least {pre:.6g} {preload_unit}" if math.isfinite(pre) else
+           "stiffen the spring")
+    if math.isfinite(r_jump) and r_jump > 0:
+        fix += f", or run slower than {_speed_text(r_jump, closed)}"
+    for lo, hi, xw, gw in positive_ranges(lambda x: -ev(x).contact_force, edges, closed=closed):
+        findings.append(Finding(
+            "FOLLOWER_JUMP", "error", _x_user(c, lo), _x_user(c, hi), float(-gw), 0.0,
+            f"the follower leaves the cam from {_x_user(c, lo):.2f} to {_x_user(c, hi):.2f} {unit} at {speed_txt}: "
+            f"the contact force falls to {-gw:.6g} N (the spring cannot hold it); {fix}"))
+    if fs > 0:
+        for lo, hi, xw, gw in positive_ranges(lambda x: fs - ev(x).contact_force, edges, closed=closed):
+            findings.append(Finding(
+                "CONTACT_FORCE_BELOW_SAFETY", "error", _x_user(c, lo), _x_user(c, hi), float(fs - gw), fs,
+                f"the contact force is below the safety force {fs:g} N from {_x_user(c, lo):.2f} to "
+                f"{_x_user(c, hi):.2f} {unit} (down to {fs - gw:.6g} N at {_x_user(c, xw):.2f} {unit}); {fix}"))
+    return DynamicsReport(summary, tuple(findings))
+
+
+def _speed_user(r: float, closed: bool, at: float) -> dict[str, Any]:
+    if not math.isfinite(r):
+        return {"value": None, "unit": "rpm" if closed else "mm/s", "at_deg": None}
+    return {"value": float(r / RPM if closed else r), "unit": "rpm" if closed else "mm/s", "at_deg": at}
+
+
+def _speed_text(r: float, closed: bool) -> str:
+    return f"{r / RPM:.6g} rpm" if closed else f"{r:.6g} mm/s"

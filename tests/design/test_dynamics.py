@@ -1,0 +1,282 @@
+"""Follower dynamics: contact force, jump, drive torque and work, against closed forms and
+independent physics (virtual work / power balance, energy per cycle), over random designs."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+
+from camfab.design.assemble import check_design, dynamics_of, loads_from_spec
+from camfab.design.dynamics import ContactDynamics, Loads, analyse_dynamics
+from camfab.design.mechanisms import OscillatingFlat, OscillatingRoller, TranslatingCamRoller, TranslatingFlat, \
+    TranslatingRoller
+from camfab.design.profile import CamGeometry, integrate
+from camfab.design.program import MotionProgram
+from camfab.design.spec import design_from_dict, load_design
+from camfab.errors import SpecError
+from camfab.units import RPM
+
+from ..conftest import EXAMPLES
+
+SHM = MotionProgram.from_segments([("simple_harmonic", 20, 180), ("simple_harmonic", -20, 180)])
+RISE = MotionProgram.from_segments([("cycloidal", 12, 100), ("dwell", 0, 40), ("poly345", -12, 120),
+                                    ("dwell", 0, 100)])
+SWING = MotionProgram.from_segments([("cycloidal", 15, 120), ("dwell", 0, 60), ("modified_sine", -15, 120),
+                                     ("dwell", 0, 60)])
+WEDGE = MotionProgram.from_segments([("cycloidal", 12, 40), ("dwell", 0, 30), ("poly345", -12, 50),
+                                     ("dwell", 0, 30)], unit="mm")
+W = 600 * RPM
+
+
+def test_translating_flat_shm_closed_form():
+    """Flat face, SHM 180/180: N = m·S″ω² + F₀ + k·S exactly; the drive torque is N·S′ (virtual work,
+    no friction); the follower jumps at the top when 0.5·0.01·ω² reaches F₀ + k·h = 150 N."""
+    g = CamGeometry(TranslatingFlat(40.0), SHM)
+    L = Loads(0.5, 5000.0, 50.0)
+    d = ContactDynamics(g.profiles[0], L, W)
+    x = np.linspace(0, 2 * np.pi, 721)
+    s = d.evaluate(x)
+    S0, S1, S2 = 10 * (1 - np.cos(x)), 10 * np.sin(x), 10 * np.cos(x)  # mm, per radian
+    N = 0.5 * S2 * 1e-3 * W * W + 50.0 + 5000.0 * S0 * 1e-3
+    np.testing.assert_allclose(s.contact_force, N, rtol=1e-13, atol=1e-11)
+    np.testing.assert_allclose(s.drive, N * S1 * 1e-3, rtol=1e-12, atol=1e-13)
+    np.testing.assert_allclose(s.bearing_force, np.abs(N), rtol=1e-14)
+    rep = analyse_dynamics(g, L, W)
+    # at this speed the bottom (S = 0, S″ = +10) is the weakest point, the top the strongest
+    cf = rep.summary["contact_force_n"]
+    assert cf["min"] == pytest.approx(50 + 0.005 * W * W, rel=1e-12) and cf["at_min_deg"] == pytest.approx(0, abs=1e-6)
+    assert cf["max"] == pytest.approx(150 - 0.005 * W * W, rel=1e-12) and cf["at_max_deg"] == pytest.approx(180, abs=1e-6)
+    # jump: 150 − 0.005·ω² = 0 at the top
+    assert rep.summary["jump_speed"]["value"] == pytest.approx(math.sqrt(150 / 0.005) / RPM, rel=1e-10)
+    assert rep.summary["jump_speed"]["unit"] == "rpm"
+    assert abs(rep.summary["work_per_cycle_j"]) < 1e-12
+    assert rep.findings == ()
+
+
+def test_translating_roller_force_is_axial_over_cos_pressure_angle():
+    g = CamGeometry(TranslatingRoller(35.0, 8.0, 6.0), RISE)
+    L = Loads(0.3, 8000.0, 120.0, damping=15.0, external=20.0)
+    c = g.profiles[0]
+    x = np.linspace(0.01, 2 * np.pi - 0.01, 500)
+    s = ContactDynamics(c, L, W).evaluate(x)
+    S = RISE.evaluate(x, (0, 1, 2))
+    G = 0.3 * S[2] * 1e-3 * W**2 + 120 + 8000 * S[0] * 1e-3 + 15 * S[1] * 1e-3 * W + 20
+    np.testing.assert_allclose(s.required, G, rtol=1e-13)
+    np.testing.assert_allclose(s.contact_force, G / np.cos(c.evaluate(x).pressure_angle), rtol=1e-12)
+
+
+# ---------------------------------------------------------------------------
+# property-based: power balance and energy per cycle over random designs
+@st.composite
+def cams(draw):
+    kind = draw(st.sampled_from(["tr", "knife", "tf", "or", "of", "wedge"]))
+    rot = draw(st.sampled_from(["cw", "ccw"]))
+    mu = draw(st.sampled_from([0.0, 0.0, 0.05, 0.2]))
+    damping = draw(st.sampled_from([0.0, 0.0, 30.0]))
+    if kind == "wedge":
+        mech = TranslatingCamRoller(draw(st.floats(0.0, 10.0)), draw(st.floats(0.0, 20.0)),
+                                    "left" if rot == "cw" else "right")
+        prog, speed = WEDGE, draw(st.floats(50.0, 2000.0))
+        if mech.roller_radius_mm > 0:
+            mu = 0.0
+        loads = Loads(draw(st.floats(0.05, 2.0)), draw(st.floats(0.0, 2e4)), draw(st.floats(0.0, 300.0)),
+                      damping, 0.0, mu)
+        return mech, prog, loads, speed
+    speed = draw(st.floats(10.0, 1500.0)) * RPM
+    if kind in ("or", "of"):
+        m = draw(st.floats(60.0, 150.0))
+        if kind == "or":
+            a = draw(st.floats(0.6, 1.1)) * m
+            rr = draw(st.floats(0.0, 10.0))
+            rp = abs(a - m) + 5 + draw(st.floats(0.2, 0.6)) * (a + m - abs(a - m) - 10)
+            assume(rp - rr > 8)
+            mech = OscillatingRoller(rp - rr, rr, m, a, rot)
+            if rr > 0:
+                mu = 0.0
+        else:
+            mech = OscillatingFlat(draw(st.floats(25.0, 0.6 * m)), m, draw(st.floats(-10.0, 10.0)), rot)
+        loads = Loads(draw(st.floats(1e-3, 0.05)), draw(st.floats(0.0, 50.0)), draw(st.floats(0.0, 20.0)),
+                      damping * 1e-3, 0.0, mu)
+        return mech, SWING, loads, speed
+    rb = draw(st.floats(25.0, 80.0))
+    if kind == "tf":
+        mech = TranslatingFlat(rb, draw(st.floats(-5.0, 5.0)), rot)
+    else:
+        rr = 0.0 if kind == "knife" else draw(st.floats(2.0, 12.0))
+        mech = TranslatingRoller(rb, rr, draw(st.floats(-0.3, 0.3)) * rb, rot)
+        if rr > 0:
+            mu = 0.0
+    loads = Loads(draw(st.floats(0.05, 2.0)), draw(st.floats(0.0, 2e4)), draw(st.floats(0.0, 300.0)), damping,
+                  draw(st.floats(-10.0, 10.0)), mu)
+    return mech, RISE, loads, speed
+
+
+@settings(max_examples=40, deadline=None)
+@given(cams())
+def test_power_balance_and_work_per_cycle(cam):
+    """The drive torque from the forces on the cam (T = σ·P × F) balances the power the follower takes
+    (G·q̇, by virtual work) plus the friction loss μN·|v_rel|; over a cycle the work is the damping
+    loss c·∮q̇² dt plus the friction loss — 0 for a conservative follower."""
+    mech, prog, L, speed = cam
+    try:
+        g = CamGeometry(mech, prog)
+    except SpecError:
+        assume(False)
+    c = g.profiles[0]
+    d = ContactDynamics(c, L, speed)
+    x = np.linspace(0.0, c.period, 2001)[:-1] + 1e-3
+    s = d.evaluate(x)
+    assume(np.all(s.lever > 1e-6))
+    k = d.q_per_s
+    S = prog.evaluate(x, (0, 1, 2))
+    qd = k * S[1] * speed
+    _, _, samp, w, u = d._kinematics(x)
+    slip = np.hypot(*(u - w * qd[:, None]).T)
+    loss = s.friction_force * slip if d.sliding else 0.0  # μN·|v_rel|
+    scale = np.abs(s.power).max() + np.abs(s.required * qd).max() + 1e-9
+    np.testing.assert_allclose(s.power, s.required * qd + loss, rtol=0, atol=1e-10 * scale)
+    if not d.sliding:
+        assert np.all(s.friction_force == 0)
+    # work per cycle (J): ∮ drive dφ = damping loss + friction loss
+    per = (lambda v: v) if c.closed else (lambda v: v * 1e-3)  # drive force × mm of travel
+    work = per(integrate(lambda y: d.evaluate(y).drive, c.breakpoints, atol=1e-12 * scale * c.period))
+    damp = L.damping * k * k * speed * integrate(lambda y: prog.evaluate(y, (1,))[0] ** 2, c.breakpoints)
+    fric = 0.0  # ∫ μN·|v_rel| dt, dt = dφ/ω (or dx/v)
+    if d.sliding and L.friction_coefficient:
+        fric = integrate(lambda y: _friction_loss(d, y) / speed, c.breakpoints)
+    assert work == pytest.approx(damp + fric, rel=1e-8, abs=1e-9 * scale * c.period / max(speed, 1e-9))
+
+
+def _friction_loss(d, y):
+    s = d.evaluate(y)
+    _, S, _, w, u = d._kinematics(y)
+    qd = d.q_per_s * S[1] * d.speed
+    return s.friction_force * np.hypot(*(u - w * qd[:, None]).T)
+
+
+def test_pressure_angle_free_force_matches_the_arm_moment_for_an_oscillating_roller():
+    """Oscillating roller: the contact force's moment about the pivot equals the required torque
+    (N·A·cos δ = G), an independent statement of the arm's moment balance."""
+    g = CamGeometry(OscillatingRoller(40.0, 10.0, 100.0, 90.0), SWING)
+    c = g.profiles[0]
+    L = Loads(0.02, 30.0, 5.0)
+    x = np.linspace(0.02, 2 * np.pi - 0.02, 400)
+    s = ContactDynamics(c, L, W).evaluate(x)
+    fs = c.evaluate_fixed(x)
+    arm = (fs.pitch - np.array([c.m, 0.0])) * 1e-3
+    force = s.contact_force[:, None] * fs.normal
+    moment = -(arm[:, 0] * force[:, 1] - arm[:, 1] * force[:, 0])  # clockwise (ξ increasing) positive
+    np.testing.assert_allclose(moment, s.required, rtol=1e-11, atol=1e-12 * np.abs(s.required).max())
+
+
+# ---------------------------------------------------------------------------
+# design helpers: the preload and the speed at the limit
+@pytest.mark.parametrize("mech,prog,L", [
+    (TranslatingRoller(35.0, 8.0, 4.0), RISE, Loads(0.4, 6000.0, 60.0, damping=20.0, safety_force_n=40.0)),
+    (TranslatingFlat(45.0, 2.0, "ccw"), RISE, Loads(0.4, 3000.0, 40.0, friction_coefficient=0.1,
+                                                    safety_force_n=25.0)),
+    (OscillatingRoller(40.0, 10.0, 100.0, 90.0), SWING, Loads(0.02, 20.0, 3.0, safety_force_n=30.0)),
+])
+def test_needed_preload_and_jump_speed_sit_exactly_at_the_safety_force(mech, prog, L):
+    g = CamGeometry(mech, prog)
+    speed = 900 * RPM
+    rep = analyse_dynamics(g, L, speed)
+    pre = rep.summary["preload_needed"]["value"]
+    at_limit = analyse_dynamics(g, Loads(**{**L.__dict__, "preload": pre}), speed)
+    assert at_limit.summary["contact_force_n"]["min"] == pytest.approx(L.safety_force_n, rel=1e-9)
+    jump = rep.summary["jump_speed"]["value"] * RPM
+    for f, ok in ((1 - 1e-6, True), (1 + 1e-6, False)):
+        r = analyse_dynamics(g, L, jump * f)
+        assert (r.summary["contact_force_n"]["min"] >= L.safety_force_n * (1 - 1e-9)) is ok
+        assert bool(r.findings) is not ok
+
+
+def test_jump_ranges_and_messages():
+    g = CamGeometry(TranslatingFlat(40.0), SHM)
+    rep = analyse_dynamics(g, Loads(0.5, 500.0, 10.0, safety_force_n=5.0), 1200 * RPM)
+    jump = [f for f in rep.findings if f.code == "FOLLOWER_JUMP"]
+    low = [f for f in rep.findings if f.code == "CONTACT_FORCE_BELOW_SAFETY"]
+    assert len(jump) == 1 and len(low) == 1
+    # N = 0.5·10cos φ·1e-3·ω² + 10 + 0.5·10(1 − cos φ) = 0 where cos φ = −15/(0.005ω² − 5)
+    w = 1200 * RPM
+    phi = math.degrees(math.acos(-15 / (0.005 * w * w - 5)))
+    assert jump[0].from_deg == pytest.approx(phi, abs=1e-8) and jump[0].to_deg == pytest.approx(360 - phi, abs=1e-8)
+    assert jump[0].severity == "error" and jump[0].value == pytest.approx(20 - 0.005 * w * w, rel=1e-10)
+    assert "raise the spring preload to at least" in jump[0].message and "rpm" in jump[0].message
+    assert low[0].from_deg < jump[0].from_deg and low[0].limit == 5.0
+
+
+def test_self_locking_with_high_friction_on_a_knife_edge():
+    g = CamGeometry(TranslatingRoller(20.0, 0.0, 0.0), MotionProgram.from_segments(
+        [("cycloidal", 25, 80), ("dwell", 0, 40), ("cycloidal", -25, 80), ("dwell", 0, 160)]))
+    rep = analyse_dynamics(g, Loads(0.1, 1000.0, 50.0, friction_coefficient=1.5), 100 * RPM)
+    lock = [f for f in rep.findings if f.code == "SELF_LOCKING"]
+    assert lock and all(f.severity == "error" for f in lock)
+
+
+# ---------------------------------------------------------------------------
+# the design file
+BASE = {"name": "t", "cam": {"speed_rpm": 1000}, "follower": {"type": "flat", "base_radius_mm": 30},
+        "motion": [{"law": "cycloidal", "lift": 9, "angle_deg": 90}, {"law": "dwell", "angle_deg": 20},
+                   {"law": "cycloidal", "lift": -9, "angle_deg": 90}, {"law": "dwell", "angle_deg": 160}]}
+
+
+def _design(dyn, **over):
+    d = {**BASE, **over, "dynamics": dyn}
+    return design_from_dict(d)
+
+
+def test_design_file_units_convert_to_si():
+    spec = _design({"mass_kg": 0.2, "spring_rate_n_per_mm": 20, "spring_preload_n": 200, "damping_n_s_per_m": 3,
+                    "external_force_n": 4, "friction_coefficient": 0.05, "safety_force_n": 100})
+    L = loads_from_spec(spec.dynamics)
+    assert (L.inertia, L.spring_rate, L.preload, L.damping, L.external, L.friction_coefficient,
+            L.safety_force_n) == (0.2, 20000.0, 200.0, 3.0, 4.0, 0.05, 100.0)
+    osc = load_design(EXAMPLES / "press_feed_oscillating.toml")
+    L = loads_from_spec(osc.dynamics)
+    assert L.spring_rate == pytest.approx(osc.dynamics.spring_rate * 180 / math.pi)
+    assert osc.dynamics.preload_unit == "N·m"
+
+
+@pytest.mark.parametrize("dyn,over,path", [
+    ({"spring_rate_n_per_mm": 20}, {}, "dynamics.mass_kg"),
+    ({"mass_kg": -1}, {}, "dynamics.mass_kg"),
+    ({"mass_kg": 1, "spring_rate_n_per_mm": -5}, {}, "dynamics.spring_rate_n_per_mm"),
+    ({"mass_kg": 1, "inertia_kg_m2": 0.1}, {}, "dynamics.inertia_kg_m2"),
+    ({"mass_kg": 1, "spring_rate": 3}, {}, "dynamics.spring_rate"),
+    ({"mass_kg": 1, "friction_coefficient": 0.1},
+     {"follower": {"type": "roller", "base_radius_mm": 30, "roller_radius_mm": 5}}, "dynamics.friction_coefficient"),
+    ({"mass_kg": 1}, {"cam": {}}, "cam.speed_rpm"),
+    ({"mass_kg": 1}, {"cam": {"kind": "conjugate", "speed_rpm": 100},
+                      "follower": {"type": "flat", "base_radius_mm": 30, "follower_distance_mm": 80}}, "dynamics"),
+    ({"mass_kg": 1, "safety_force_n": -1}, {}, "dynamics.safety_force_n"),
+    ({"mass_kg": 1, "friction_coefficient": 3}, {}, "dynamics.friction_coefficient"),
+])
+def test_bad_dynamics_input_is_refused_naming_the_field(dyn, over, path):
+    with pytest.raises(SpecError) as err:
+        _design(dyn, **over)
+    assert any(p.path == path for p in err.value.problems), [p.path for p in err.value.problems]
+
+
+def test_check_report_carries_dynamics_and_its_verdict():
+    ok = check_design(_design({"mass_kg": 0.2, "spring_rate_n_per_mm": 20, "spring_preload_n": 200,
+                               "safety_force_n": 100}))
+    d = ok.to_dict()["dynamics"]
+    assert d["contact_force_n"]["min"] == pytest.approx(200.0, rel=1e-12)  # the dwell at S = 0
+    assert ok.verdict != "unacceptable"
+    weak = check_design(_design({"mass_kg": 0.2, "spring_rate_n_per_mm": 2, "spring_preload_n": 20}))
+    assert weak.verdict == "unacceptable" and "FOLLOWER_JUMP" in weak.codes()
+    none = check_design(design_from_dict(BASE))
+    assert none.to_dict()["dynamics"] is None
+    assert dynamics_of(_design({"mass_kg": 0.2, "spring_preload_n": 200})).summary["safety_force_n"] == 0.0
+
+
+@pytest.mark.parametrize("name", ["valve_exhaust_ej1", "press_feed_oscillating"])
+def test_examples_with_dynamics_hold_their_safety_force(name):
+    rep = check_design(load_design(EXAMPLES / f"{name}.toml"))
+    d = rep.to_dict()["dynamics"]
+    assert d["contact_force_n"]["min"] >= d["safety_force_n"] > 0
+    assert not rep.codes() & {"FOLLOWER_JUMP", "CONTACT_FORCE_BELOW_SAFETY", "SELF_LOCKING"}
