@@ -40,12 +40,12 @@ def best(fn, repeat):
 def best_cold(make, repeat):
     """Best time of ``check`` on a freshly built geometry (nothing cached: the motion analysis,
     which a program computes once, and the sample grids included)."""
-    import camfab.design.profile as profile
+    import camfab.design.solvers as solvers
 
     t = math.inf
     for _ in range(repeat):
         geom = make()
-        profile._GRIDS.clear()
+        solvers._GRIDS.clear()
         t0 = time.perf_counter()
         check(geom)
         t = min(t, time.perf_counter() - t0)

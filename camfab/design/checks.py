@@ -33,10 +33,9 @@ from typing import Any, Callable
 import numpy as np
 
 from .motion_report import Finding, MotionReport, analyse_motion, verdict_of
-from .profile import (CamGeometry, Contact, OscillatingRollerContact, _bracket_min, _bracket_root,
-                      _channel_solvers, _cross, _default_step, _ExtremaPlan, _extrema_steps,
-                      _extremum_steps, _gather, _integrate_steps, _mapped, _sampling,
-                      _run)
+from .profile import CamGeometry, Contact, OscillatingRollerContact, _cross
+from .solvers import (_bracket_min, _bracket_root, _channel_solvers, _default_step, _ExtremaPlan, _extrema_steps,
+                      _extremum_steps, _gather, _integrate_steps, _mapped, _sampling, _run)
 
 __all__ = ["Code", "Finding", "Report", "check", "positive_ranges", "CUSP_TOL_MM", "DEFAULT_PRESSURE_LIMIT_DEG"]
 
@@ -583,7 +582,7 @@ def _positive_ranges_multi(edges, closed: bool, k: int, ext=()):
     of further functions, run as one: it yields parameter values and is sent a
     (k + len(ext), n) array, row j the j-th function at them (the ranges' first).  Every
     search gives exactly its own result (the solvers run one batch per search, see
-    :func:`~.profile._bracket_min_multi`).  Returns the k lists of ranges, then the extrema."""
+    :func:`~.solvers._channel_solvers`).  Returns the k lists of ranges, then the extrema."""
     edges = np.asarray(edges, dtype=float)
     per0, per1 = edges[0], edges[-1]
     step = _default_step(per1 - per0)
@@ -759,7 +758,7 @@ def _positive_ranges_multi(edges, closed: bool, k: int, ext=()):
 def _range_specs(k, edges, closed, step, ivs, grid, starts, sizes, inner, V, xs_ls, rootss):
     """The ranges of :func:`_positive_ranges_multi` from the samples (with the inserted maxima
     ``xs_ls``/``v_ls`` where any) and the refined roots: the worst-value searches (specs of
-    :func:`~.profile._extrema_steps`) and the spans ``(lo, hi, first search, searches)`` per function."""
+    :func:`~.solvers._extrema_steps`) and the spans ``(lo, hi, first search, searches)`` per function."""
     xs_ls, v_ls = xs_ls
     per0, per1 = edges[0], edges[-1]
     nint = len(ivs)
@@ -811,7 +810,7 @@ def _neg(y):
 
 
 def _positive_ranges_steps(edges, *, closed: bool = True, step: float | None = None):
-    """Generator form of :func:`positive_ranges` (for :func:`~.profile._run` / ``_gather``):
+    """Generator form of :func:`positive_ranges` (for :func:`~.solvers._run` / ``_gather``):
     one dense sampling, then every refinement batched (one call of g per round)."""
     edges = np.asarray(edges, dtype=float)
     per0, per1 = edges[0], edges[-1]

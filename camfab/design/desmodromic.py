@@ -128,11 +128,8 @@ class _Second:
         super().__init__(*args, sense=sense)  # type: ignore[call-arg]
         self._inner = self._plain(*args, sense=-sense)
 
-    def evaluate(self, phi) -> ProfileSample:
-        return _mirror(self._inner.evaluate(phi))
-
-    def evaluate_fixed(self, phi) -> ProfileSample:
-        return _mirror(self._inner.evaluate_fixed(phi))
+    def _evaluate(self, phi, rotate: bool) -> ProfileSample:
+        return _mirror(self._inner._evaluate(phi, rotate))
 
 
 class SecondTranslatingFlatContact(_Second, TranslatingFlatContact):
