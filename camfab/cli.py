@@ -216,9 +216,16 @@ def format_check(spec, report) -> str:
     if dyn:
         cf = dyn["contact_force_n"]
         low = codes & {"FOLLOWER_JUMP", "CONTACT_FORCE_BELOW_SAFETY", "SELF_LOCKING"}
-        rows.append(("Contact force (N)", _num(cf["max"]), _num(cf["min"]),
-                     "below the safety force or jumping: see findings" if low else
-                     f"never below the safety force ({dyn['safety_force_n']:g} N)"))
+        if dyn.get("form_closed"):
+            cf2 = dyn["second_contact_force_n"]
+            rev = len(dyn["load_reversals_deg"])
+            rows.append(("Contact force, follower 1 (N)", _num(cf["max"]), _num(cf["min"]), "form-closed: no jump"))
+            rows.append(("Contact force, follower 2 (N)", _num(cf2["max"]), _num(cf2["min"]),
+                         f"the load changes follower {rev} time{'s' if rev != 1 else ''} per turn"))
+        else:
+            rows.append(("Contact force (N)", _num(cf["max"]), _num(cf["min"]),
+                         "below the safety force or jumping: see findings" if low else
+                         f"never below the safety force ({dyn['safety_force_n']:g} N)"))
         key, label = (("drive_torque_nm", "Drive torque (N·m)") if "drive_torque_nm" in dyn
                       else ("drive_force_n", "Drive force (N)"))
         rows.append((label, _num(dyn[key]["max"]), _num(dyn[key]["min"]),
@@ -230,7 +237,7 @@ def format_check(spec, report) -> str:
     out += [f"{a:<{width}}{b:>13}{c:>13}  {e}" for a, b, c, e in rows]
     extra = [(k, d.get(k)) for k in ("base_radius_mm", "max_radius_mm", "area_mm2", "initial_arm_angle_deg")]
     out += [""] + [f"{k}: {v:.6g}" for k, v in extra if v is not None]
-    if dyn:
+    if dyn and not dyn.get("form_closed"):
         pre, jump = dyn["preload_needed"], dyn["jump_speed"]
         out.append(f"spring preload for the safety force: {pre['value']:.6g} {pre['unit']} (worst at "
                    f"{pre['at_deg']:.2f})")
@@ -245,6 +252,8 @@ def format_check(spec, report) -> str:
 def _num(v) -> str:
     if v is None:
         return "--"
+    if v != 0 and abs(v) < 0.01:
+        return f"{v:.3g}"  # small forces and torques keep their digits
     return f"{v:.2f}" if abs(v) < 1e7 else f"{v:.5g}"
 
 

@@ -115,3 +115,17 @@ def test_check_dynamics_json_table_and_exit_code(tmp_path, capsys):
     assert main(["check", str(p)]) == 1
     out = capsys.readouterr().out
     assert "Contact force (N)" in out and "jump speed:" in out and "spring preload for the safety force" in out
+
+
+def test_check_form_closed_dynamics_table(tmp_path, capsys):
+    """A constant-width cam with [dynamics]: both followers' forces and the load reversals, no jump rows."""
+    text = (EXAMPLES / "constant_width.toml").read_text() + "\n[dynamics]\nmass_kg = 0.4\n"
+    p = tmp_path / "cw.toml"
+    p.write_text(text)
+    assert main(["check", str(p)]) == 0
+    out = capsys.readouterr().out
+    assert "Contact force, follower 1 (N)" in out and "Contact force, follower 2 (N)" in out
+    assert "the load changes follower 2 times per turn" in out and "jump speed" not in out
+    code, d = _json(capsys, str(p))
+    assert d["dynamics"]["form_closed"] and d["dynamics"]["jump_speed"] is None
+    assert [f["code"] for f in d["findings"]].count("LOAD_REVERSAL") == 2

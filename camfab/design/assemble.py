@@ -10,7 +10,7 @@ import math
 
 from ..errors import SpecError
 from .checks import Report, check
-from .dynamics import DynamicsReport, Loads, analyse_dynamics
+from .dynamics import ContactDynamics, DynamicsReport, Loads, PairDynamics, analyse_dynamics, pair_of
 from .motion_report import Finding
 from .mechanisms import OscillatingFlat, OscillatingRoller, TranslatingCamRoller, TranslatingFlat, TranslatingRoller
 from .profile import CamGeometry
@@ -22,7 +22,7 @@ DESMODROMIC = (ConjugateTranslatingFlat, ConjugateTranslatingRoller, ConjugateOs
                ConjugateOscillatingRoller, ConstantWidthCam, ConstantDiameterCam)
 
 __all__ = ["mechanism_from_spec", "geometry_from_spec", "check_design", "knot_findings", "loads_from_spec",
-           "dynamics_of"]
+           "dynamics_of", "dynamics_model", "is_form_closed"]
 
 
 def mechanism_from_spec(spec: DesignSpec):
@@ -101,13 +101,27 @@ def loads_from_spec(d: DynamicsSpec) -> Loads:
                  d.friction_coefficient, d.safety_force_n)
 
 
+def is_form_closed(spec: DesignSpec) -> bool:
+    """Conjugate, constant-width and constant-diameter cams drive their follower both ways."""
+    return spec.cam.kind in ("conjugate", "constant_width", "constant_diameter")
+
+
+def dynamics_model(spec: DesignSpec, geometry: CamGeometry) -> ContactDynamics | PairDynamics:
+    """The force model of a design with a ``[dynamics]`` section (``evaluate(x)`` → forces at x)."""
+    loads = loads_from_spec(spec.dynamics)
+    if is_form_closed(spec):
+        return pair_of(geometry, loads, spec.speed)
+    return ContactDynamics(geometry.profiles[0], loads, spec.speed)
+
+
 def dynamics_of(spec: DesignSpec, geometry: CamGeometry | None = None) -> DynamicsReport:
     """Contact force, jump, drive torque and work of a design with a ``[dynamics]`` section."""
     if spec.dynamics is None:
         raise ValueError(f"{spec.name} has no [dynamics] section")
     geom = geometry if geometry is not None else geometry_from_spec(spec)
     return analyse_dynamics(geom, loads_from_spec(spec.dynamics), spec.speed,
-                            preload_unit=spec.dynamics.preload_unit)
+                            preload_unit=spec.dynamics.preload_unit,
+                            form_closed=is_form_closed(spec))
 
 
 def knot_findings(spec: DesignSpec) -> list[Finding]:

@@ -1,4 +1,4 @@
-"""Follower dynamics of force-closed (spring-loaded) cams: contact force, jump, drive torque.
+"""Follower dynamics: contact forces, jump, drive torque — spring-loaded and form-closed followers.
 
 Kinetostatics at constant cam speed (``spec/valve-case-and-textbook.md`` §3.9 items 5–6): the
 motion is imposed, so every force follows from S, S′, S″ and the exact geometry; nothing is
@@ -30,6 +30,10 @@ The force on the cam is −(N·n + f) at P; the drive torque that keeps ω const
 translating cam needs the drive force along its travel instead.  Work per cycle ∮T dφ is the
 energy lost to damping and friction (0 without them).
 
+Form-closed followers (conjugate pairs, constant-width and constant-diameter cams) touch the cam
+twice and cannot jump: follower 1 carries G where G > 0, follower 2 where G < 0 (:class:`PairDynamics`);
+where G changes sign the load crosses to the other follower (``LOAD_REVERSAL``, info).
+
 Design helpers: the preload that keeps N ≥ the safety force everywhere (N is linear in F₀),
 and the speed at which the follower starts to jump (N ≥ F_s is a quadratic in the speed at every
 angle; D does not depend on the speed).
@@ -46,7 +50,8 @@ from ..units import DEG, RPM
 from .motion_report import Finding
 from .profile import CamGeometry, Contact, extremum, integrate
 
-__all__ = ["Loads", "DynamicsSample", "DynamicsReport", "ContactDynamics", "analyse_dynamics"]
+__all__ = ["Loads", "DynamicsSample", "DynamicsReport", "ContactDynamics", "PairDynamics", "pair_of",
+           "analyse_dynamics"]
 
 
 @dataclass(frozen=True)
@@ -92,6 +97,7 @@ class DynamicsSample:
     bearing_force: np.ndarray   # |N·n + f| (N): the load on the camshaft bearings
     drive: np.ndarray           # drive torque (N·m), or drive force along the travel (N) of a translating cam
     power: np.ndarray           # drive power (W)
+    contact_force_2: np.ndarray | None = None  # form-closed followers: follower 2's contact force (N)
 
 
 class ContactDynamics:
@@ -141,13 +147,12 @@ class ContactDynamics:
             u[:, 0] = c.sense * self.speed * 1e-3
         return x, S, s, w, u
 
-    def evaluate(self, x) -> DynamicsSample:
-        """Forces, torque and power at parameters x (radians, or mm of travel)."""
+    def _lever(self, x):
+        """(x, S, q̇, the fixed-frame sample, D, v̂) at parameters x: D = n·w + μ·v̂·w is the
+        generalised force per newton of contact force, v̂ the sliding direction (0 for rollers)."""
         L = self.loads
         x, S, s, w, u = self._kinematics(x)
-        rate, k = self.speed, self.q_per_s
-        q, qd, qdd = k * S[0], k * S[1] * rate, k * S[2] * rate * rate
-        G = L.inertia * qdd + L.preload + L.spring_rate * q + L.damping * qd + L.external
+        qd = self.q_per_s * S[1] * self.speed
         n = s.normal
         D = n[:, 0] * w[:, 0] + n[:, 1] * w[:, 1]
         vhat = np.zeros_like(u)
@@ -157,19 +162,36 @@ class ContactDynamics:
             moving = speed > 0
             vhat[moving] = rel[moving] / speed[moving, None]
             D = D + L.friction_coefficient * (vhat[:, 0] * w[:, 0] + vhat[:, 1] * w[:, 1])
-        with np.errstate(divide="ignore", invalid="ignore"):  # D = 0: wedged (N infinite), see SELF_LOCKING
-            N = G / D
-            f = (L.friction_coefficient * N)[:, None] * vhat
-            F = -(N[:, None] * n + f)  # on the cam, at P
+        return x, S, qd, s, D, vhat, u
+
+    def required(self, S: np.ndarray) -> np.ndarray:
+        """G = M·q̈ + F₀ + k·q + c·q̇ + F_ext from S, S′, S″ (rows of S)."""
+        L, k, rate = self.loads, self.q_per_s, self.speed
+        return (L.inertia * (k * S[2] * rate * rate) + L.preload + L.spring_rate * (k * S[0])
+                + L.damping * (k * S[1] * rate) + L.external)
+
+    def _transmit(self, N, s, vhat, u):
+        """(friction μN, bearing force, drive, power) when the cam pushes with N (newtons) along n."""
+        mu = self.loads.friction_coefficient
+        with np.errstate(invalid="ignore"):  # N = ±inf where wedged
+            f = (mu * N)[:, None] * vhat
+            F = -(N[:, None] * s.normal + f)  # on the cam, at P
         P = s.point * 1e-3
         if self.contact.closed:
             drive = self.contact.sense * (P[:, 0] * F[:, 1] - P[:, 1] * F[:, 0])
-            power = drive * rate
+            power = drive * self.speed
         else:  # drive force along the plate's motion (velocity u)
             drive = -F[:, 0] * np.sign(u[:, 0])
             power = drive * np.abs(u[:, 0])
-        return DynamicsSample(x, G, D, N, L.friction_coefficient * N * (vhat != 0).any(axis=1),
-                              np.hypot(F[:, 0], F[:, 1]), drive, power)
+        return mu * N * (vhat != 0).any(axis=1), np.hypot(F[:, 0], F[:, 1]), drive, power
+
+    def evaluate(self, x) -> DynamicsSample:
+        """Forces, torque and power at parameters x (radians, or mm of travel)."""
+        x, S, qd, s, D, vhat, u = self._lever(x)
+        G = self.required(S)
+        with np.errstate(divide="ignore", invalid="ignore"):  # D = 0: wedged (N infinite), see SELF_LOCKING
+            N = G / D
+        return DynamicsSample(x, G, D, N, *self._transmit(N, s, vhat, u))
 
     # ---- design helpers -----------------------------------------------------------------
     def _speed_terms(self, x):
@@ -204,6 +226,52 @@ class ContactDynamics:
         return self.loads.preload + self.loads.safety_force_n * sm.lever - sm.required
 
 
+class PairDynamics:
+    """Forces on a form-closed (desmodromic) follower: one rigid follower touching the cam twice —
+    conjugate pairs, constant-width and constant-diameter cams.
+
+    Follower 2's coordinate moves against follower 1's (q₂ = const − q₁), so the cam must supply G
+    (of follower 1's coordinate) through follower 1 where G > 0 and through follower 2 where G < 0:
+    N₁ = max(G, 0)/D₁, N₂ = max(−G, 0)/D₂ (no preload between the two, no clearance).  Where G
+    changes sign the load passes from one follower to the other; across a clearance the follower
+    knocks there (``LOAD_REVERSAL``).  The follower cannot leave the cam: no jump.
+
+    Parameters
+    ----------
+    first, second : ContactDynamics
+        Follower 1's and follower 2's contacts, each with its own coordinate.
+    shift : float
+        Follower 2 is evaluated at φ + shift (π for a constant-width/diameter cam, whose one
+        profile follower 2 touches half a turn later; 0 for a conjugate pair).
+    """
+
+    def __init__(self, first: ContactDynamics, second: ContactDynamics, shift: float = 0.0):
+        self.first, self.second, self.shift = first, second, float(shift)
+        self.contact, self.loads, self.speed = first.contact, first.loads, first.speed
+
+    def evaluate(self, x) -> DynamicsSample:
+        x, S, qd, s1, D1, v1, u1 = self.first._lever(x)
+        _, _, _, s2, D2, v2, u2 = self.second._lever(x + self.shift)
+        G = self.first.required(S)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            N1 = np.where(G > 0, G / D1, 0.0)
+            N2 = np.where(G < 0, -G / D2, 0.0)
+        f1, b1, d1, p1 = self.first._transmit(N1, s1, v1, u1)
+        f2, b2, d2, p2 = self.second._transmit(N2, s2, v2, u2)
+        # one of N₁, N₂ is 0 at every angle: the bearing carries the other's force
+        return DynamicsSample(x, G, np.where(G < 0, D2, D1), N1, f1 + f2, b1 + b2, d1 + d2, p1 + p2, N2)
+
+
+def pair_of(geometry: CamGeometry, loads: Loads, speed: float) -> PairDynamics:
+    """The :class:`PairDynamics` of a desmodromic geometry (two profiles, or one touched twice)."""
+    profs = geometry.profiles
+    first = ContactDynamics(profs[0], loads, speed)
+    if len(profs) == 2:  # conjugate: follower 2 is the mirror image of a plain follower on a mirrored cam,
+        # and every scalar (N, D, G, torque, power) is the same computed in that mirrored world
+        return PairDynamics(first, ContactDynamics(getattr(profs[1], "_inner", profs[1]), loads, speed))
+    return PairDynamics(first, ContactDynamics(profs[0], loads, speed), math.pi)
+
+
 @dataclass(frozen=True)
 class DynamicsReport:
     """Summary and findings of :func:`analyse_dynamics` (user units: N, N·m, J, W, rpm, degrees)."""
@@ -216,79 +284,132 @@ def _x_user(c: Contact, x: float) -> float:
     return math.degrees(x) if c.closed else x
 
 
-def analyse_dynamics(geometry: CamGeometry, loads: Loads, speed: float, *, preload_unit: str = "N") -> DynamicsReport:
-    """Contact force, jump, bearing load, drive torque and work per cycle of a force-closed cam.
+def analyse_dynamics(geometry: CamGeometry, loads: Loads, speed: float, *, preload_unit: str = "N",
+                     form_closed: bool | None = None) -> DynamicsReport:
+    """Contact force(s), jump or load reversals, bearing load, drive torque and work per cycle.
 
+    A force-closed (spring-loaded) follower is checked for jump and its safety force, with the
+    preload and the speed at the limit; a form-closed follower (``form_closed``, default: the
+    geometry is desmodromic) reports both followers' forces and where the load passes between them.
     Every extreme is exact (refined between the motion's breakpoints); ranges are located by
     root refinement.  ``speed`` is ω (rad/s), or mm/s for a translating cam.
     """
-    from .checks import positive_ranges
+    if form_closed is None:
+        from .desmodromic import DesmodromicGeometry
 
-    if len(geometry.profiles) != 1:
-        raise ValueError("dynamics applies to a single spring-loaded follower (not to form-closed cams)")
+        form_closed = isinstance(geometry, DesmodromicGeometry)
+    if not form_closed and len(geometry.profiles) != 1:
+        raise ValueError("a force-closed cam has one follower")
     c = geometry.profiles[0]
-    dyn = ContactDynamics(c, loads, speed)
-    edges = c.breakpoints
+    dyn = pair_of(geometry, loads, speed) if form_closed else ContactDynamics(c, loads, speed)
+    edges = np.unique(np.concatenate([c.breakpoints, np.mod(c.breakpoints - math.pi, 2 * math.pi)])) \
+        if form_closed and len(geometry.profiles) == 1 else geometry.breakpoints
     closed = c.closed
     ev = dyn.evaluate
 
     def ext(fn, maximize=False):
         at, val = extremum(lambda x: fn(ev(x)), edges, maximize=maximize)
-        return float(val), _x_user(c, at)
+        return {"min" if not maximize else "max": float(val),
+                "at_min_deg" if not maximize else "at_max_deg": _x_user(c, at)}
 
-    nmin, at_nmin = ext(lambda s: s.contact_force)
-    nmax, at_nmax = ext(lambda s: s.contact_force, True)
-    bmax, at_bmax = ext(lambda s: s.bearing_force, True)
-    tmin, at_tmin = ext(lambda s: s.drive)
-    tmax, at_tmax = ext(lambda s: s.drive, True)
-    dmin, at_dmin = ext(lambda s: s.lever)
+    force = {**ext(lambda s: s.contact_force), **ext(lambda s: s.contact_force, True)}
+    drive = {**ext(lambda s: s.drive), **ext(lambda s: s.drive, True)}
+    bearing = ext(lambda s: s.bearing_force, True)
     # the work may cancel to 0 (no damping, no friction): an absolute target of 1e-12 of the
     # largest |drive| over the cycle
     span = float(edges[-1] - edges[0])
-    work = integrate(lambda x: ev(x).drive, edges, atol=1e-12 * max(abs(tmin), abs(tmax)) * span)
+    work = integrate(lambda x: ev(x).drive, edges, atol=1e-12 * max(abs(drive["min"]), abs(drive["max"])) * span)
     work *= 1.0 if closed else 1e-3
     cycle_s = (2 * math.pi / speed) if closed else c.period / speed
+    summary: dict[str, Any] = {
+        "form_closed": form_closed,
+        "contact_force_n": {k: force[k] for k in ("min", "max", "at_min_deg", "at_max_deg")},
+        "safety_force_n": None if form_closed else loads.safety_force_n,
+        "bearing_force_n": bearing,
+        ("drive_torque_nm" if closed else "drive_force_n"): {k: drive[k] for k in ("min", "max", "at_min_deg",
+                                                                                    "at_max_deg")},
+        "work_per_cycle_j": work,
+        "mean_power_w": work / cycle_s,
+    }
+    findings: list[Finding] = []
+    lock = _self_locking(ev, edges, c)
+    findings += lock
+    if form_closed:
+        second = {**ext(lambda s: s.contact_force_2), **ext(lambda s: s.contact_force_2, True)}
+        summary["second_contact_force_n"] = {k: second[k] for k in ("min", "max", "at_min_deg", "at_max_deg")}
+        summary["preload_needed"] = summary["jump_speed"] = None
+        rev = _reversals(ev, edges, c)
+        summary["load_reversals_deg"] = [[f.from_deg, f.to_deg] for f in rev]
+        findings += rev
+    else:
+        findings += _force_closed(dyn, ev, edges, c, loads, speed, preload_unit, summary)
+    return DynamicsReport(summary, tuple(findings))
+
+
+def _self_locking(ev, edges, c) -> list[Finding]:
+    from .checks import positive_ranges
+
+    unit = "deg" if c.closed else "mm"
+    out = []
+    for lo, hi, xw, gw in positive_ranges(lambda x: -ev(x).lever, edges, closed=c.closed):
+        out.append(Finding(
+            "SELF_LOCKING", "error", _x_user(c, lo), _x_user(c, hi), float(-gw), 0.0,
+            f"friction wedges the follower from {_x_user(c, lo):.2f} to {_x_user(c, hi):.2f} {unit}: no contact "
+            "force can move it (μ too high for the pressure angle there); lower the friction coefficient or "
+            "the pressure angle (larger base radius)"))
+    return out
+
+
+def _reversals(ev, edges, c) -> list[Finding]:
+    """LOAD_REVERSAL (info) between consecutive stretches where different followers carry the load."""
+    from .checks import positive_ranges
+
+    unit = "deg" if c.closed else "mm"
+    runs = sorted([(lo, hi, 1) for lo, hi, _, _ in positive_ranges(lambda x: ev(x).required, edges)]
+                  + [(lo, hi, 2) for lo, hi, _, _ in positive_ranges(lambda x: -ev(x).required, edges)])
+    out = []
+    if len({k for _, _, k in runs}) < 2:
+        return out
+    for (lo, hi, k), (lo2, _, k2) in zip(runs, runs[1:] + runs[:1]):
+        if k != k2:
+            a, b = _x_user(c, hi), _x_user(c, lo2)
+            where = f"at {a:.2f} {unit}" if abs(b - a) < 1e-9 else f"between {a:.2f} and {b:.2f} {unit}"
+            out.append(Finding(
+                "LOAD_REVERSAL", "info", a, b, None, None,
+                f"the load passes from follower {k} to follower {k2} {where}: across a clearance the follower "
+                "knocks there — keep the clearance small (or preload the pair)"))
+    return sorted(out, key=lambda f: f.from_deg)
+
+
+def _force_closed(dyn, ev, edges, c, loads, speed, preload_unit, summary) -> list[Finding]:
+    """Preload and jump speed into ``summary``; FOLLOWER_JUMP and CONTACT_FORCE_BELOW_SAFETY."""
+    from .checks import positive_ranges
+
+    closed, unit = c.closed, ("deg" if c.closed else "mm")
     at_pre, pre = extremum(lambda x: dyn.needed_preload(x), edges, maximize=True)
     with np.errstate(invalid="ignore"):  # the per-angle jump speed is +inf where N never drops
         at_jump, r_jump = extremum(lambda x: dyn.jump_speed(x), edges)
+    summary["preload_needed"] = {"value": float(pre), "unit": preload_unit, "at_deg": _x_user(c, at_pre)}
+    summary["jump_speed"] = _speed_user(r_jump, closed, _x_user(c, at_jump))
     fs = loads.safety_force_n
-    summary: dict[str, Any] = {
-        "contact_force_n": {"min": nmin, "max": nmax, "at_min_deg": at_nmin, "at_max_deg": at_nmax},
-        "safety_force_n": fs,
-        "bearing_force_n": {"max": bmax, "at_max_deg": at_bmax},
-        ("drive_torque_nm" if closed else "drive_force_n"): {"min": tmin, "max": tmax, "at_min_deg": at_tmin,
-                                                              "at_max_deg": at_tmax},
-        "work_per_cycle_j": work,
-        "mean_power_w": work / cycle_s,
-        "preload_needed": {"value": float(pre), "unit": preload_unit, "at_deg": _x_user(c, at_pre)},
-        "jump_speed": _speed_user(r_jump, closed, _x_user(c, at_jump)),
-    }
-    findings: list[Finding] = []
-    unit = "deg" if closed else "mm"
     speed_txt = _speed_text(speed, closed)
-    if dmin <= 0:
-        for lo, hi, xw, gw in positive_ranges(lambda x: -ev(x).lever, edges, closed=closed):
-            findings.append(Finding(
-                "SELF_LOCKING", "error", _x_user(c, lo), _x_user(c, hi), float(-gw), 0.0,
-                f"friction wedges the follower from {_x_user(c, lo):.2f} to {_x_user(c, hi):.2f} {unit}: no contact "
-                "force can move it (μ too high for the pressure angle there); lower the friction coefficient or "
-                "the pressure angle (larger base radius)"))
     fix = (f"raise the spring preload to at least {pre:.6g} {preload_unit}" if math.isfinite(pre) else
            "stiffen the spring")
     if math.isfinite(r_jump) and r_jump > 0:
         fix += f", or run slower than {_speed_text(r_jump, closed)}"
+    out = []
     for lo, hi, xw, gw in positive_ranges(lambda x: -ev(x).contact_force, edges, closed=closed):
-        findings.append(Finding(
+        out.append(Finding(
             "FOLLOWER_JUMP", "error", _x_user(c, lo), _x_user(c, hi), float(-gw), 0.0,
             f"the follower leaves the cam from {_x_user(c, lo):.2f} to {_x_user(c, hi):.2f} {unit} at {speed_txt}: "
             f"the contact force falls to {-gw:.6g} N (the spring cannot hold it); {fix}"))
     if fs > 0:
         for lo, hi, xw, gw in positive_ranges(lambda x: fs - ev(x).contact_force, edges, closed=closed):
-            findings.append(Finding(
+            out.append(Finding(
                 "CONTACT_FORCE_BELOW_SAFETY", "error", _x_user(c, lo), _x_user(c, hi), float(fs - gw), fs,
                 f"the contact force is below the safety force {fs:g} N from {_x_user(c, lo):.2f} to "
                 f"{_x_user(c, hi):.2f} {unit} (down to {fs - gw:.6g} N at {_x_user(c, xw):.2f} {unit}); {fix}"))
-    return DynamicsReport(summary, tuple(findings))
+    return out
 
 
 def _speed_user(r: float, closed: bool, at: float) -> dict[str, Any]:

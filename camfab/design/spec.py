@@ -154,7 +154,8 @@ class DynamicsSpec:
     ``inertia_kg_m2`` (about the pivot, required), ``spring_rate_nm_per_deg``, ``spring_preload_nm``,
     ``damping_nm_s_per_deg``, ``external_torque_nm``.  Both: ``friction_coefficient`` (sliding
     contacts: knife edges and flat faces) and ``safety_force_n`` (the smallest acceptable contact
-    force).  The fields of the other motion are None."""
+    force).  Form-closed cams (conjugate, constant width/diameter) take no spring and no safety force.
+    The fields of the other motion are None."""
 
     motion: str
     inertia: float
@@ -520,9 +521,10 @@ def _dynamics(v: _Validator, data: Mapping[str, Any], cam: CamSpec, fol: Followe
                   f"{kind} follower takes: " + ", ".join(own))
     v.keys({k: t[k] for k in t if k not in other}, own + _DYN_COMMON, "dynamics")
     if cam.kind in ("conjugate", "constant_width", "constant_diameter"):
-        v.add("dynamics", "...", f"a {cam.kind.replace('_', '-')} cam drives its follower both ways (form "
-              "closure): it cannot jump, and there is no spring to size", "remove the [dynamics] section")
-        return None
+        for k in (own[1], own[2], "safety_force_n"):
+            if k in t:
+                v.add(f"dynamics.{k}", t[k], f"a {cam.kind.replace('_', '-')} cam drives its follower both ways "
+                      "(form closure): it has no return spring and cannot jump", f"remove {k}")
     if not cam.speed_given:
         key = "speed_mm_s" if cam.kind == "translating" else "speed_rpm"
         v.add(f"cam.{key}", None, "dynamics needs the cam speed", f"add {key} = ... to [cam]")

@@ -129,7 +129,11 @@ def _highlights(spec, report) -> list[str]:
     if face and face.get("left") is not None:
         out.append(f"Face length needed {fmt(face['left'])} mm left and {fmt(face['right'])} mm right of the stem")
     cf = (d.get("dynamics") or {}).get("contact_force_n")
-    if cf:
+    if cf and d["dynamics"].get("form_closed"):
+        n = len(d["dynamics"]["load_reversals_deg"])
+        out.append(f"Form-closed follower: the load passes between the followers {n} time{'s' if n != 1 else ''} "
+                   "per cycle")
+    elif cf:
         out.append(f"Smallest contact force {fmt(cf['min'])} N at {fmt_at(cf['at_min_deg'], xu.strip())} "
                    f"(safety force {d['dynamics']['safety_force_n']:g} N)")
     return out
@@ -147,6 +151,8 @@ def dynamics_rows(spec, report) -> list[dict[str, Any]]:
     if not dyn:
         return []
     xu = "°" if report.x_unit == "deg" else "mm"
+    if dyn.get("form_closed"):
+        return _pair_rows(dyn, report, xu)
     fs, codes, none = dyn["safety_force_n"], report.codes(), _cell(None)
     cf = dyn["contact_force_n"]
     bad = next((text.format(fs=fs) for code, text in _DYNAMICS_CODES if code in codes), None)
@@ -154,6 +160,28 @@ def dynamics_rows(spec, report) -> list[dict[str, Any]]:
     rows = [_row("Contact force (N)", _cell(cf["max"], cf["at_max_deg"], xu), _cell(cf["min"], cf["at_min_deg"], xu),
                  bad or ok_text, "bad" if bad else "ok"),
             _row("Safety force (N)", _cell(fs), none, "Smallest acceptable contact force (design input)")]
+    return rows + _drive_rows(dyn, report, xu) + _limit_rows(spec, dyn, xu)
+
+
+def _pair_rows(dyn: dict[str, Any], report, xu: str) -> list[dict[str, Any]]:
+    """The dynamics table of a form-closed follower: both contact forces and the load reversals."""
+    none, rows = _cell(None), []
+    for k, key in ((1, "contact_force_n"), (2, "second_contact_force_n")):
+        cf = dyn[key]
+        rows.append(_row(f"Contact force, follower {k} (N)", _cell(cf["max"], cf["at_max_deg"], xu),
+                         _cell(cf["min"], cf["at_min_deg"], xu),
+                         "Form closure: the follower cannot leave the cam" if k == 1 else
+                         "Pushes where follower 1 cannot (the load has changed sides)"))
+    rev = dyn["load_reversals_deg"]
+    where = ", ".join(f"{a:.1f}{xu}" for a, _ in rev) or "never"
+    rows.append(_row("Load reversals", {**none, "text": str(len(rev))}, none,
+                     f"The load passes to the other follower at {where}: across a clearance the follower knocks"))
+    return rows + _drive_rows(dyn, report, xu)
+
+
+def _drive_rows(dyn: dict[str, Any], report, xu: str) -> list[dict[str, Any]]:
+    """Bearing force, drive torque (force), work per cycle and mean power rows."""
+    none, rows = _cell(None), []
     b = dyn["bearing_force_n"]
     rows.append(_row("Bearing force (N)", _cell(b["max"], b["at_max_deg"], xu), none,
                      "Largest load on the camshaft bearings" if report.x_unit == "deg"
@@ -167,7 +195,7 @@ def dynamics_rows(spec, report) -> list[dict[str, Any]]:
     rows.append(_row("Work per cycle (J)", _cell(dyn["work_per_cycle_j"]), none,
                      "Energy lost to damping and friction in one cycle"))
     rows.append(_row("Mean power (W)", _cell(dyn["mean_power_w"]), none, "Mean drive power at the design speed"))
-    return rows + _limit_rows(spec, dyn, xu)
+    return rows
 
 
 def _limit_rows(spec, dyn: dict[str, Any], xu: str) -> list[dict[str, Any]]:

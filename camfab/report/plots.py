@@ -438,6 +438,10 @@ def _mark_extremes(ax, ext: dict | None, unit: str, xu: str, colour: str, lim: f
                     textcoords="offset points", fontsize=7, va=va, color=colour)
 
 
+def _max_only(ext: dict | None) -> dict | None:
+    return None if not ext else {"max": ext["max"], "at_max_deg": ext["at_max_deg"]}
+
+
 def dynamics_figure(spec, geometry, report, *, n: int = _N):
     """Contact force and drive torque (drive force of a translating cam) against the cam angle.
 
@@ -458,8 +462,7 @@ def dynamics_figure(spec, geometry, report, *, n: int = _N):
     -------
     matplotlib.figure.Figure
     """
-    from ..design.assemble import loads_from_spec
-    from ..design.dynamics import ContactDynamics
+    from ..design.assemble import dynamics_model
 
     if spec.dynamics is None:
         raise ValueError(f"{spec.name} has no [dynamics] section")
@@ -467,7 +470,8 @@ def dynamics_figure(spec, geometry, report, *, n: int = _N):
     axis = axis_of(prog)
     c = geometry.profiles[0]
     x = sample_grid(c.period, c.breakpoints, n)
-    sm = ContactDynamics(c, loads_from_spec(spec.dynamics), spec.speed).evaluate(x)
+    sm = dynamics_model(spec, geometry).evaluate(x)
+    pair = sm.contact_force_2 is not None
     dyn = report.summary.get("dynamics") or {}
     locking = bool(report.by_code("SELF_LOCKING"))
     xu, fs = axis.unit, spec.dynamics.safety_force_n
@@ -477,13 +481,18 @@ def dynamics_figure(spec, geometry, report, *, n: int = _N):
         fig = new_figure(9.0, 6.4)
         ax, ax2 = fig.subplots(2, 1, sharex=True, height_ratios=(3, 2))
         force, lim = _finite_view(sm.contact_force, locking)
-        ax.plot(x * axis.scale, force, color="C0", label="contact force N")
-        ax.axhline(0.0, color="0.1", lw=0.9, label="N = 0 (jump limit)")
-        if fs > 0:
+        ax.plot(x * axis.scale, force, color="C0", label="follower 1" if pair else "contact force N")
+        if pair:
+            ax.plot(x * axis.scale, sm.contact_force_2, color="C1", label="follower 2")
+            _mark_extremes(ax, _max_only(dyn.get("second_contact_force_n")), "N", xu, "0.1", lim)
+        ax.axhline(0.0, color="0.1", lw=0.9, label="N = 0" if pair else "N = 0 (jump limit)")
+        if fs:
             ax.axhline(fs, color=_BAD, lw=1.0, ls="--", label=f"safety force {fs:g} N")
         for codes, colour, label in _DYNAMICS_SHADES:
             shade(ax, finding_spans(report.findings, codes, axis), color=colour, label=label)
-        _mark_extremes(ax, dyn.get("contact_force_n"), "N", xu, "0.1", lim)
+        # a form-closed pair's minima are the 0 N of the unloaded follower: only the maxima are marked
+        _mark_extremes(ax, _max_only(dyn.get("contact_force_n")) if pair else dyn.get("contact_force_n"), "N", xu,
+                       "0.1", lim)
         ax.set_ylabel("contact force N (N)")
         ax.set_title("Contact force", loc="left", fontsize=9)
         ax.margins(y=0.15)

@@ -239,16 +239,19 @@ def dynamics_columns(spec, geometry, *, step_deg: float = 1.0) -> tuple[list[str
         Angle (deg, or travel in mm), contact, friction and bearing force (N), drive torque (N·m) or
         drive force (N), power (W); NaN where not finite.
     """
-    from ..design.assemble import loads_from_spec
-    from ..design.dynamics import ContactDynamics
+    from ..design.assemble import dynamics_model
 
     if spec.dynamics is None:
         raise ValueError(f"{spec.name} has no [dynamics] section")
     x = sample_params(geometry, step_deg)
-    sm = ContactDynamics(geometry.profiles[0], loads_from_spec(spec.dynamics), spec.speed).evaluate(x)
-    head = ["Cam angle (deg)" if geometry.closed else "Cam travel (mm)", "Contact force (N)", "Friction force (N)",
+    sm = dynamics_model(spec, geometry).evaluate(x)
+    pair = sm.contact_force_2 is not None
+    head = ["Cam angle (deg)" if geometry.closed else "Cam travel (mm)",
+            "Contact force, follower 1 (N)" if pair else "Contact force (N)",
+            *(["Contact force, follower 2 (N)"] if pair else []), "Friction force (N)",
             "Bearing force (N)", "Drive torque (N·m)" if geometry.closed else "Drive force (N)", "Power (W)"]
-    cols = [geometry.to_user(x), sm.contact_force, sm.friction_force, sm.bearing_force, sm.drive, sm.power]
+    cols = [geometry.to_user(x), sm.contact_force, *([sm.contact_force_2] if pair else []), sm.friction_force,
+            sm.bearing_force, sm.drive, sm.power]
     return head, [np.where(np.isfinite(c), c, np.nan) for c in cols]
 
 
@@ -262,6 +265,15 @@ def dynamics_summary_rows(report) -> list[tuple[str, Any, str, float | None]]:
     torque = "drive_torque_nm" in d
     t, tu = (d["drive_torque_nm"], "N·m") if torque else (d["drive_force_n"], "N")
     word = "drive torque" if torque else "drive force"
+    common = [("Maximum bearing force", b["max"], "N", b["at_max_deg"]),
+              (f"Minimum {word}", t["min"], tu, t["at_min_deg"]), (f"Maximum {word}", t["max"], tu, t["at_max_deg"]),
+              ("Work per cycle", d["work_per_cycle_j"], "J", None), ("Mean power", d["mean_power_w"], "W", None)]
+    if d.get("form_closed"):
+        cf2 = d["second_contact_force_n"]
+        return [("Maximum contact force, follower 1", cf["max"], "N", cf["at_max_deg"]),
+                ("Maximum contact force, follower 2", cf2["max"], "N", cf2["at_max_deg"]), *common,
+                *[("Load passes to the other follower", lo, "deg" if torque else "mm", None)
+                  for lo, _ in d["load_reversals_deg"]]]
     pre, js = d["preload_needed"], d["jump_speed"]
     return [("Minimum contact force", cf["min"], "N", cf["at_min_deg"]),
             ("Maximum contact force", cf["max"], "N", cf["at_max_deg"]),

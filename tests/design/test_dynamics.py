@@ -250,8 +250,9 @@ def test_design_file_units_convert_to_si():
     ({"mass_kg": 1, "friction_coefficient": 0.1},
      {"follower": {"type": "roller", "base_radius_mm": 30, "roller_radius_mm": 5}}, "dynamics.friction_coefficient"),
     ({"mass_kg": 1}, {"cam": {}}, "cam.speed_rpm"),
-    ({"mass_kg": 1}, {"cam": {"kind": "conjugate", "speed_rpm": 100},
-                      "follower": {"type": "flat", "base_radius_mm": 30, "follower_distance_mm": 80}}, "dynamics"),
+    ({"mass_kg": 1, "spring_preload_n": 50}, {"cam": {"kind": "conjugate", "speed_rpm": 100},
+                      "follower": {"type": "flat", "base_radius_mm": 30, "follower_distance_mm": 80}},
+     "dynamics.spring_preload_n"),
     ({"mass_kg": 1, "safety_force_n": -1}, {}, "dynamics.safety_force_n"),
     ({"mass_kg": 1, "friction_coefficient": 3}, {}, "dynamics.friction_coefficient"),
 ])
@@ -280,3 +281,85 @@ def test_examples_with_dynamics_hold_their_safety_force(name):
     d = rep.to_dict()["dynamics"]
     assert d["contact_force_n"]["min"] >= d["safety_force_n"] > 0
     assert not rep.codes() & {"FOLLOWER_JUMP", "CONTACT_FORCE_BELOW_SAFETY", "SELF_LOCKING"}
+
+
+# ---------------------------------------------------------------------------
+# form-closed followers: conjugate pairs, constant width and constant diameter
+from camfab.design.desmodromic import (ConjugateOscillatingFlat, ConjugateOscillatingRoller,  # noqa: E402
+                                       ConjugateTranslatingFlat, ConjugateTranslatingRoller, ConstantDiameterCam,
+                                       ConstantWidthCam, desmodromic_geometry)
+from camfab.design.dynamics import pair_of  # noqa: E402
+
+E9 = MotionProgram.from_segments([("modified_sine", 10, 50), ("dwell", 0, 40), ("cycloidal", -10, 50),
+                                  ("dwell", 0, 40), ("poly345", 10, 50), ("dwell", 0, 40), ("poly4567", -10, 50),
+                                  ("dwell", 0, 40)])
+E2 = MotionProgram.from_segments([("poly4567", 10, 120), ("dwell", 0, 120), ("poly4567", -10, 120)])
+PAIRS = [
+    (ConjugateTranslatingFlat(100, 210), E9, Loads(0.4, damping=25.0, external=5.0, friction_coefficient=0.1)),
+    (ConjugateTranslatingFlat(100, 210, "ccw"), E9, Loads(0.4)),
+    (ConjugateTranslatingRoller(35, 7, 110, 4.0, 6.0, "ccw"), E9, Loads(0.4, damping=25.0, external=-3.0)),
+    (ConjugateTranslatingRoller(35, 7, 110, 0.0, -5.0), E9, Loads(0.4)),
+    (ConjugateOscillatingFlat(40, 100, 5, 60), E2, Loads(0.01, damping=0.02, friction_coefficient=0.08)),
+    (ConjugateOscillatingRoller(40, 10, 100, 90, 95, 6.0, "ccw"), E2, Loads(0.01, external=0.3)),
+    (ConstantWidthCam(40, 100, 120), None, Loads(0.4, damping=10.0, friction_coefficient=0.05)),
+    (ConstantDiameterCam(40, 8, 110, 150, 0.0, "ccw"), None, Loads(0.4, external=2.0)),
+]
+
+
+@pytest.mark.parametrize("mech,prog,L", PAIRS)
+def test_form_closed_power_balance_and_load_sharing(mech, prog, L):
+    """Follower 1 carries G where G > 0 and follower 2 where G < 0 (never both); the drive torque from
+    both contacts' forces on the cam balances G·q̇₁ plus the friction loss — an independent check that
+    follower 2's contact (mirrored conjugate, or the same profile half a turn on) is mapped right."""
+    g = desmodromic_geometry(mech, prog)
+    pair = pair_of(g, L, W)
+    x = np.linspace(0.0, 2 * np.pi, 1441)[:-1] + 1e-3
+    s = pair.evaluate(x)
+    G = s.required
+    assert np.all(s.contact_force >= 0) and np.all(s.contact_force_2 >= 0)
+    assert np.all((s.contact_force == 0) | (s.contact_force_2 == 0))
+    np.testing.assert_allclose(np.where(G > 0, s.contact_force, -s.contact_force_2) * s.lever, G,
+                               rtol=1e-12, atol=1e-12 * np.abs(G).max())
+    S = g.profiles[0].motion.evaluate(x, (0, 1, 2))
+    qd = pair.first.q_per_s * S[1] * W
+    loss = 0.0
+    for dyn, shift, N in ((pair.first, 0.0, s.contact_force), (pair.second, pair.shift, s.contact_force_2)):
+        if dyn.sliding and L.friction_coefficient:
+            _, S2, _, w, u = dyn._kinematics(x + shift)
+            qd2 = dyn.q_per_s * S2[1] * W
+            loss = loss + L.friction_coefficient * N * np.hypot(*(u - w * qd2[:, None]).T)
+    scale = np.abs(G * qd).max() + 1e-12
+    np.testing.assert_allclose(s.power, G * qd + loss, rtol=0, atol=1e-10 * scale)
+    rep = analyse_dynamics(g, L, W)
+    assert rep.summary["form_closed"] and rep.summary["jump_speed"] is None
+    assert not [f for f in rep.findings if f.severity == "error"]
+
+
+def test_constant_width_shm_loads_and_reversals():
+    """Constant width, SHM rise 120°: G = m·S″·ω², so follower 1 pushes while S″ > 0 and follower 2 while
+    S″ < 0; the load crosses at the SHM mid-points 60° and 240° only (the dwells carry nothing)."""
+    mech = ConstantWidthCam(40, 100, 120)
+    g = desmodromic_geometry(mech)
+    rep = analyse_dynamics(g, Loads(0.4), W)
+    h = 20.0  # width − 2·Rb
+    peak = 0.4 * (h / 2) * (math.pi / (120 * math.pi / 180)) ** 2 * 1e-3 * W * W  # m·(h/2)(π/β)²·ω²
+    assert rep.summary["contact_force_n"]["max"] == pytest.approx(peak, rel=1e-10)
+    assert rep.summary["second_contact_force_n"]["max"] == pytest.approx(peak, rel=1e-10)
+    rev = [f for f in rep.findings if f.code == "LOAD_REVERSAL"]
+    assert [(round(f.from_deg, 9), round(f.to_deg, 9)) for f in rev] == [(60.0, 60.0), (240.0, 240.0)]
+    assert all(f.severity == "info" for f in rev)
+    assert abs(rep.summary["work_per_cycle_j"]) < 1e-12
+
+
+def test_form_closed_design_file():
+    d = {"name": "cw", "cam": {"kind": "constant_width", "speed_rpm": 300},
+         "follower": {"type": "flat", "motion": "translating", "base_radius_mm": 40.0, "width_mm": 100.0},
+         "dynamics": {"mass_kg": 0.4, "friction_coefficient": 0.05}}
+    rep = check_design(design_from_dict(d))
+    dyn = rep.to_dict()["dynamics"]
+    assert dyn["form_closed"] and dyn["second_contact_force_n"]["max"] > 0 and dyn["load_reversals_deg"]
+    assert rep.verdict != "unacceptable"
+    for bad in ("spring_rate_n_per_mm", "spring_preload_n", "safety_force_n"):
+        with pytest.raises(SpecError) as err:
+            design_from_dict({**d, "dynamics": {"mass_kg": 0.4, bad: 10.0}})
+        assert [p.path for p in err.value.problems] == [f"dynamics.{bad}"]

@@ -348,3 +348,41 @@ def test_xlsx_design_dynamics_errors_name_the_cell(tmp_path):
     text = str(info.value)
     assert f"dynamics.inertia_kg_m2 [design!B{row[1].row}]" in text
     assert f"dynamics.mass_kg [design!B{ws.max_row}]" in text and "is for translating followers" in text
+
+
+# ---------------------------------------------------------------------------
+# form-closed followers (constant width: one profile touched twice)
+@pytest.fixture(scope="module")
+def width():
+    data = _toml(EXAMPLES / "constant_width.toml", cam={"speed_rpm": 300.0})
+    data["dynamics"] = {"mass_kg": 0.4, "friction_coefficient": 0.05}
+    return checked_design(design_from_dict(data, source=str(EXAMPLES / "constant_width.toml")))
+
+
+def test_form_closed_figure_xlsx_and_html(width):
+    from camfab.design.assemble import dynamics_model
+    from camfab.report.plots import report_figures
+
+    spec, geom, rep = width
+    d = rep.summary["dynamics"]
+    assert d["form_closed"] and [round(a, 6) for a, _ in d["load_reversals_deg"]] == [60.0, 240.0]
+    ref = dynamics_model(spec, geom)
+    top, _ = report_figures(spec, geom, rep)["dynamics"].axes
+    c = geom.profiles[0]
+    x = sample_grid(c.period, c.breakpoints, 1441)
+    sm = ref.evaluate(x)
+    np.testing.assert_allclose(top.lines[0].get_ydata(), sm.contact_force, rtol=1e-12)
+    np.testing.assert_allclose(top.lines[1].get_ydata(), sm.contact_force_2, rtol=1e-12)
+    head, data = _sheet_columns(_book(spec, geom, rep)["Dynamics"])
+    assert head[1:3] == ("Contact force, follower 1 (N)", "Contact force, follower 2 (N)")
+    deg = np.array([10, 59, 61, 100, 200, 250])
+    s = ref.evaluate(np.radians(deg))
+    np.testing.assert_allclose(data[deg, 1], s.contact_force, rtol=1e-12)
+    np.testing.assert_allclose(data[deg, 2], s.contact_force_2, rtol=1e-12)
+    assert np.all((data[:, 1] == 0) | (data[:, 2] == 0))  # never both
+    page = render_report(spec, geom, rep)["report.html"].decode()
+    for text in ("Contact force, follower 2 (N)", "Load reversals", "60.0°, 240.0°", "Form-closed follower"):
+        assert text in page, text
+    rows = {r[0]: r[1:5] for r in _book(spec, geom, rep)["Checks"].iter_rows(values_only=True) if r[0]}
+    assert rows["Maximum contact force, follower 2"][0] == pytest.approx(d["second_contact_force_n"]["max"], rel=1e-15)
+    assert "Jump speed" not in rows and "Safety force" not in rows
