@@ -139,6 +139,32 @@ def _t(text: str, cls: str = "") -> dict[str, Any]:
     return {"text": text, "value": None, "cls": cls}
 
 
+def _spring_loaded(d: dict, key: str, sub: str):
+    """``d["dynamics"][key][sub]`` of a spring-loaded follower (None without dynamics, or form-closed)."""
+    dyn = d.get("dynamics")
+    return None if not dyn or dyn["form_closed"] else (dyn.get(key) or {}).get(sub)
+
+
+def _max_contact_force(d: dict):
+    dyn = d.get("dynamics")
+    if not dyn:
+        return None
+    return max(dyn[k]["max"] for k in ("contact_force_n", "second_contact_force_n") if dyn.get(k))
+
+
+def _peak_torque(d: dict):
+    t = (d.get("dynamics") or {}).get("drive_torque_nm")
+    return None if not t else max(abs(t["max"]), abs(t["min"]))
+
+
+def _jump_cell(d: dict) -> dict[str, Any]:
+    dyn = d.get("dynamics")
+    if not dyn or dyn["form_closed"]:
+        return _c(None)
+    v = dyn["jump_speed"]["value"]
+    return _t("never") if v is None else _c(v, digits=1)
+
+
 def comparison_rows(items) -> list[dict[str, Any]]:
     """The side-by-side table: ``[{"label": str, "cells": [{"text", "value", "cls"}, ...]}, ...]``,
     one cell per design (``value`` is the exact report number, or None)."""
@@ -170,6 +196,10 @@ def comparison_rows(items) -> list[dict[str, Any]]:
     add("Pressure-angle limit (°)", lambda s, r, d: _c((d.get("pressure_angle_deg") or {}).get("limit"), digits=1))
     add("Face length left (mm)", lambda s, r, d: _c((d.get("face_length_mm") or {}).get("left")))
     add("Face length right (mm)", lambda s, r, d: _c((d.get("face_length_mm") or {}).get("right")))
+    add("Min contact force (N)", lambda s, r, d: _c(_spring_loaded(d, "contact_force_n", "min")))
+    add("Max contact force (N)", lambda s, r, d: _c(_max_contact_force(d)))
+    add("Peak drive torque (N·m)", lambda s, r, d: _c(_peak_torque(d)))
+    add("Jump speed (rpm)", lambda s, r, d: _jump_cell(d))
     return [r for r in rows if any(c["text"] != "--" for c in r["cells"])]
 
 

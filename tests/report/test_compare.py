@@ -89,6 +89,14 @@ def test_side_by_side_table_matches_the_reports(compared):
         [ds[0]["pressure_angle_deg"]["max"], None, ds[2]["pressure_angle_deg"]["max"]]
     assert by_label["Face length left (mm)"][1]["value"] is not None
     assert by_label["V max"][1]["text"].endswith("mm/s")
+    # the valve's dynamics (the others have none)
+    dyn = ds[1]["dynamics"]
+    assert [c["value"] and float(c["value"]) for c in by_label["Min contact force (N)"]] == \
+        [None, dyn["contact_force_n"]["min"], None]
+    assert float(by_label["Peak drive torque (N·m)"][1]["value"]) == max(abs(dyn["drive_torque_nm"]["max"]),
+                                                                         abs(dyn["drive_torque_nm"]["min"]))
+    assert float(by_label["Jump speed (rpm)"][1]["value"]) == dyn["jump_speed"]["value"]
+    assert by_label["Jump speed (rpm)"][0]["text"] == "--"
     assert len(t.imgs) == 3
 
 
