@@ -128,8 +128,8 @@ class _Second:
         super().__init__(*args, sense=sense)  # type: ignore[call-arg]
         self._inner = self._plain(*args, sense=-sense)
 
-    def _evaluate(self, phi, rotate: bool) -> ProfileSample:
-        return _mirror(self._inner._evaluate(phi, rotate))
+    def _evaluate(self, phi, rotate: bool, S=None) -> ProfileSample:
+        return _mirror(self._inner._evaluate(phi, rotate, S))
 
 
 class SecondTranslatingFlatContact(_Second, TranslatingFlatContact):

@@ -131,7 +131,7 @@ class ContactDynamics:
         c = self.contact
         x = np.atleast_1d(np.asarray(x, dtype=float))
         S = np.asarray(c.motion.evaluate(x, (0, 1, 2)), dtype=float)
-        s = c.evaluate_fixed(x)
+        s = c.evaluate_fixed(x, S)
         where = s.pitch if (c.kind == "roller" and not self.sliding) else s.point  # point of force, mm
         if self.oscillating:  # ξ grows clockwise: d r/dξ = −J·(r − pivot)
             rel = (where - self.pivot) * 1e-3
@@ -155,10 +155,11 @@ class ContactDynamics:
         qd = self.q_per_s * S[1] * self.speed
         n = s.normal
         D = n[:, 0] * w[:, 0] + n[:, 1] * w[:, 1]
-        vhat = np.zeros_like(u)
+        vhat = None  # no sliding friction
         if self.sliding and L.friction_coefficient > 0:
             rel = u - w * qd[:, None]  # the cam's surface past the follower's point (m/s)
             speed = np.hypot(rel[:, 0], rel[:, 1])
+            vhat = np.zeros_like(u)
             moving = speed > 0
             vhat[moving] = rel[moving] / speed[moving, None]
             D = D + L.friction_coefficient * (vhat[:, 0] * w[:, 0] + vhat[:, 1] * w[:, 1])
@@ -172,18 +173,22 @@ class ContactDynamics:
 
     def _transmit(self, N, s, vhat, u):
         """(friction μN, bearing force, drive, power) when the cam pushes with N (newtons) along n."""
-        mu = self.loads.friction_coefficient
+        n = s.normal
         with np.errstate(invalid="ignore"):  # N = ±inf where wedged
-            f = (mu * N)[:, None] * vhat
-            F = -(N[:, None] * s.normal + f)  # on the cam, at P
-        P = s.point * 1e-3
+            fx, fy = -N * n[:, 0], -N * n[:, 1]  # the force on the cam, at P
+            if vhat is None:
+                friction = np.zeros_like(N)
+            else:
+                friction = self.loads.friction_coefficient * N * (vhat != 0).any(axis=1)
+                fx -= friction * vhat[:, 0]
+                fy -= friction * vhat[:, 1]
         if self.contact.closed:
-            drive = self.contact.sense * (P[:, 0] * F[:, 1] - P[:, 1] * F[:, 0])
+            drive = (self.contact.sense * 1e-3) * (s.point[:, 0] * fy - s.point[:, 1] * fx)
             power = drive * self.speed
         else:  # drive force along the plate's motion (velocity u)
-            drive = -F[:, 0] * np.sign(u[:, 0])
+            drive = -fx * np.sign(u[:, 0])
             power = drive * np.abs(u[:, 0])
-        return mu * N * (vhat != 0).any(axis=1), np.hypot(F[:, 0], F[:, 1]), drive, power
+        return friction, np.hypot(fx, fy), drive, power
 
     def evaluate(self, x) -> DynamicsSample:
         """Forces, torque and power at parameters x (radians, or mm of travel)."""

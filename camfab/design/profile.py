@@ -213,20 +213,21 @@ class Contact:
         """The profile at parameters ``phi`` (cam frame)."""
         return self._evaluate(phi, True)
 
-    def evaluate_fixed(self, phi) -> ProfileSample:
+    def evaluate_fixed(self, phi, S=None) -> ProfileSample:
         """The same sample in the fixed (follower) frame: where the contact is in the machine at
         each φ — the cam-frame sample rotated back by −σφ.  Quantities that do not depend on the
         frame (curvatures, pressure angle, face position, |point|, point × point′) are those of
-        :meth:`evaluate`, to rounding; the checks use this form, which skips the rotation."""
-        return self._evaluate(phi, False)
+        :meth:`evaluate`, to rounding; the checks use this form, which skips the rotation.  ``S``: the
+        motion's S, S′, S″ at ``phi`` (3, n) when the caller has them already."""
+        return self._evaluate(phi, False, S)
 
-    def _evaluate(self, phi, rotate: bool) -> ProfileSample:  # pragma: no cover - abstract
+    def _evaluate(self, phi, rotate: bool, S=None) -> ProfileSample:  # pragma: no cover - abstract
         """The sample in the cam frame (``rotate``) or in the fixed frame."""
         raise NotImplementedError
 
-    def _S(self, phi) -> tuple[np.ndarray, np.ndarray]:
+    def _S(self, phi, S=None) -> tuple[np.ndarray, np.ndarray]:
         x = np.atleast_1d(np.asarray(phi, dtype=float))
-        return x, self.motion.evaluate(x, (0, 1, 2))
+        return x, (self.motion.evaluate(x, (0, 1, 2)) if S is None else S)
 
     def radius(self, phi) -> tuple[np.ndarray, np.ndarray]:
         """Distance of the profile from the cam centre (mm; height above the bottom
@@ -256,8 +257,8 @@ class DiscRollerContact(Contact):
         C, C1, C2, v, arm = self._path(S)
         return C[:, 0], C[:, 1], C1[:, 0], C1[:, 1], C2[:, 0], C2[:, 1], v[:, 0], v[:, 1], arm
 
-    def _evaluate(self, phi, rotate: bool) -> ProfileSample:
-        x, S = self._S(phi)
+    def _evaluate(self, phi, rotate: bool, S=None) -> ProfileSample:
+        x, S = self._S(phi, S)
         n = x.size
         sg, rr = self.sense, self.roller_radius
         # outputs filled chunk by chunk: the long chain of elementwise temporaries then
@@ -462,8 +463,8 @@ class DiscFlatContact(Contact):
         contact point (px, py) (fixed frame), and the optional outputs (or None)."""
         raise NotImplementedError
 
-    def _evaluate(self, phi, rotate: bool) -> ProfileSample:
-        x, S = self._S(phi)
+    def _evaluate(self, phi, rotate: bool, S=None) -> ProfileSample:
+        x, S = self._S(phi, S)
         n = x.size
         sg = self.sense
         out = _block(13, n)  # the last two rows are the face position and the arm angle, when given
@@ -551,10 +552,10 @@ class TranslatingCamContact(Contact):
         super().__init__(motion, 1 if direction == "right" else -1)
         self.roller_radius, self.base_height = float(roller_radius), float(base_height)
 
-    def _evaluate(self, phi, rotate: bool) -> ProfileSample:
+    def _evaluate(self, phi, rotate: bool, S=None) -> ProfileSample:
         # a sliding plate is not turned: one sample serves both frames (the checked quantities and the
         # normal do not depend on where the plate has slid to)
-        x, (s0, s1, s2) = self._S(phi)
+        x, (s0, s1, s2) = self._S(phi, S)
         chi = -self.sense  # +1: x = B (cam slides left)
         x0 = 0.0 if chi > 0 else self.period
         z = np.zeros_like(s0)
