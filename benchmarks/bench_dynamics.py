@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from bench_profile import ROWS, best
+from bench_profile import OSC_ROWS, ROWS, best
 from camfab.design.desmodromic import ConjugateTranslatingRoller, desmodromic_geometry
 from camfab.design.dynamics import ContactDynamics, Loads, analyse_dynamics, pair_of
 from camfab.design.mechanisms import OscillatingRoller, TranslatingFlat, TranslatingRoller
@@ -29,25 +29,24 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=5)
     a = ap.parse_args()
     prog = MotionProgram.from_segments(ROWS)
-    osc = MotionProgram.from_segments([(law, lift / 2, span) for law, lift, span in ROWS])
+    osc = MotionProgram.from_segments(OSC_ROWS)
     phi = np.linspace(0, 2 * math.pi, a.n, endpoint=False)
     t_motion = best(lambda: prog.evaluate(phi), a.repeat)
     w = 600 * RPM
-    lin = Loads(0.3, 20000.0, 400.0, damping=20.0, friction_coefficient=0.05, safety_force_n=50.0)
-    cams = (("translating roller", ContactDynamics(CamGeometry(TranslatingRoller(40.0, 8.0, 5.0), prog).profiles[0],
-                                                   Loads(0.3, 20000.0, 400.0, damping=20.0, safety_force_n=50.0), w)),
-            ("oscillating roller", ContactDynamics(CamGeometry(OscillatingRoller(50.0, 8.0, 120.0, 90.0), osc)
-                                                   .profiles[0], Loads(0.02, 30.0, 20.0, safety_force_n=50.0), w)),
-            ("translating flat", ContactDynamics(CamGeometry(TranslatingFlat(80.0), prog).profiles[0], lin, w)),
-            ("conjugate roller pair", pair_of(desmodromic_geometry(ConjugateTranslatingRoller(40.0, 8.0, 110.0),
-                                                                   prog), Loads(0.3, damping=20.0), w)))
+    cams = (("translating roller", CamGeometry(TranslatingRoller(40.0, 8.0, 5.0), prog),
+             Loads(0.3, 20000.0, 400.0, damping=20.0, safety_force_n=50.0)),
+            ("oscillating roller", CamGeometry(OscillatingRoller(50.0, 8.0, 120.0, 90.0), osc),
+             Loads(0.02, 30.0, 20.0, safety_force_n=50.0)),
+            ("translating flat", CamGeometry(TranslatingFlat(80.0), prog),
+             Loads(0.3, 20000.0, 400.0, damping=20.0, friction_coefficient=0.05, safety_force_n=50.0)),
+            ("conjugate roller pair", desmodromic_geometry(ConjugateTranslatingRoller(40.0, 8.0, 110.0), prog),
+             Loads(0.3, damping=20.0)))
     print(f"12-segment cam, {a.n:,} angles, 600 rpm; motion engine S..S''' {t_motion * 1e3:.1f} ms")
     print(f"{'mechanism':<24}{'forces ms':>11}{'ratio':>8}{'analysis ms':>13}")
-    for name, dyn in cams:
+    for name, geom, loads in cams:
+        dyn = pair_of(geom, loads, w) if len(geom.profiles) > 1 else ContactDynamics(geom.profiles[0], loads, w)
         t_ev = best(lambda: dyn.evaluate(phi), a.repeat)
-        geom = (desmodromic_geometry(ConjugateTranslatingRoller(40.0, 8.0, 110.0), prog) if "pair" in name else
-                CamGeometry.from_contacts([dyn.contact]))
-        t_an = best(lambda: analyse_dynamics(geom, dyn.loads, w, form_closed="pair" in name), a.repeat)
+        t_an = best(lambda: analyse_dynamics(geom, loads, w), a.repeat)
         print(f"{name:<24}{t_ev * 1e3:>11.1f}{t_ev / t_motion:>7.2f}x{t_an * 1e3:>13.1f}")
 
 

@@ -26,6 +26,8 @@ from camfab.design.program import MotionProgram
 ROWS = [("cycloidal", 10, 30), ("dwell", 0, 30), ("poly345", 10, 30), ("dwell", 0, 30),
         ("poly4567", -10, 30), ("dwell", 0, 30), ("cycloidal", -5, 30), ("dwell", 0, 30),
         ("poly345", 10, 30), ("dwell", 0, 30), ("poly4567", -15, 30), ("dwell", 0, 30)]
+#: the same program for an oscillating follower (lifts in degrees, halved)
+OSC_ROWS = [(law, lift / 2, span) for law, lift, span in ROWS]
 
 
 def best(fn, repeat):
@@ -58,7 +60,7 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=5)
     a = ap.parse_args()
     prog = MotionProgram.from_segments(ROWS)
-    osc = MotionProgram.from_segments([(law, lift / 2, span) for law, lift, span in ROWS])  # degrees
+    osc = MotionProgram.from_segments(OSC_ROWS)
     phi = np.linspace(0, 2 * math.pi, a.n, endpoint=False)
     t_motion = best(lambda: prog.evaluate(phi), a.repeat)
     print(f"12-segment cam, {a.n:,} angles; motion engine S..S''' {t_motion * 1e3:.1f} ms")
@@ -66,7 +68,7 @@ def main() -> None:
           f"{'ratio':>8}{'cold check() ms':>17}{'ratio (cold)':>14}")
     cams = (("translating roller", lambda p: CamGeometry(TranslatingRoller(40.0, 8.0, 5.0), p), ROWS),
             ("oscillating roller", lambda p: CamGeometry(OscillatingRoller(50.0, 8.0, 120.0, 90.0), p),
-             [(law, lift / 2, span) for law, lift, span in ROWS]),
+             OSC_ROWS),
             ("translating flat", lambda p: CamGeometry(TranslatingFlat(80.0), p), ROWS))
     for name, build, rows in cams:
         geom = build(prog if rows is ROWS else osc)

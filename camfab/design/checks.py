@@ -755,6 +755,40 @@ def _positive_ranges_multi(edges, closed: bool, k: int, ext=()):
     return out + ext_out
 
 
+def _joined(xs_l):
+    """The samples of consecutive intervals concatenated: ``(x, start index of each interval, mask
+    of the adjacent pairs that lie in one interval)``."""
+    xa = np.concatenate(xs_l)
+    st = np.r_[0, np.cumsum([len(t) for t in xs_l])[:-1]]
+    inn = np.ones(xa.size - 1, dtype=bool)
+    inn[st[1:] - 1] = False
+    return xa, st, inn
+
+
+def _sign_ranges(ivs, xa, pos, st, inn, roots) -> list[list[float]]:
+    """``[start, end]`` of every stretch where ``pos`` holds, per interval ``ivs[m] = (a, b, _)``
+    of the concatenated samples ``xa`` (interval m from index ``st[m]``; ``inn`` marks the pairs
+    inside one interval); ends at the refined ``roots`` of the sample pairs, or at a and b."""
+    nint = len(ivs)
+    anypos = np.logical_or.reduceat(pos, st)
+    chg = np.flatnonzero((pos[:-1] != pos[1:]) & inn)
+    cut = np.searchsorted(chg, st)
+    raw: list[list[float]] = []
+    for m in np.flatnonzero(anypos):
+        a, b, _ = ivs[m]
+        start = a if pos[st[m]] else None
+        for q in chg[cut[m]:cut[m + 1] if m + 1 < nint else chg.size]:
+            root = roots[(xa[q], xa[q + 1])]
+            if pos[q + 1]:
+                start = root
+            else:
+                raw.append([start, root])
+                start = None
+        if start is not None:
+            raw.append([start, b])
+    return raw
+
+
 def _range_specs(k, edges, closed, step, ivs, grid, starts, sizes, inner, V, xs_ls, rootss):
     """The ranges of :func:`_positive_ranges_multi` from the samples (with the inserted maxima
     ``xs_ls``/``v_ls`` where any) and the refined roots: the worst-value searches (specs of
@@ -769,29 +803,11 @@ def _range_specs(k, edges, closed, step, ivs, grid, starts, sizes, inner, V, xs_
         if xs_ls[j]:  # the samples with the inserted maxima
             xs_l = [xs_ls[j].get(m, grid[starts[m]:starts[m] + sizes[m]]) for m in range(nint)]
             v_l = [v_ls[j].get(m, V[j, starts[m]:starts[m] + sizes[m]]) for m in range(nint)]
-            xa, va = np.concatenate(xs_l), np.concatenate(v_l)
-            st = np.r_[0, np.cumsum([len(t) for t in xs_l])[:-1]]
-            inn = np.ones(xa.size - 1, dtype=bool)
-            inn[st[1:] - 1] = False
+            xa, st, inn = _joined(xs_l)
+            va = np.concatenate(v_l)
         else:
             xa, va, st, inn = grid, V[j], starts, inner
-        pos = va > 0
-        anypos = np.logical_or.reduceat(pos, st)
-        chg = np.flatnonzero((pos[:-1] != pos[1:]) & inn)
-        cut = np.searchsorted(chg, st)
-        raw: list[list[float]] = []
-        for m in np.flatnonzero(anypos):
-            a, b, _ = ivs[m]
-            start = a if pos[st[m]] else None
-            for q in chg[cut[m]:cut[m + 1] if m + 1 < nint else chg.size]:
-                root = roots[(xa[q], xa[q + 1])]
-                if pos[q + 1]:
-                    start = root
-                else:
-                    raw.append([start, root])
-                    start = None
-            if start is not None:
-                raw.append([start, b])
+        raw = _sign_ranges(ivs, xa, va > 0, st, inn, roots)
         for lo, hi, subs in _merged_ranges(raw, edges, closed, tol):
             spans.append((lo, hi, len(specs), len(subs)))
             specs += [(sub, True, step, j) for sub in subs]
@@ -847,22 +863,8 @@ def _positive_ranges_steps(edges, *, closed: bool = True, step: float | None = N
                 xs_l[k] = np.insert(xs_l[k], j, rx[m])
                 v_l[k] = np.insert(v_l[k], j, -rf[m])
         yield from _roots_of(xs_l, v_l, roots)  # sign changes made by an inserted maximum
-    pos_l = [vv > 0 for vv in v_l]
-    raw: list[list[float]] = []
-    for k, (a, b, _) in enumerate(ivs):
-        pos = pos_l[k]
-        if not pos.any():
-            continue
-        start = a if pos[0] else None
-        for j in np.flatnonzero(pos[:-1] != pos[1:]):
-            root = roots[(xs_l[k][j], xs_l[k][j + 1])]
-            if pos[j + 1]:
-                start = root
-            else:
-                raw.append([start, root])
-                start = None
-        if start is not None:
-            raw.append([start, b])
+    xa, st, inn = _joined(xs_l)
+    raw = _sign_ranges(ivs, xa, np.concatenate(v_l) > 0, st, inn, roots)
     tol = 1e-9 * max(per1 - per0, 1.0)
     # the worst value of every range, all searched at once
     spans, jobs = [], []

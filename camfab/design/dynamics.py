@@ -48,7 +48,9 @@ import numpy as np
 
 from ..units import DEG, RPM
 from .motion_report import Finding
-from .profile import CamGeometry, Contact, extremum, integrate
+from .checks import _positive_ranges_steps
+from .profile import CamGeometry, Contact
+from .solvers import _extremum_steps, _gather, _mapped, _run, integrate
 
 __all__ = ["Loads", "DynamicsSample", "DynamicsReport", "ContactDynamics", "PairDynamics", "pair_of",
            "analyse_dynamics"]
@@ -97,6 +99,7 @@ class DynamicsSample:
     bearing_force: np.ndarray   # |N·n + f| (N): the load on the camshaft bearings
     drive: np.ndarray           # drive torque (N·m), or drive force along the travel (N) of a translating cam
     power: np.ndarray           # drive power (W)
+    motion: np.ndarray | None = None           # S, S′, S″ at phi (3, n): lift unit per unit of phi
     contact_force_2: np.ndarray | None = None  # form-closed followers: follower 2's contact force (N)
 
 
@@ -196,25 +199,18 @@ class ContactDynamics:
         G = self.required(S)
         with np.errstate(divide="ignore", invalid="ignore"):  # D = 0: wedged (N infinite), see SELF_LOCKING
             N = G / D
-        return DynamicsSample(x, G, D, N, *self._transmit(N, s, vhat, u))
+        return DynamicsSample(x, G, D, N, *self._transmit(N, s, vhat, u), S)
 
-    # ---- design helpers -----------------------------------------------------------------
-    def _speed_terms(self, x):
-        """(a, b, e, D) with (N − F_s)·D = a·ṡ² + b·ṡ + e at parameters x (D does not depend on ṡ)."""
-        L = self.loads
-        S = np.asarray(self.contact.motion.evaluate(np.atleast_1d(np.asarray(x, dtype=float)), (0, 1, 2)))
-        D = self.evaluate(x).lever
-        k = self.q_per_s
+    # ---- design helpers (from a sample: no second evaluation) --------------------------
+    def jump_speed(self, s: DynamicsSample) -> np.ndarray:
+        """Per sample: the smallest speed (rad/s, or mm/s) at which N falls below the safety force
+        there; inf where it never does, 0 where it already does at rest (or the follower is wedged,
+        D ≤ 0).  (N − F_s)·D = a·ṡ² + b·ṡ + e, and D does not depend on the speed ṡ: the smallest
+        positive root of that quadratic."""
+        L, k, S, D = self.loads, self.q_per_s, s.motion, s.lever
         a = L.inertia * k * S[2]
         b = L.damping * k * S[1]
         e = L.preload + L.spring_rate * k * S[0] + L.external - L.safety_force_n * D
-        return a, b, e, D
-
-    def jump_speed(self, x) -> np.ndarray:
-        """Per parameter x: the smallest speed (rad/s, or mm/s) at which N falls below the safety
-        force there — the smallest positive root of a·ṡ² + b·ṡ + e; inf where it never does, 0
-        where it already does at rest (or the follower is wedged, D ≤ 0)."""
-        a, b, e, D = self._speed_terms(x)
         with np.errstate(divide="ignore", invalid="ignore"):
             disc = b * b - 4 * a * e
             sq = np.sqrt(np.maximum(disc, 0.0))
@@ -225,10 +221,9 @@ class ContactDynamics:
         r = np.min(np.where(ok, roots, np.inf), axis=0)
         return np.where((e < 0) | ~(D > 0), 0.0, r)
 
-    def needed_preload(self, x) -> np.ndarray:
-        """Per parameter x: the preload F₀ (N or N·m) that makes N equal the safety force there."""
-        sm = self.evaluate(x)
-        return self.loads.preload + self.loads.safety_force_n * sm.lever - sm.required
+    def needed_preload(self, s: DynamicsSample) -> np.ndarray:
+        """Per sample: the preload F₀ (N or N·m) that makes N equal the safety force there."""
+        return self.loads.preload + self.loads.safety_force_n * s.lever - s.required
 
 
 class PairDynamics:
@@ -264,7 +259,7 @@ class PairDynamics:
         f1, b1, d1, p1 = self.first._transmit(N1, s1, v1, u1)
         f2, b2, d2, p2 = self.second._transmit(N2, s2, v2, u2)
         # one of N₁, N₂ is 0 at every angle: the bearing carries the other's force
-        return DynamicsSample(x, G, np.where(G < 0, D2, D1), N1, f1 + f2, b1 + b2, d1 + d2, p1 + p2, N2)
+        return DynamicsSample(x, G, np.where(G < 0, D2, D1), N1, f1 + f2, b1 + b2, d1 + d2, p1 + p2, S, N2)
 
 
 def pair_of(geometry: CamGeometry, loads: Loads, speed: float) -> PairDynamics:
@@ -309,69 +304,88 @@ def analyse_dynamics(geometry: CamGeometry, loads: Loads, speed: float, *, prelo
     dyn = pair_of(geometry, loads, speed) if form_closed else ContactDynamics(c, loads, speed)
     edges = np.unique(np.concatenate([c.breakpoints, np.mod(c.breakpoints - math.pi, 2 * math.pi)])) \
         if form_closed and len(geometry.profiles) == 1 else geometry.breakpoints
-    closed = c.closed
-    ev = dyn.evaluate
+    closed, fs = c.closed, loads.safety_force_n
+    # every search runs in lockstep: one evaluation of the forces per round, its columns
+    cols = ("contact_force", "bearing_force", "drive", "lever",
+            *(("contact_force_2", "required") if form_closed else ("preload", "jump")))
 
-    def ext(fn, maximize=False):
-        at, val = extremum(lambda x: fn(ev(x)), edges, maximize=maximize)
-        return {"min" if not maximize else "max": float(val),
-                "at_min_deg" if not maximize else "at_max_deg": _x_user(c, at)}
+    def table(x):
+        sm = dyn.evaluate(x)
+        more = ((sm.contact_force_2, sm.required) if form_closed else
+                (dyn.needed_preload(sm), dyn.jump_speed(sm)))
+        return np.stack([sm.contact_force, sm.bearing_force, sm.drive, sm.lever, *more], axis=1)
 
-    force = {**ext(lambda s: s.contact_force), **ext(lambda s: s.contact_force, True)}
-    drive = {**ext(lambda s: s.drive), **ext(lambda s: s.drive, True)}
-    bearing = ext(lambda s: s.bearing_force, True)
+    def col(name, sign=1.0, offset=0.0):
+        j = cols.index(name)
+        return lambda v: sign * v[:, j] + offset
+
+    extrema = [("contact_force", False), ("contact_force", True), ("drive", False), ("drive", True),
+               ("bearing_force", True)]
+    extrema += ([("contact_force_2", False), ("contact_force_2", True)] if form_closed else
+                [("preload", True), ("jump", False)])
+    ranges = [("lever", -1.0, 0.0)]  # self-locking: D < 0
+    ranges += ([("required", 1.0, 0.0), ("required", -1.0, 0.0)] if form_closed else
+               [("contact_force", -1.0, 0.0)] + ([("contact_force", -1.0, fs)] if fs > 0 else []))
+    jobs = [_mapped(_extremum_steps(edges, maximize=mx), col(name)) for name, mx in extrema]
+    jobs += [_mapped(_positive_ranges_steps(edges, closed=closed), col(*r)) for r in ranges]
+    with np.errstate(invalid="ignore"):  # the per-angle jump speed is +inf where N never drops
+        found = _run(table, _gather(jobs))
+    ext = {(name, mx): (float(v), _x_user(c, at)) for (name, mx), (at, v) in zip(extrema, found)}
+    got = found[len(extrema):]
+
+    def minmax(name):
+        (lo, at_lo), (hi, at_hi) = ext[(name, False)], ext[(name, True)]
+        return {"min": lo, "max": hi, "at_min_deg": at_lo, "at_max_deg": at_hi}
+
+    drive = minmax("drive")
     # the work may cancel to 0 (no damping, no friction): an absolute target of 1e-12 of the
     # largest |drive| over the cycle
     span = float(edges[-1] - edges[0])
-    work = integrate(lambda x: ev(x).drive, edges, atol=1e-12 * max(abs(drive["min"]), abs(drive["max"])) * span)
+    work = integrate(lambda x: dyn.evaluate(x).drive, edges,
+                     atol=1e-12 * max(abs(drive["min"]), abs(drive["max"])) * span)
     work *= 1.0 if closed else 1e-3
     cycle_s = (2 * math.pi / speed) if closed else c.period / speed
+    bmax, at_b = ext[("bearing_force", True)]
     summary: dict[str, Any] = {
         "form_closed": form_closed,
-        "contact_force_n": {k: force[k] for k in ("min", "max", "at_min_deg", "at_max_deg")},
-        "safety_force_n": None if form_closed else loads.safety_force_n,
-        "bearing_force_n": bearing,
-        ("drive_torque_nm" if closed else "drive_force_n"): {k: drive[k] for k in ("min", "max", "at_min_deg",
-                                                                                    "at_max_deg")},
+        "contact_force_n": minmax("contact_force"),
+        "safety_force_n": None if form_closed else fs,
+        "bearing_force_n": {"max": bmax, "at_max_deg": at_b},
+        ("drive_torque_nm" if closed else "drive_force_n"): drive,
         "work_per_cycle_j": work,
         "mean_power_w": work / cycle_s,
     }
-    findings: list[Finding] = []
-    lock = _self_locking(ev, edges, c)
-    findings += lock
+    findings = _self_locking(got[0], c)
     if form_closed:
-        second = {**ext(lambda s: s.contact_force_2), **ext(lambda s: s.contact_force_2, True)}
-        summary["second_contact_force_n"] = {k: second[k] for k in ("min", "max", "at_min_deg", "at_max_deg")}
+        summary["second_contact_force_n"] = minmax("contact_force_2")
         summary["preload_needed"] = summary["jump_speed"] = None
-        rev = _reversals(ev, edges, c)
+        rev = _reversals(got[1], got[2], c)
         summary["load_reversals_deg"] = [[f.from_deg, f.to_deg] for f in rev]
         findings += rev
     else:
-        findings += _force_closed(dyn, ev, edges, c, loads, speed, preload_unit, summary)
+        pre, at_pre = ext[("preload", True)]
+        r_jump, at_jump = ext[("jump", False)]
+        summary["preload_needed"] = {"value": pre, "unit": preload_unit, "at_deg": at_pre}
+        summary["jump_speed"] = _speed_user(r_jump, closed, at_jump)
+        findings += _force_closed(got[1], got[2] if fs > 0 else [], c, fs, speed, pre, r_jump, preload_unit)
     return DynamicsReport(summary, tuple(findings))
 
 
-def _self_locking(ev, edges, c) -> list[Finding]:
-    from .checks import positive_ranges
-
+def _self_locking(ranges, c) -> list[Finding]:
+    """SELF_LOCKING from the ranges where −D > 0."""
     unit = "deg" if c.closed else "mm"
-    out = []
-    for lo, hi, xw, gw in positive_ranges(lambda x: -ev(x).lever, edges, closed=c.closed):
-        out.append(Finding(
-            "SELF_LOCKING", "error", _x_user(c, lo), _x_user(c, hi), float(-gw), 0.0,
-            f"friction wedges the follower from {_x_user(c, lo):.2f} to {_x_user(c, hi):.2f} {unit}: no contact "
-            "force can move it (μ too high for the pressure angle there); lower the friction coefficient or "
-            "the pressure angle (larger base radius)"))
-    return out
+    return [Finding("SELF_LOCKING", "error", _x_user(c, lo), _x_user(c, hi), float(-gw), 0.0,
+                    f"friction wedges the follower from {_x_user(c, lo):.2f} to {_x_user(c, hi):.2f} {unit}: no "
+                    "contact force can move it (μ too high for the pressure angle there); lower the friction "
+                    "coefficient or the pressure angle (larger base radius)")
+            for lo, hi, _, gw in ranges]
 
 
-def _reversals(ev, edges, c) -> list[Finding]:
-    """LOAD_REVERSAL (info) between consecutive stretches where different followers carry the load."""
-    from .checks import positive_ranges
-
+def _reversals(first, second, c) -> list[Finding]:
+    """LOAD_REVERSAL (info) between consecutive stretches where different followers carry the load
+    (``first``/``second``: the ranges where G > 0 / G < 0)."""
     unit = "deg" if c.closed else "mm"
-    runs = sorted([(lo, hi, 1) for lo, hi, _, _ in positive_ranges(lambda x: ev(x).required, edges)]
-                  + [(lo, hi, 2) for lo, hi, _, _ in positive_ranges(lambda x: -ev(x).required, edges)])
+    runs = sorted([(lo, hi, 1) for lo, hi, _, _ in first] + [(lo, hi, 2) for lo, hi, _, _ in second])
     out = []
     if len({k for _, _, k in runs}) < 2:
         return out
@@ -386,34 +400,22 @@ def _reversals(ev, edges, c) -> list[Finding]:
     return sorted(out, key=lambda f: f.from_deg)
 
 
-def _force_closed(dyn, ev, edges, c, loads, speed, preload_unit, summary) -> list[Finding]:
-    """Preload and jump speed into ``summary``; FOLLOWER_JUMP and CONTACT_FORCE_BELOW_SAFETY."""
-    from .checks import positive_ranges
-
+def _force_closed(jump, low, c, fs, speed, pre, r_jump, preload_unit) -> list[Finding]:
+    """FOLLOWER_JUMP and CONTACT_FORCE_BELOW_SAFETY from the ranges where −N > 0 and F_s − N > 0."""
     closed, unit = c.closed, ("deg" if c.closed else "mm")
-    at_pre, pre = extremum(lambda x: dyn.needed_preload(x), edges, maximize=True)
-    with np.errstate(invalid="ignore"):  # the per-angle jump speed is +inf where N never drops
-        at_jump, r_jump = extremum(lambda x: dyn.jump_speed(x), edges)
-    summary["preload_needed"] = {"value": float(pre), "unit": preload_unit, "at_deg": _x_user(c, at_pre)}
-    summary["jump_speed"] = _speed_user(r_jump, closed, _x_user(c, at_jump))
-    fs = loads.safety_force_n
     speed_txt = _speed_text(speed, closed)
     fix = (f"raise the spring preload to at least {pre:.6g} {preload_unit}" if math.isfinite(pre) else
            "stiffen the spring")
     if math.isfinite(r_jump) and r_jump > 0:
         fix += f", or run slower than {_speed_text(r_jump, closed)}"
-    out = []
-    for lo, hi, xw, gw in positive_ranges(lambda x: -ev(x).contact_force, edges, closed=closed):
-        out.append(Finding(
-            "FOLLOWER_JUMP", "error", _x_user(c, lo), _x_user(c, hi), float(-gw), 0.0,
-            f"the follower leaves the cam from {_x_user(c, lo):.2f} to {_x_user(c, hi):.2f} {unit} at {speed_txt}: "
-            f"the contact force falls to {-gw:.6g} N (the spring cannot hold it); {fix}"))
-    if fs > 0:
-        for lo, hi, xw, gw in positive_ranges(lambda x: fs - ev(x).contact_force, edges, closed=closed):
-            out.append(Finding(
-                "CONTACT_FORCE_BELOW_SAFETY", "error", _x_user(c, lo), _x_user(c, hi), float(fs - gw), fs,
-                f"the contact force is below the safety force {fs:g} N from {_x_user(c, lo):.2f} to "
-                f"{_x_user(c, hi):.2f} {unit} (down to {fs - gw:.6g} N at {_x_user(c, xw):.2f} {unit}); {fix}"))
+    out = [Finding("FOLLOWER_JUMP", "error", _x_user(c, lo), _x_user(c, hi), float(-gw), 0.0,
+                   f"the follower leaves the cam from {_x_user(c, lo):.2f} to {_x_user(c, hi):.2f} {unit} at "
+                   f"{speed_txt}: the contact force falls to {-gw:.6g} N (the spring cannot hold it); {fix}")
+           for lo, hi, _, gw in jump]
+    out += [Finding("CONTACT_FORCE_BELOW_SAFETY", "error", _x_user(c, lo), _x_user(c, hi), float(fs - gw), fs,
+                    f"the contact force is below the safety force {fs:g} N from {_x_user(c, lo):.2f} to "
+                    f"{_x_user(c, hi):.2f} {unit} (down to {fs - gw:.6g} N at {_x_user(c, xw):.2f} {unit}); {fix}")
+            for lo, hi, xw, gw in low]
     return out
 
 

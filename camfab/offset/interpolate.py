@@ -71,42 +71,30 @@ def _project(curve: ParametricCurve, x: np.ndarray, t0: np.ndarray, a: np.ndarra
 # --------------------------------------------------------------------------------------
 # per-interval measurement
 # --------------------------------------------------------------------------------------
-def _golden_max(f: Callable[[np.ndarray], np.ndarray], lo: np.ndarray, hi: np.ndarray,
-                iters: int = _GOLDEN_ITERS) -> np.ndarray:
-    """Vectorised golden-section search for the maximum of ``f`` on each ``[lo, hi]``."""
-    a, b = lo.astype(float), hi.astype(float)
-    c = b - _INV_PHI * (b - a)
-    d = a + _INV_PHI * (b - a)
-    fc, fd = f(c), f(d)
-    best = np.maximum(fc, fd)
-    for _ in range(iters):
-        left = fc > fd
-        b = np.where(left, d, b)
-        a = np.where(left, a, c)
-        x = np.where(left, b - _INV_PHI * (b - a), a + _INV_PHI * (b - a))
-        fx = f(x)
-        best = np.maximum(best, fx)
-        c, d, fc, fd = (np.where(left, x, d), np.where(left, c, x),
-                        np.where(left, fx, fd), np.where(left, fc, fx))
-    return best
-
-
 def _golden_min(f: Callable[[np.ndarray], np.ndarray], lo: np.ndarray, hi: np.ndarray,
-                iters: int = _GOLDEN_ITERS) -> np.ndarray:
-    """Vectorised golden-section search: the argument minimising ``f`` on each ``[lo, hi]``."""
+                iters: int = _GOLDEN_ITERS) -> tuple[np.ndarray, np.ndarray]:
+    """Vectorised golden-section search on each ``[lo, hi]``: the argument minimising ``f`` and the
+    smallest value of ``f`` met on the way."""
     a, b = lo.astype(float), hi.astype(float)
     c = b - _INV_PHI * (b - a)
     d = a + _INV_PHI * (b - a)
     fc, fd = f(c), f(d)
+    best = np.minimum(fc, fd)
     for _ in range(iters):
         left = fc < fd
         b = np.where(left, d, b)
         a = np.where(left, a, c)
         x = np.where(left, b - _INV_PHI * (b - a), a + _INV_PHI * (b - a))
         fx = f(x)
+        best = np.minimum(best, fx)
         c, d, fc, fd = (np.where(left, x, d), np.where(left, c, x),
                         np.where(left, fx, fd), np.where(left, fc, fx))
-    return np.where(fc < fd, c, d)
+    return np.where(fc < fd, c, d), best
+
+
+def _golden_max(f: Callable[[np.ndarray], np.ndarray], lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """The largest value of ``f`` a golden-section search finds on each ``[lo, hi]``."""
+    return -_golden_min(lambda t: -f(t), lo, hi)[1]
 
 
 def _interval_entities(curve: ParametricCurve, a, b, lo, hi, kind: str, pa=None, pb=None) -> dict:
@@ -136,7 +124,7 @@ def _interval_entities(curve: ParametricCurve, a, b, lo, hi, kind: str, pa=None,
         return np.where(ent["valid"], d.min(axis=-1).max(axis=-1), np.inf)
 
     bound = np.full(a.size, _LOG_RATIO_BOUND)
-    log_r = _golden_min(proxy, -bound, bound)
+    log_r = _golden_min(proxy, -bound, bound)[0]
     log_r = np.where(proxy(log_r) < proxy(np.zeros(a.size)), log_r, 0.0)
     return _biarc(pa, ta, pb, tb, np.exp(log_r))
 

@@ -114,19 +114,24 @@ def cams(draw):
     return mech, RISE, loads, speed
 
 
+def _built(cam):
+    """(geometry, contact, ContactDynamics, program, loads, speed) of a drawn design (invalid ones are
+    discarded)."""
+    mech, prog, L, speed = cam
+    try:
+        g = CamGeometry(mech, prog)
+    except SpecError:
+        assume(False)
+    return g, g.profiles[0], ContactDynamics(g.profiles[0], L, speed), prog, L, speed
+
+
 @settings(max_examples=40, deadline=None)
 @given(cams())
 def test_power_balance_and_work_per_cycle(cam):
     """The drive torque from the forces on the cam (T = σ·P × F) balances the power the follower takes
     (G·q̇, by virtual work) plus the friction loss μN·|v_rel|; over a cycle the work is the damping
     loss c·∮q̇² dt plus the friction loss — 0 for a conservative follower."""
-    mech, prog, L, speed = cam
-    try:
-        g = CamGeometry(mech, prog)
-    except SpecError:
-        assume(False)
-    c = g.profiles[0]
-    d = ContactDynamics(c, L, speed)
+    g, c, d, prog, L, speed = _built(cam)
     x = np.linspace(0.0, c.period, 2001)[:-1] + 1e-3
     s = d.evaluate(x)
     assume(np.all(s.lever > 1e-6))
@@ -370,13 +375,7 @@ def test_form_closed_design_file():
 def test_summary_extremes_are_exact_against_dense_sampling(cam):
     """The summary's extremes are refined, not sampled: never beaten by a dense grid, and attained at
     the angle they name."""
-    mech, prog, L, speed = cam
-    try:
-        g = CamGeometry(mech, prog)
-    except SpecError:
-        assume(False)
-    c = g.profiles[0]
-    d = ContactDynamics(c, L, speed)
+    g, c, d, prog, L, speed = _built(cam)
     x = np.linspace(0.0, c.period, 20001)
     s = d.evaluate(x)
     assume(np.all(s.lever > 1e-6) and np.all(np.isfinite(s.contact_force)))
