@@ -410,7 +410,7 @@ def _lift_table(spec, step: float) -> str:
     if _x_scale(prog) == 1.0:
         raise UsageError("a lift table needs a rotating cam")
     ang = lift_angles(step)
-    return lift_table_csv(ang, prog(np.radians(ang)))
+    return lift_table_csv(ang, prog(np.radians(ang)), lift_unit=prog.axis.lift_unit)
 
 
 def _verify_args(p: argparse.ArgumentParser) -> None:

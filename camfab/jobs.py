@@ -182,4 +182,4 @@ def _lift_csv(spec, step_deg: float) -> str:
     if spec.is_translating_cam:
         raise GeometryError("a polar lift table needs a rotating cam")
     ang = lift_angles(step_deg)
-    return lift_table_csv(ang, prog(np.radians(ang)))
+    return lift_table_csv(ang, prog(np.radians(ang)), lift_unit=prog.axis.lift_unit)

@@ -93,6 +93,7 @@ class ComplementMotion:
     def __init__(self, base, lift: float):
         self.base, self.lift, self.period = base, float(lift), float(base.period)
         self.breakpoints = np.asarray(base.breakpoints, dtype=float)
+        self.axis = base.axis
 
     def evaluate(self, x, orders=(0, 1, 2, 3)) -> np.ndarray:
         out = -np.asarray(self.base.evaluate(x, orders), dtype=float)

@@ -56,6 +56,7 @@ from typing import Protocol, Sequence
 import numpy as np
 
 from ..errors import SpecError
+from .kinds import Axis, ContactKind
 from .solvers import extremum, integrate
 from .mechanisms import (Mechanism, OscillatingFlat, OscillatingRoller, TranslatingCamRoller,
                          TranslatingFlat, TranslatingRoller)
@@ -81,9 +82,10 @@ _K = math.pi / 180.0  # oscillating lifts are in degrees
 
 
 class MotionLike(Protocol):
-    """What a contact needs from a motion: S and derivatives, breakpoints, period."""
+    """What a contact needs from a motion: S and derivatives, breakpoints, period, axis."""
 
     period: float
+    axis: Axis
 
     @property
     def breakpoints(self) -> np.ndarray: ...
@@ -183,16 +185,32 @@ class Contact:
     motion : MotionLike
     sense : int
         σ = +1 (cw) or −1 (ccw); for a translating cam +1 = slides right.
-    kind : {"roller", "flat"}
+    kind : ContactKind
+        ROLLER (a circle about a point of the follower; a knife edge has radius 0) or FLAT.
     roller_radius : float
         R_r in mm (0 for flat faces and knife edges).
     closed : bool
         True for disc cams (periodic closed curve), False for a translating cam.
+    oscillating : bool
+        True when the follower turns about a pivot (its lift S is in degrees).
+    has_face : bool
+        True when the follower touches with a face whose contact position the sample gives
+        (``ProfileSample.face_position``): its length is checked.
+    sliding : bool
+        True when the follower slides on the cam (knife edges and faces; friction applies), False
+        for a roller that rolls.
     """
 
-    kind = "roller"
+    kind = ContactKind.ROLLER
     closed = True
+    oscillating = False
+    has_face = False
     roller_radius = 0.0
+
+    @property
+    def sliding(self) -> bool:
+        """Knife edges and faces slide on the cam; a roller of radius > 0 rolls."""
+        return self.has_face or self.kind is ContactKind.FLAT or self.roller_radius == 0.0
 
     def __init__(self, motion: MotionLike, sense: int = 1):
         if sense not in (1, -1):
@@ -203,6 +221,11 @@ class Contact:
     @property
     def period(self) -> float:
         return float(self.motion.period)
+
+    @property
+    def axis(self) -> Axis:
+        """The motion's axis: what the parameter is (cam angle or travel) and the lift unit."""
+        return self.motion.axis
 
     @property
     def breakpoints(self) -> np.ndarray:
@@ -426,6 +449,8 @@ class TranslatingRollerContact(DiscRollerContact):
 class OscillatingRollerContact(DiscRollerContact):
     """Oscillating roller: pivot (m, 0), C = (m − A cos ξ, A sin ξ), ξ = ξ₀ + S (S in degrees)."""
 
+    oscillating = True
+
     def __init__(self, motion: MotionLike, pivot_distance: float, arm_length: float,
                  initial_arm_angle: float, roller_radius: float, sense: int = 1):
         super().__init__(motion, roller_radius, sense)
@@ -453,7 +478,8 @@ class DiscFlatContact(Contact):
     centre, and implement :meth:`_extras` (follower velocity direction, face
     position, arm angle)."""
 
-    kind = "flat"
+    kind = ContactKind.FLAT
+    has_face = True
 
     def _face(self, S):  # pragma: no cover - abstract
         raise NotImplementedError
@@ -521,6 +547,8 @@ class TranslatingFlatContact(DiscFlatContact):
 
 class OscillatingFlatContact(DiscFlatContact):
     """Oscillating flat face: normal (sin ξ, cos ξ), distance f + m sin ξ (spec §6)."""
+
+    oscillating = True
 
     def __init__(self, motion: MotionLike, pivot_distance: float, face_offset: float,
                  initial_arm_angle: float, sense: int = 1):
@@ -605,6 +633,11 @@ class CamGeometry:
     @property
     def closed(self) -> bool:
         return self.profiles[0].closed
+
+    @property
+    def axis(self) -> Axis:
+        """What the parameter is (cam angle or travel) and the lift unit."""
+        return self.profiles[0].axis
 
     @property
     def period(self) -> float:

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..errors import Problem, SpecError
 from ..tolerances import ANGLE_SUM_TOL_DEG
+from .kinds import ROTATING_MM, TRANSLATING_MM, Axis, LiftUnit
 from .laws import GENERIC, HALF_PERIOD, LAWS, TRIG1, get_law, horner, law_names, trig_rows
 
 __all__ = [
@@ -212,6 +213,8 @@ class MotionProgram:
 
     segments: tuple[Segment, ...]
     period: float = TWO_PI
+    #: what x is (cam angle or travel) and the unit of S (mm or degrees)
+    axis: Axis = ROTATING_MM
     _starts: np.ndarray = field(init=False, repr=False, compare=False)
     _tab: "_Tables" = field(init=False, repr=False, compare=False)
     _memo: dict = field(init=False, repr=False, compare=False)
@@ -224,12 +227,13 @@ class MotionProgram:
     # ---- construction -------------------------------------------------
     @classmethod
     def from_segments(cls, rows: Iterable[Sequence], *, unit: str = "deg",
-                      period: float | None = None) -> "MotionProgram":
+                      period: float | None = None, lift_unit: str = "mm") -> "MotionProgram":
         """Build from ``(law, lift, span[, shape])`` rows; span in degrees by default.
 
         ``unit="rad"`` takes spans in radians; ``unit="mm"`` builds a
         translating-cam program whose period is the sum of the spans (or
-        ``period``).  A span of ``None`` is solved (half-period laws).
+        ``period``).  A span of ``None`` is solved (half-period laws).  ``lift_unit``: "mm", or
+        "deg" for an oscillating follower.
         """
         scale = {"deg": math.pi / 180.0, "rad": 1.0, "mm": 1.0}[unit]
         inputs = []
@@ -239,7 +243,7 @@ class MotionProgram:
                                        rest[0] if rest else None))
         if period is None:
             period = TWO_PI if unit != "mm" else sum(i.span or 0.0 for i in inputs)
-        return build_program(inputs, period=period, unit=unit)
+        return build_program(inputs, period=period, unit=unit, lift_unit=lift_unit)
 
     # ---- evaluation ---------------------------------------------------
     @property
@@ -360,7 +364,7 @@ class MotionProgram:
             return self._memo["peaks"]  # type: ignore[return-value]
         if mode == "camdas":
             if step is None:
-                step = math.pi / 180.0 if abs(self.period - TWO_PI) < 1e-12 else 1.0
+                step = math.pi / 180.0 if self.axis.rotating else 1.0
             return _sampled_peaks(self, step)
         raise ValueError(f"'{mode}' is not a valid peaks mode, must be one of: exact, camdas")
 
@@ -750,7 +754,7 @@ def _half_period_span(name: str, lift: float, slope: float) -> float:
 
 
 def build_program(inputs: Sequence[SegmentInput], *, period: float = TWO_PI, unit: str = "rad",
-                  path: str = "motion", source: str | None = None) -> MotionProgram:
+                  path: str = "motion", source: str | None = None, lift_unit: str = "mm") -> MotionProgram:
     """Validate segment inputs and resolve them into a :class:`MotionProgram`.
 
     Every rule of the CAM-DAS data entry (spec motion-laws §2, §3, §5.4, §5.9)
@@ -873,7 +877,8 @@ def build_program(inputs: Sequence[SegmentInput], *, period: float = TWO_PI, uni
                 prev_end = next_start = np.zeros(4)
             c = solve_generic(GENERIC[laws[i]], segs[i].s0, segs[i].lift, segs[i].span, prev_end, next_start)
             segs[i] = Segment(laws[i], segs[i].lift, segs[i].span, segs[i].start, segs[i].s0, c, segs[i].title)
-    prog = MotionProgram(tuple(segs), period)
+    axis = (TRANSLATING_MM if unit == "mm" else ROTATING_MM).with_lift(LiftUnit(lift_unit))
+    prog = MotionProgram(tuple(segs), period, axis)
 
     for i, seg in enumerate(prog.segments):
         u, v = _segment_candidates(seg, 0)

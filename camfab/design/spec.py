@@ -599,4 +599,4 @@ def _build_motion(spec: DesignSpec):
         inputs = [SegmentInput(s.law, s.lift, s.span, s.shape) for s in spec.motion]
         return build_program(inputs, period=length, unit="mm", source=spec.source)
     inputs = [SegmentInput(s.law, s.lift, None if s.span is None else s.span * DEG, s.shape) for s in spec.motion]
-    return build_program(inputs, period=TWO_PI, unit="rad", source=spec.source)
+    return build_program(inputs, period=TWO_PI, unit="rad", source=spec.source, lift_unit=spec.follower.lift_unit)

@@ -1,7 +1,8 @@
 """Polar lift table for cam grinders: cam angle against follower lift, as CSV.
 
-Format: header ``angle_deg,lift_mm``, one row per angle, both columns with exactly 6 decimals, ``\\n``
-line ends and a final newline; ``-0.000000`` is written ``0.000000``.  Deterministic.
+Format: header ``angle_deg,lift_mm`` (``angle_deg,lift_deg`` for an oscillating follower, whose lift is
+the arm angle in degrees), one row per angle, both columns with exactly 6 decimals, ``\\n`` line ends and
+a final newline; ``-0.000000`` is written ``0.000000``.  Deterministic.
 """
 from __future__ import annotations
 
@@ -41,7 +42,7 @@ def lift_angles(step_deg: float) -> np.ndarray:
     return np.arange(int(round(n))) * float(step_deg)
 
 
-def lift_table_csv(angles_deg, lift_mm) -> str:
+def lift_table_csv(angles_deg, lift_mm, *, lift_unit: str = "mm") -> str:
     """The polar lift table as CSV text.
 
     Parameters
@@ -50,6 +51,8 @@ def lift_table_csv(angles_deg, lift_mm) -> str:
         Cam angles in degrees.
     lift_mm : array_like (n,) or callable
         Follower lift at each angle in mm, or a function of the angle array (degrees) returning it.
+    lift_unit : {"mm", "deg"}
+        The unit of the lift, written into the header: "deg" for an oscillating follower's arm angle.
 
     Returns
     -------
@@ -71,12 +74,15 @@ def lift_table_csv(angles_deg, lift_mm) -> str:
         problems.append(Problem("angles_deg", "non-finite", "must be finite", ""))
     if not np.all(np.isfinite(lift)):
         problems.append(Problem("lift_mm", "non-finite", "must be finite", ""))
+    if lift_unit not in ("mm", "deg"):
+        problems.append(Problem("lift_unit", lift_unit, "is not a valid option", "must be one of: mm, deg"))
     if problems:
         raise SpecError(problems)
-    rows = [HEADER] + [f"{_f6(x)},{_f6(y)}" for x, y in zip(a.tolist(), lift.tolist())]
+    rows = [f"angle_deg,lift_{lift_unit}"] + [f"{_f6(x)},{_f6(y)}" for x, y in zip(a.tolist(), lift.tolist())]
     return "\n".join(rows) + "\n"
 
 
-def write_lift_table(path: str | Path, angles_deg, lift_mm: "np.ndarray | Callable") -> Path:
+def write_lift_table(path: str | Path, angles_deg, lift_mm: "np.ndarray | Callable", *,
+                     lift_unit: str = "mm") -> Path:
     """Write :func:`lift_table_csv` atomically to ``path``."""
-    return atomic_write(path, lift_table_csv(angles_deg, lift_mm))
+    return atomic_write(path, lift_table_csv(angles_deg, lift_mm, lift_unit=lift_unit))

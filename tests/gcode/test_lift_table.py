@@ -45,3 +45,19 @@ def test_step_must_divide_360():
         lift_angles(0.7)
     with pytest.raises(SpecError):
         lift_angles(0)
+
+
+@pytest.mark.parametrize("example,unit", [("ejemplo11ro", "deg"), ("ejemplo9rt", "mm")])
+def test_header_names_the_lift_unit(tmp_path, example, unit):
+    """Regression (core issue): an oscillating follower's lift table is in degrees of arm angle and
+    its header says so; it was written as ``lift_mm``."""
+    from camfab.cli import main
+
+    assert main(["run", example, "-o", str(tmp_path), "--outputs", "lift_table"]) == 0
+    (table,) = tmp_path.glob("*_lift.csv")
+    assert table.read_text().splitlines()[0] == f"angle_deg,lift_{unit}"
+
+
+def test_bad_lift_unit():
+    with pytest.raises(SpecError):
+        lift_table_csv([0.0], [0.0], lift_unit="inch")
