@@ -48,9 +48,10 @@ below 0 (the follower would cross the base/prime circle), naming every
 offending segment.  :meth:`KnotTable.warnings` lists segments whose implied
 peak ``|S″|`` (and ``|S‴|`` for degree 7) is more than ``ratio`` (default 5)
 times the largest value given at the segment's two knots — the symptom of
-rounded or otherwise inconsistent knots (spec §3.6).  The default is 5, not
-10: the printed Example 2 matrix peaks at 9× (Example 1 at 18.6×), while its
-µm-precision reconstruction (spec §3.6) stays at 4.1×; a smooth motion
+rounded or otherwise inconsistent knots (s printed to 0.1 mm beside v and a
+to four digits).  The default is 5, not 10: the printed valve PUNTOS matrix of
+Example 2 peaks at 9× (Example 1 at 18.6×), while Example 1 with s
+reconstructed to 1 µm (``valve_recon_ej1.csv``) stays at 4.1×; a smooth motion
 sampled at several knots per acceleration swing stays close to 1×.  A segment whose two knots both
 give exactly 0 leaves that derivative to the interpolant (a dwell or a
 rest-to-rest rise) and is not compared.
