@@ -12,9 +12,8 @@ from __future__ import annotations
 import time
 
 from camfab.cad.export import build_artifacts
-from camfab.cli import resolve_design_path
 from camfab.design.assemble import geometry_from_spec
-from camfab.design.spec import load_design
+from camfab.formats import load_design, resolve_design_path
 from camfab.offset.cutter import profile_curve, tool_centre_path
 from camfab.offset.discretize import arcs
 

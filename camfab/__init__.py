@@ -16,8 +16,8 @@ from .design import (
     analyse_motion,
     build_program,
     design_from_dict,
-    load_design,
 )
+from .formats import load_design
 
 __all__ = [
     "__version__",

@@ -18,12 +18,12 @@ import numpy as np
 
 from . import __version__
 from .errors import CamfabError, GeometryError, MissingDependencyError, SpecError
+from .formats import load_design, resolve_design_path
 from .io import atomic_write
 
-__all__ = ["main", "register", "COMMANDS", "EXAMPLES_DIR", "resolve_design_path"]
+__all__ = ["main", "register", "COMMANDS"]
 
 EXIT_OK, EXIT_CHECKS, EXIT_INPUT, EXIT_IO = 0, 1, 2, 3
-EXAMPLES_DIR = Path(__file__).parent / "templates" / "examples"
 COMMANDS: dict[str, Callable] = {}
 
 
@@ -42,20 +42,8 @@ def register(name: str, help: str):
     return deco
 
 
-def resolve_design_path(name: str) -> Path:
-    """A design path, or the name of a built-in example (``ejemplo9rt``)."""
-    p = Path(name)
-    if p.exists():
-        return p
-    for cand in sorted(EXAMPLES_DIR.glob("*.toml")):
-        if cand.stem.lower() == name.lower():
-            return cand
-    return p  # load_design reports the missing file
-
-
 def _load(name: str):
-    from .design.spec import load_design
-
+    """The design ``name``: a TOML or xlsx file, or a built-in example."""
     return load_design(resolve_design_path(name))
 
 

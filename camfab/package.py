@@ -21,11 +21,13 @@ import json
 import multiprocessing
 import os
 import time
+from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
-from typing import Callable, Iterable
 
 from . import __version__
+from .design.spec import DesignSpec
+from .formats import load_design
 from .io import atomic_write
 from .jobs import JobRequest
 
@@ -66,12 +68,23 @@ def _templates_hash() -> str:
     return h.hexdigest()
 
 
-def input_key(path: Path, options: dict, templates: str) -> str:
-    """Hash of everything a cam's outputs depend on (see the module docstring)."""
+def input_key(sources: Sequence[str | Path], options: dict, templates: str) -> str:
+    """Hash of everything a cam's outputs depend on (see the module docstring).
+
+    Parameters
+    ----------
+    sources : sequence of str or Path
+        The design file, then the files it references: the :attr:`~camfab.design.spec.DesignSpec.sources`
+        its spec recorded when it was read (the design file alone when it could not be read).
+    options : dict
+        The job options.
+    templates : str
+        Hash of the shipped templates.
+    """
     h = hashlib.sha256()
-    data = path.read_bytes()
-    h.update(data)
-    for ref in _referenced_files(path, data):
+    design, *refs = map(Path, sources)
+    h.update(design.read_bytes())
+    for ref in refs:
         h.update(ref.name.encode())
         h.update(ref.read_bytes() if ref.exists() else b"<missing>")
     h.update(__version__.encode())
@@ -80,35 +93,26 @@ def input_key(path: Path, options: dict, templates: str) -> str:
     return h.hexdigest()
 
 
-def _referenced_files(path: Path, data: bytes) -> list[Path]:
-    if path.suffix != ".toml":
-        return []
-    import tomllib
-
+def _read(path: Path) -> tuple[DesignSpec | None, tuple[str | Path, ...]]:
+    """The design's spec and the files it was built from; (None, the file) when it cannot be read
+    (the build then records why)."""
     try:
-        table = tomllib.loads(data.decode("utf-8")).get("motion_table", {})
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError):
-        return []
-    f = table.get("file") if isinstance(table, dict) else None
-    return [path.parent / f] if isinstance(f, str) else []
-
-
-def _load(path: Path):
-    from .design.spec import load_design
-
-    return load_design(path)
+        spec = load_design(path)
+    except Exception:  # any failure is reported by the build of this design, with the others kept
+        return None, (path,)
+    return spec, spec.sources
 
 
 def _build(args: tuple) -> dict:
     """Worker: build one design into its folder; never raises (errors go into the entry)."""
-    path, out, overrides, key = args
+    path, out, overrides, key, spec = args
     from .errors import CamfabError
     from .jobs import request_from_outputs, run_design
 
     t0 = time.perf_counter()
     entry = {"source": str(path), "key": key, "rebuilt": True}
     try:
-        spec = _load(Path(path))
+        spec = spec if spec is not None else load_design(Path(path))
         entry["name"] = spec.name
         folder = Path(out) / _folder_name(spec.name)
         req = request_from_outputs(spec, **overrides)
@@ -163,13 +167,16 @@ def package(paths: Iterable[str | Path], out: str | Path, *, jobs: int = 1, over
     opts = JobRequest(**{k: v for k, v in overrides.items()}).key() if overrides else {}
     todo, entries = [], {}
     for p in designs:
-        key = input_key(p, opts, templates) if p.is_file() else "missing"
+        spec, sources = _read(p)
+        key = input_key(sources, opts, templates) if p.is_file() else "missing"
         prev = old.get(str(p))
         if prev and prev.get("key") == key and _still_valid(prev, out):
             entries[str(p)] = {**prev, "rebuilt": False}
             say(f"[up to date] {prev.get('name', p.stem)}")
         else:
-            todo.append((str(p), str(out), overrides, key))
+            todo.append((str(p), str(out), overrides, key, spec))
+    if jobs > 1 and len(todo) > 1:  # worker processes read their design again (a program does not pickle)
+        todo = [(*t[:4], None) for t in todo]
     t0 = time.perf_counter()
     done = 0
     for entry in _map(_build, todo, jobs):

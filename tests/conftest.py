@@ -38,7 +38,8 @@ def base_design(**over):
 
 
 def _designs():
-    from camfab.design.spec import design_from_dict, load_design
+    from camfab.design.spec import design_from_dict
+    from camfab.formats import load_design
 
     osc = base_design(follower={"type": "roller", "motion": "oscillating", "base_radius_mm": 40.0,
                                 "roller_radius_mm": 8.0, "pivot_distance_mm": 110.0, "arm_length_mm": 90.0},

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from camfab.cli import main
-from camfab.design.spec import load_design
+from camfab.formats import load_design
 from tests.conftest import EXAMPLES
 
 

@@ -157,3 +157,27 @@ def test_internal_error_on_one_design_does_not_lose_the_others(designs, tmp_path
     cams = {c["name"]: c for c in _manifest(out)["cams"]}
     assert cams["Ejemplo1RT"]["status"] == "error" and "simulated bug" in cams["Ejemplo1RT"]["error"]
     assert cams["Ejemplo9RT"]["status"] == cams["Ejemplo10EX"]["status"] == "ok"
+
+
+def test_input_key_hashes_the_knot_file_a_design_names(tmp_path):
+    from camfab.formats import design_to_xlsx, load_design
+    from camfab.package import input_key
+
+    for name in ("valve_exhaust_ej1.toml", "valve_recon_ej1.csv"):
+        shutil.copy(EXAMPLES / name, tmp_path)
+    toml = tmp_path / "valve_exhaust_ej1.toml"
+    spec = load_design(toml)
+    assert spec.sources == (str(toml), str(tmp_path / "valve_recon_ej1.csv"))
+    book = tmp_path / "valve.xlsx"  # an xlsx design that names the same knot file
+    book.write_bytes(design_to_xlsx(spec))
+    import openpyxl
+
+    wb = openpyxl.load_workbook(book)
+    del wb["knots"]
+    wb["design"].append(["motion_table.file", "valve_recon_ej1.csv"])
+    wb.save(book)
+    keys = [input_key(load_design(p).sources, {}, "t") for p in (toml, book)]
+    csv = tmp_path / "valve_recon_ej1.csv"
+    csv.write_text(csv.read_text().replace("0.0005,0.4744", "0.00051,0.4744"))
+    new = [input_key(load_design(p).sources, {}, "t") for p in (toml, book)]
+    assert new[0] != keys[0] and new[1] != keys[1] and len(set(keys)) == 2

@@ -54,7 +54,7 @@ def _versions() -> dict[str, str | None]:
 
 
 def _examples() -> list[str]:
-    from camfab.cli import EXAMPLES_DIR
+    from camfab.formats import EXAMPLES_DIR
 
     return sorted(p.stem for p in EXAMPLES_DIR.glob("*.toml"))
 

@@ -1,13 +1,14 @@
 """Design stage: motion laws, segment programs, the design spec, profile synthesis and checks.
 
-This package knows nothing of exporters.
+This package reads and writes no files and knows nothing of exporters: :mod:`camfab.formats`
+reads designs into :class:`DesignSpec` values.
 """
 from __future__ import annotations
 
 from .laws import LAWS, Law, get_law, law_names
 from .motion_report import Finding, MotionReport, analyse_motion
 from .program import MotionProgram, Segment, SegmentInput, build_program
-from .spec import DesignSpec, design_from_dict, load_design
+from .spec import DesignSpec, design_from_dict
 
 __all__ = [
     "LAWS",
@@ -19,7 +20,6 @@ __all__ = [
     "SegmentInput",
     "build_program",
     "DesignSpec",
-    "load_design",
     "design_from_dict",
     "Finding",
     "MotionReport",

@@ -126,12 +126,7 @@ def dynamics_of(spec: DesignSpec, geometry: CamGeometry | None = None) -> Dynami
 
 def knot_findings(spec: DesignSpec) -> list[Finding]:
     """KNOT_INCONSISTENT warnings of a knot-table design (none for segment programs)."""
-    if spec.motion_table is None:
+    if spec.knot_table is None:
         return []
-    from pathlib import Path
-
-    from .knots import load_motion_table
-
-    base = Path(spec.base_dir) if spec.base_dir else None
     return [Finding(w.code, "warning", w.from_deg, w.to_deg, w.implied_peak, w.knot_max, w.message)
-            for w in load_motion_table(spec.motion_table, base_dir=base).warnings()]
+            for w in spec.knot_table.warnings()]

@@ -1,12 +1,12 @@
 """Knot-table motions: rows ``(angle, s, v, a[, j])`` joined by Hermite polynomials.
 
 A knot table is the ``[motion_table]`` alternative to ``[[motion]]`` segments
-(design notes §6; valve case, spec ``valve-case-and-textbook.md`` §3).  Each row
+(a valve lift given as a table of points, for instance).  Each row
 fixes the follower's displacement and its derivatives at one cam angle; between
 consecutive knots the displacement is the unique polynomial meeting both ends:
 
 * ``degree = 5`` (default): quintic Hermite through ``s, v, a`` — C² everywhere,
-  the jerk generally jumps at knots (spec §3.5);
+  the jerk generally jumps at knots;
 * ``degree = 7``: 7th-degree Hermite through ``s, v, a, j`` — C³ everywhere.
 
 The result is an ordinary :class:`~camfab.design.program.MotionProgram` whose
@@ -39,7 +39,7 @@ Either way the program is periodic and C² (C³) at 0°/360° as well.
 
 Validation and warnings
 -----------------------
-:func:`load_motion_table` checks everything that can be checked on the rows
+:func:`build_knot_table` checks everything that can be checked on the rows
 and reports every problem at once in one :class:`~camfab.errors.SpecError`
 (paths such as ``motion_table.rows[3][1]`` or ``motion_table.units.v``; rows
 are counted from 0, after any header, also for rows read from a file).
@@ -48,31 +48,20 @@ below 0 (the follower would cross the base/prime circle), naming every
 offending segment.  :meth:`KnotTable.warnings` lists segments whose implied
 peak ``|S″|`` (and ``|S‴|`` for degree 7) is more than ``ratio`` (default 5)
 times the largest value given at the segment's two knots — the symptom of
-rounded or otherwise inconsistent knots (spec §3.6).  The default is 5, not
-10: the printed Example 2 matrix peaks at 9× (Example 1 at 18.6×), while its
-µm-precision reconstruction (spec §3.6) stays at 4.1×; a smooth motion
+rounded or otherwise inconsistent knots (s printed to 0.1 mm beside v and a
+to four digits).  The default is 5, not 10: the printed valve PUNTOS matrix of
+Example 2 peaks at 9× (Example 1 at 18.6×), while Example 1 with s
+reconstructed to 1 µm (``valve_recon_ej1.csv``) stays at 4.1×; a smooth motion
 sampled at several knots per acceleration swing stays close to 1×.  A segment whose two knots both
 give exactly 0 leaves that derivative to the interpolant (a dwell or a
 rest-to-rest rise) and is not compared.
 
 Files
 -----
-``file = "puntos.csv"`` is resolved against ``base_dir`` (the design file's
-folder).  ``.csv .txt .dat .tsv`` are text; ``.xlsx .xlsm`` are read with
-openpyxl.
-
-* Text: lines starting with ``#`` or ``%`` and blank lines are skipped; the
-  first remaining line is a header when it is not numeric (so a MATLAB
-  ``PUNTOS=`` paste works).  Separators: ``;`` if any line has one, else ``,``
-  if any line has one, else whitespace.  Decimal commas are accepted only
-  where they cannot be separators: in ``;``-separated files, and in
-  whitespace-separated files whose commas, taken as separators, would not
-  give numbers (``22 0,5 0,39 1875,3``).  A comma file is always read as
-  comma-separated with decimal points.  Trailing separators are ignored.
-* xlsx: the first sheet; empty rows are skipped; a first row holding text is
-  a header.  Columns A–D are angle, s, v, a; column E is j when any data row
-  has a number there; further columns are ignored.  Numeric text cells are
-  accepted (a decimal comma in a cell is unambiguous).
+The core reads no files.  A ``file = "puntos.csv"`` is read by
+:mod:`camfab.formats` (relative to the design file's folder), which hands the
+rows over as a :class:`KnotFile`; they are validated like inline rows and
+messages name the file.
 """
 from __future__ import annotations
 
@@ -93,10 +82,9 @@ __all__ = [
     "UNITS",
     "KnotTable",
     "KnotWarning",
-    "load_motion_table",
-    "read_knots",
-    "read_knots_csv",
-    "read_knots_xlsx",
+    "KnotFile",
+    "TABLE_KEYS",
+    "build_knot_table",
 ]
 
 TWO_PI = 2.0 * math.pi
@@ -110,8 +98,6 @@ UNITS: dict[str, tuple[str, ...]] = {
 }
 COLUMNS = ("angle", "s", "v", "a", "j")
 TABLE_KEYS = ("rows", "file", "units", "speed_rpm", "degree")
-TEXT_SUFFIXES = (".csv", ".txt", ".dat", ".tsv")
-XLSX_SUFFIXES = (".xlsx", ".xlsm")
 #: two knot values are "equal" (360° row = 0° row) within this relative tolerance
 CLOSURE_REL_TOL = 1e-9
 #: default ratio of implied peak to knot values above which a segment is flagged
@@ -122,6 +108,36 @@ _TITLES = {5: "Quintic Hermite knot segment", 7: "7th-degree Hermite knot segmen
 
 # ---------------------------------------------------------------------------
 # results
+@dataclass(frozen=True, slots=True)
+class KnotFile:
+    """The ``file`` of a ``[motion_table]`` once read (by :mod:`camfab.formats`).
+
+    The formats layer reads the file once, relative to the design file's folder,
+    and hands this value to the core in place of the name; the rows are then
+    validated exactly like inline rows.
+
+    Attributes
+    ----------
+    name : str
+        The file name as written in the design (shown in reports).
+    path : str
+        The file that was read (named in messages).
+    rows : tuple of tuple of float, or None
+        The data rows, header and comments dropped; None when the file could
+        not be read.
+    problems : tuple of Problem
+        Why it could not be read (reported with the design's other problems).
+    """
+
+    name: str
+    path: str
+    rows: tuple[tuple[float, ...], ...] | None
+    problems: tuple[Problem, ...] = ()
+
+    def __str__(self) -> str:
+        return self.name
+
+
 @dataclass(frozen=True, slots=True)
 class KnotWarning:
     """One inconsistent knot segment (a warning, not an error).
@@ -165,7 +181,7 @@ class KnotWarning:
 
 @dataclass(frozen=True, eq=False)
 class KnotTable:
-    """A validated knot table (build it with :func:`load_motion_table`).
+    """A validated knot table (build it with :func:`build_knot_table`).
 
     Attributes
     ----------
@@ -494,19 +510,15 @@ def _build(rows: Any, units: Any, speed: Any, degree: Any, path: str, source: st
 
 # ---------------------------------------------------------------------------
 # the [motion_table] entry point
-def load_motion_table(table: Mapping[str, Any], *, base_dir: Path | None = None,
-                      path: str = "motion_table") -> KnotTable:
-    """Build a :class:`KnotTable` from a ``[motion_table]`` dict.
+def build_knot_table(table: Mapping[str, Any], *, path: str = "motion_table") -> KnotTable:
+    """Build a :class:`KnotTable` from a ``[motion_table]`` dict whose rows are at hand.
 
     Parameters
     ----------
     table : dict
-        ``{"rows": [[angle, s, v, a(, j)], ...]}`` or ``{"file": "puntos.csv"}``,
-        plus optional ``units`` (dict), ``speed_rpm`` (float) and ``degree``
-        (5 or 7).
-    base_dir : Path, optional
-        Folder a relative ``file`` is resolved against (default: the current
-        directory).
+        ``{"rows": [[angle, s, v, a(, j)], ...]}``, or ``{"file": KnotFile}`` (a
+        file already read by the formats layer), plus optional ``units`` (dict),
+        ``speed_rpm`` (float) and ``degree`` (5 or 7).
     path : str
         Field path used in messages.
 
@@ -521,7 +533,7 @@ def load_motion_table(table: Mapping[str, Any], *, base_dir: Path | None = None,
 
     Examples
     --------
-    >>> t = load_motion_table({"rows": [[0, 0, 0, 0], [90, 5, 0, 0], [180, 0, 0, 0]]})
+    >>> t = build_knot_table({"rows": [[0, 0, 0, 0], [90, 5, 0, 0], [180, 0, 0, 0]]})
     >>> round(float(t.program()(np.pi / 2)[0]), 12)
     5.0
     """
@@ -529,13 +541,13 @@ def load_motion_table(table: Mapping[str, Any], *, base_dir: Path | None = None,
         raise SpecError(Problem(path, table, "must be a table", 'e.g. [motion_table] file = "puntos.csv"'))
     problems = [Problem(f"{path}.{k}", table[k], "unknown key", "use keys: " + ", ".join(TABLE_KEYS))
                 for k in table if k not in TABLE_KEYS]
-    rows, source = _table_rows(table, base_dir, path, problems)
+    rows, source = _table_rows(table, path, problems)
     return _build(rows, table.get("units"), table.get("speed_rpm"), table.get("degree", 5), path,
                   source, problems)
 
 
-def _table_rows(table: Mapping[str, Any], base_dir: Path | None, path: str,
-                problems: list[Problem]) -> tuple[Any, str | None]:
+def _table_rows(table: Mapping[str, Any], path: str, problems: list[Problem]) -> tuple[Any, str | None]:
+    """The rows (None when missing or unreadable, reported) and the file they came from."""
     has_rows, has_file = "rows" in table, "file" in table
     if has_rows == has_file:
         problems.append(Problem(path, sorted(k for k in ("rows", "file") if k in table),
@@ -544,192 +556,14 @@ def _table_rows(table: Mapping[str, Any], base_dir: Path | None, path: str,
         return table.get("rows", [[]]) if has_rows else None, None
     if has_rows:
         return table["rows"], None
-    name = table["file"]
-    if not isinstance(name, (str, Path)) or not str(name):
-        problems.append(Problem(f"{path}.file", name, "file must be a path", 'e.g. file = "puntos.csv"'))
-        return None, None
-    file = Path(name)
-    if not file.is_absolute() and base_dir is not None:
-        file = Path(base_dir) / file
-    try:
-        return read_knots(file, field=f"{path}.file"), str(file)
-    except SpecError as exc:
-        problems.extend(exc.problems)
-        return None, str(file)
-
-
-# ---------------------------------------------------------------------------
-# readers
-def _file_error(fld: str, file: Path, rule: str, fix: str) -> SpecError:
-    return SpecError(Problem(fld, str(file), rule, fix), str(file))
-
-
-def read_knots(path: str | Path, *, field: str = "motion_table.file") -> list[list[float]]:
-    """Read knot rows from a text (CSV) or xlsx file, chosen by its suffix.
-
-    Raises
-    ------
-    SpecError
-        Unknown suffix, missing or unreadable file (naming the file).
-    """
-    file = Path(path)
-    suffix = file.suffix.lower()
-    if suffix in XLSX_SUFFIXES:
-        return read_knots_xlsx(file, field=field)
-    if suffix in TEXT_SUFFIXES:
-        return read_knots_csv(file, field=field)
-    raise _file_error(field, file, f"unknown knot-file type '{file.suffix}'",
-                      "use one of: " + ", ".join(TEXT_SUFFIXES + XLSX_SUFFIXES))
-
-
-def _number(tok: str, decimal_comma: bool) -> float:
-    t = tok.strip()
-    if decimal_comma and "," in t:
-        if "." in t or t.count(",") > 1:
-            raise ValueError(t)
-        t = t.replace(",", ".")
-    return float(t)
-
-
-def _split(line: str, sep: str | None, decimal_comma: bool) -> list[float]:
-    toks = line.split(sep)
-    while sep and toks and not toks[-1].strip():
-        toks.pop()
-    return [_number(t, decimal_comma) for t in toks]
-
-
-def _dialects(lines: Sequence[str]) -> list[tuple[str | None, bool]]:
-    if any(";" in ln for ln in lines):
-        return [(";", True)]
-    if any("," in ln for ln in lines):
-        return [(",", False), (None, True)]
-    return [(None, False)]
-
-
-def _parse_rows(lines: list[tuple[int, str]], sep: str | None, dc: bool) -> list[list[float]]:
-    """Rows of one dialect; the first line may be a header.  ValueError("line N: ...")."""
-    rows = []
-    for i, (no, text) in enumerate(lines):
-        try:
-            rows.append(_split(text, sep, dc))
-        except ValueError:
-            if i == 0 and len(lines) > 1:
-                continue  # header
-            raise ValueError(f"line {no}: {text.strip()!r} is not a row of numbers") from None
-    return rows
-
-
-def _parse_lines(lines: list[tuple[int, str]]) -> list[list[float]]:
-    """Rows from (line number, text) pairs, trying each plausible dialect."""
-    err: ValueError | None = None
-    for sep, dc in _dialects([t for _, t in (lines[1:] or lines)]):
-        try:
-            return _parse_rows(lines, sep, dc)
-        except ValueError as exc:
-            err = err or exc
-    assert err is not None
-    raise err
-
-
-def read_knots_csv(path: str | Path, *, field: str = "motion_table.file") -> list[list[float]]:
-    """Read knot rows from a text file (CSV, ``;``- or whitespace-separated).
-
-    Parameters
-    ----------
-    path : str or Path
-        The file; see the module docstring for the accepted formats.
-    field : str
-        Field path used in messages.
-
-    Returns
-    -------
-    list of list of float
-        One list per data row (the header, comments and blank lines dropped).
-
-    Raises
-    ------
-    SpecError
-        Missing, undecodable or non-numeric file, naming the file and the line.
-    """
-    file = Path(path)
-    try:
-        text = file.read_text(encoding="utf-8-sig")
-    except FileNotFoundError:
-        raise _file_error(field, file, "file not found", "check the path (relative paths are "
-                          "resolved against the design file's folder)") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise _file_error(field, file, f"cannot read the file as UTF-8 text ({exc.__class__.__name__})",
-                          "save the knot table as a UTF-8 CSV") from None
-    lines = [(no, ln) for no, ln in enumerate(text.splitlines(), 1)
-             if ln.strip() and not ln.lstrip().startswith(("#", "%"))]
-    if not lines:
-        raise _file_error(field, file, "the file holds no knot rows", "add rows: angle, s, v, a[, j]")
-    try:
-        rows = _parse_lines(lines)
-    except ValueError as exc:
-        raise _file_error(field, file, str(exc), "write one knot per line: angle, s, v, a[, j] "
-                          "(separated by ',', ';' or spaces; one optional header line)") from None
-    return rows
-
-
-def _cell_number(x: Any) -> float | None:
-    if _is_real(x):
-        return float(x)
-    if isinstance(x, str) and x.strip():
-        try:
-            return _number(x, True)
-        except ValueError:
-            return None
-    return None
-
-
-def read_knots_xlsx(path: str | Path, *, field: str = "motion_table.file") -> list[list[float]]:
-    """Read knot rows from the first sheet of an xlsx workbook.
-
-    Columns A–D are angle, s, v, a and column E is j when any data row has a
-    number there; a first row holding text is a header; empty rows are skipped.
-
-    Raises
-    ------
-    SpecError
-        Missing or corrupt workbook, or non-numeric cells (naming the cells).
-    """
-    from openpyxl.utils import get_column_letter
-
-    file = Path(path)
-    cells = _xlsx_cells(file, field)
-    cells = [(no, r) for no, r in cells if any(c is not None and str(c).strip() for c in r)]
-    if cells and any(isinstance(c, str) and _cell_number(c) is None for c in cells[0][1]):
-        cells = cells[1:]
-    if not cells:
-        raise _file_error(field, file, "the first sheet holds no knot rows",
-                          "put angle, s, v, a[, j] in columns A–E")
-    width = 5 if any(len(r) > 4 and _cell_number(r[4]) is not None for _, r in cells) else 4
-    rows, bad = [], []
-    for no, r in cells:
-        vals = [_cell_number(r[k]) if k < len(r) else None for k in range(width)]
-        bad += [f"{get_column_letter(k + 1)}{no}" for k, v in enumerate(vals) if v is None]
-        rows.append(vals)
-    if bad:
-        listed = ", ".join(bad[:20]) + (" …" if len(bad) > 20 else "")
-        raise _file_error(field, file, f"cells are not numbers: {listed}",
-                          f"fill columns A–{get_column_letter(width)} with numbers (angle, s, v, a[, j])")
-    return rows
-
-
-def _xlsx_cells(file: Path, fld: str) -> list[tuple[int, tuple[Any, ...]]]:
-    """(row number, values) of the first sheet; SpecError if the workbook cannot be read."""
-    import openpyxl
-
-    if not file.is_file():
-        raise _file_error(fld, file, "file not found", "check the path (relative paths are resolved "
-                          "against the design file's folder)")
-    try:
-        wb = openpyxl.load_workbook(file, read_only=True, data_only=True)
-        try:
-            return [(no, tuple(r)) for no, r in enumerate(wb.worksheets[0].iter_rows(values_only=True), 1)]
-        finally:
-            wb.close()
-    except Exception as exc:  # openpyxl raises many types for a damaged file
-        raise _file_error(fld, file, f"not a readable xlsx workbook ({exc.__class__.__name__}: {exc})",
-                          "re-save it as .xlsx from a spreadsheet program, or export the table as CSV") from None
+    file = table["file"]
+    if isinstance(file, KnotFile):
+        problems.extend(file.problems)
+        return file.rows, file.path
+    if not isinstance(file, (str, Path)) or not str(file):
+        problems.append(Problem(f"{path}.file", file, "file must be a path", 'e.g. file = "puntos.csv"'))
+    else:
+        problems.append(Problem(f"{path}.file", file, "the file has not been read (the design core reads "
+                                "no files)", "load the design with camfab.formats.load_design (or "
+                                "camfab.formats.design_from_data for a dict), or give rows = [...]"))
+    return None, None

@@ -1,26 +1,29 @@
-"""The design file: TOML (or a dict) → one immutable, validated :class:`DesignSpec`.
+"""The design as data (the TOML structure, a dict) → one immutable, validated :class:`DesignSpec`.
 
-The keys are the user-facing contract of ``../shared/design.md`` §6.  Every
-problem in a file is collected and reported together in one
-:class:`~camfab.errors.SpecError`; each names the field path, the value, the
-rule and a fix.  Nothing here computes geometry: :meth:`DesignSpec.program`
-builds the (validated) motion program, and mechanism geometry is checked by
-:mod:`camfab.design.mechanisms`.
+The keys are the user-facing contract of the design file (see the README).  Every
+problem in a design is collected and reported together in one
+:class:`~camfab.errors.SpecError`; each names the field path, the value, the rule
+and a fix.  This module reads no files: :mod:`camfab.formats` reads TOML and xlsx
+designs, and the knot file a ``[motion_table]`` names, and hands the data over.
+Nothing here computes geometry: :meth:`DesignSpec.program` builds the (validated)
+motion program, and mechanism geometry is checked by :mod:`camfab.design.mechanisms`.
 """
 from __future__ import annotations
 
 import difflib
 import functools
-import math
-import tomllib
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 from ..errors import Problem, SpecError
-from ..tolerances import MAX_EXPORT_TOL_MM, MIN_EXPORT_TOL_MM, DEFAULT_EXPORT_TOL_MM
+from ..tolerances import DEFAULT_EXPORT_TOL_MM, MAX_EXPORT_TOL_MM, MIN_EXPORT_TOL_MM
 from ..units import DEG, RPM
+from .kinds import CamKind, Direction, FollowerMotion, FollowerType, LiftUnit, Rotation
+from .knots import KnotFile, KnotTable, build_knot_table
 from .laws import law_names
+from .program import TWO_PI, MotionProgram, SegmentInput, build_program
+from .validator import Validator
 
 __all__ = [
     "CamSpec",
@@ -30,16 +33,11 @@ __all__ = [
     "OutputsSpec",
     "DynamicsSpec",
     "DesignSpec",
-    "load_design",
     "design_from_dict",
-    "CAM_KINDS",
+    "dynamics_items",
     "POSTS",
 ]
 
-CAM_KINDS = ("disc", "conjugate", "constant_width", "constant_diameter", "translating")
-FOLLOWER_TYPES = ("roller", "flat", "knife")
-FOLLOWER_MOTIONS = ("translating", "oscillating")
-ROTATIONS = ("cw", "ccw")
 POSTS = ("linuxcnc", "fanuc", "grbl")
 
 _TOP_KEYS = ("name", "description", "cam", "follower", "motion", "motion_table", "manufacturing",
@@ -50,6 +48,18 @@ _FOLLOWER_FLOATS = ("base_radius_mm", "roller_radius_mm", "offset_mm", "pivot_di
                     "second_roller_radius_mm", "follower_angle_deg", "cam_length_mm",
                     "base_height_mm", "width_mm", "rise_deg")
 _FOLLOWER_KEYS = ("type", "motion", *_FOLLOWER_FLOATS)
+#: [follower] lengths that must be > 0, and those that may be 0 (the others lie in ±1e6)
+_POSITIVE = ("base_radius_mm", "arm_length_mm", "cam_length_mm", "follower_distance_mm", "width_mm")
+_NON_NEGATIVE = ("roller_radius_mm", "pivot_distance_mm", "second_roller_radius_mm", "base_height_mm")
+#: [follower] keys a disc (or conjugate) cam needs, by follower type and motion
+_REQUIRED: dict[tuple[str, str], tuple[str, ...]] = {
+    ("roller", "translating"): ("base_radius_mm", "roller_radius_mm"),
+    ("knife", "translating"): ("base_radius_mm",),
+    ("roller", "oscillating"): ("base_radius_mm", "roller_radius_mm", "pivot_distance_mm", "arm_length_mm"),
+    ("knife", "oscillating"): ("base_radius_mm", "pivot_distance_mm", "arm_length_mm"),
+    ("flat", "translating"): ("base_radius_mm",),
+    ("flat", "oscillating"): ("base_radius_mm", "pivot_distance_mm"),
+}
 _SEGMENT_KEYS = ("law", "lift", "angle_deg", "length_mm", "shape")
 _MFG_KEYS = ("thickness_mm", "bore_mm", "keyway", "hub_diameter_mm", "hub_length_mm",
              "tool_diameter_mm", "tolerance_mm", "material")
@@ -72,20 +82,20 @@ class CamSpec:
     of a translating cam.
     """
 
-    kind: str = "disc"
-    rotation: str = "cw"
+    kind: CamKind = CamKind.DISC
+    rotation: Rotation = Rotation.CW
     omega_rad_s: float = 1.0
     speed_mm_s: float | None = None
     speed_given: bool = False
-    direction: str = "left"
+    direction: Direction = Direction.LEFT
 
 
 @dataclass(frozen=True, slots=True)
 class FollowerSpec:
     """``[follower]``: type, motion and geometry (mm, degrees).  Unused fields are None."""
 
-    type: str = "roller"
-    motion: str = "translating"
+    type: FollowerType = FollowerType.ROLLER
+    motion: FollowerMotion = FollowerMotion.TRANSLATING
     base_radius_mm: float | None = None
     roller_radius_mm: float | None = None
     offset_mm: float | None = None
@@ -101,9 +111,9 @@ class FollowerSpec:
     rise_deg: float | None = None
 
     @property
-    def lift_unit(self) -> str:
-        """'deg' for oscillating followers, 'mm' otherwise."""
-        return "deg" if self.motion == "oscillating" else "mm"
+    def lift_unit(self) -> LiftUnit:
+        """Degrees for oscillating followers, mm otherwise."""
+        return LiftUnit.DEG if self.motion == FollowerMotion.OSCILLATING else LiftUnit.MM
 
 
 @dataclass(frozen=True, slots=True)
@@ -157,7 +167,7 @@ class DynamicsSpec:
     force).  Form-closed cams (conjugate, constant width/diameter) take no spring and no safety force.
     The fields of the other motion are None."""
 
-    motion: str
+    motion: FollowerMotion
     inertia: float
     spring_rate: float = 0.0
     spring_preload: float = 0.0
@@ -168,12 +178,18 @@ class DynamicsSpec:
 
     @property
     def preload_unit(self) -> str:
-        return "N·m" if self.motion == "oscillating" else "N"
+        return "N·m" if self.motion == FollowerMotion.OSCILLATING else "N"
 
 
 @dataclass(frozen=True)
 class DesignSpec:
-    """A validated design (immutable).  Build with :func:`load_design` or :func:`design_from_dict`."""
+    """A validated design (immutable).  Build it with :func:`design_from_dict`, or read a file with
+    :func:`camfab.formats.load_design`.
+
+    ``motion_table`` is the ``[motion_table]`` section as written, its rows at hand: given inline
+    (``rows``) or read from its ``file`` by the formats layer (a :class:`~camfab.design.knots.KnotFile`).
+    ``source`` names the design file (None for a dict).
+    """
 
     name: str
     cam: CamSpec
@@ -185,13 +201,12 @@ class DesignSpec:
     pressure_angle_limit_deg: float | None = None
     description: str = ""
     source: str | None = None
-    base_dir: str | None = None
     face_margin_mm: float = 0.0
     dynamics: DynamicsSpec | None = None
 
     @property
     def is_translating_cam(self) -> bool:
-        return self.cam.kind == "translating"
+        return self.cam.kind == CamKind.TRANSLATING
 
     @property
     def speed(self) -> float:
@@ -200,69 +215,57 @@ class DesignSpec:
             return self.cam.speed_mm_s if self.cam.speed_mm_s is not None else 1.0
         return self.cam.omega_rad_s
 
+    @property
+    def sources(self) -> tuple[str, ...]:
+        """The files this design was read from: the design file, then the knot file it names."""
+        out = [self.source] if self.source else []
+        file = self.motion_table.get("file") if self.motion_table is not None else None
+        if isinstance(file, KnotFile):
+            out.append(file.path)
+        return tuple(out)
+
     @functools.cached_property
-    def motion_program(self):
+    def knot_table(self) -> KnotTable | None:
+        """The validated :class:`~camfab.design.knots.KnotTable` of a ``[motion_table]`` (built once)."""
+        return None if self.motion_table is None else build_knot_table(self.motion_table)
+
+    @functools.cached_property
+    def motion_program(self) -> MotionProgram:
         """The validated :class:`~camfab.design.program.MotionProgram` (built once)."""
         return _build_motion(self)
 
-    def program(self):
+    def program(self) -> MotionProgram:
         """The validated :class:`~camfab.design.program.MotionProgram` of this design."""
         return self.motion_program
 
 
+def dynamics_items(d: DynamicsSpec) -> list[tuple[str, float]]:
+    """The ``[dynamics]`` keys (as in the design file, units in the names) and values of a spec."""
+    own = _DYN_OSCILLATING if d.motion == FollowerMotion.OSCILLATING else _DYN_TRANSLATING
+    vals = (d.inertia, d.spring_rate, d.spring_preload, d.damping, d.external)
+    return [*zip(own, vals, strict=True), ("friction_coefficient", d.friction_coefficient),
+            ("safety_force_n", d.safety_force_n)]
+
+
 # ---------------------------------------------------------------------------
-def load_design(path: str | Path) -> DesignSpec:
-    """Read and validate a design file: TOML, or an xlsx workbook (``*.xlsx``, see
-    :mod:`camfab.design.xlsx_design`).
+def design_from_dict(data: Mapping[str, Any], *, source: str | None = None) -> DesignSpec:
+    """Validate a design given as a dict (the TOML structure) into a :class:`DesignSpec`.
+
+    Parameters
+    ----------
+    data : Mapping
+        The design; a ``[motion_table]`` gives its ``rows`` inline or a ``file`` already read by
+        :mod:`camfab.formats` (a :class:`~camfab.design.knots.KnotFile`).
+    source : str, optional
+        The design file, named in messages.
 
     Raises
     ------
     SpecError
-        On unreadable or invalid files; every problem found is listed.
+        Every problem found, each with its field path, value, rule and fix.
     """
-    p = Path(path)
-    if p.suffix.lower() == ".xlsx":
-        from .xlsx_design import load_design_xlsx
-
-        return load_design_xlsx(p)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise SpecError(Problem("file", str(p), "no such design file", "check the path"), str(p)) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SpecError(Problem("file", str(p), f"cannot be read ({exc})",
-                                "give a UTF-8 TOML design file"), str(p)) from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise SpecError(Problem("file", p.name, f"is not valid TOML: {exc}",
-                                "fix the TOML syntax at the line named"), str(p)) from None
-    data.setdefault("name", p.stem)
-    return design_from_dict(data, source=str(p), base_dir=p.parent)
-
-
-def design_from_dict(data: Mapping[str, Any], *, source: str | None = None,
-                     base_dir: str | Path | None = None) -> DesignSpec:
-    """Validate a design given as a dict (the TOML structure) into a :class:`DesignSpec`."""
-    v = _Validator()
-    v.keys(data, _TOP_KEYS, "")
-    name = data.get("name", "cam")
-    if not isinstance(name, str) or not name.strip():
-        v.add("name", name, "must be a non-empty string", 'e.g. name = "Ejemplo9RT"')
-        name = "cam"
-    cam = _cam(v, _table(v, data, "cam"))
-    fol = _follower(v, _table(v, data, "follower"), cam)
-    motion, table = _motion(v, data, cam)
-    mfg = _manufacturing(v, _table(v, data, "manufacturing"), fol, cam.kind == "translating")
-    out = _outputs(v, _table(v, data, "outputs"))
-    checks = _table(v, data, "checks")
-    v.keys(checks, _CHECK_KEYS, "checks")
-    pa = v.number(checks, "pressure_angle_limit_deg", "checks", None, lo=0.0, hi=90.0, lo_open=True, hi_open=True)
-    margin = v.number(checks, "face_margin_mm", "checks", 0.0, lo=0.0, hi=1e4)
-    dyn = _dynamics(v, data, cam, fol)
-    spec = DesignSpec(name.strip() if isinstance(name, str) else "cam", cam, fol, motion, table, mfg, out,
-                      pa, str(data.get("description", "")), source,
-                      str(base_dir) if base_dir is not None else None, margin, dyn)
+    v = Validator()
+    spec = _validate(v, data, source)
     if not v.problems:
         try:
             spec.program()
@@ -273,85 +276,46 @@ def design_from_dict(data: Mapping[str, Any], *, source: str | None = None,
     return spec
 
 
+def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> DesignSpec:
+    """Every section read into the spec, problems collected in ``v``."""
+    v.keys(data, _TOP_KEYS, "")
+    name = data.get("name", "cam")
+    if not isinstance(name, str) or not name.strip():
+        v.add("name", name, "must be a non-empty string", 'e.g. name = "Ejemplo9RT"')
+        name = "cam"
+    cam = _cam(v, v.table(data, "cam"))
+    fol = _follower(v, v.table(data, "follower"), cam)
+    motion, table = _motion(v, data, cam)
+    mfg = _manufacturing(v, v.table(data, "manufacturing"), fol, cam.kind == CamKind.TRANSLATING)
+    out = _outputs(v, v.table(data, "outputs"))
+    checks = v.table(data, "checks")
+    v.keys(checks, _CHECK_KEYS, "checks")
+    pa = v.number(checks, "pressure_angle_limit_deg", "checks", None, lo=0.0, hi=90.0, lo_open=True, hi_open=True)
+    margin = v.number(checks, "face_margin_mm", "checks", 0.0, lo=0.0, hi=1e4)
+    dyn = _dynamics(v, data, cam, fol)
+    return DesignSpec(name.strip(), cam, fol, motion, table, mfg, out, pressure_angle_limit_deg=pa,
+                      description=str(data.get("description", "")), source=source, face_margin_mm=margin,
+                      dynamics=dyn)
+
+
 # ---------------------------------------------------------------------------
-class _Validator:
-    """Collects problems while reading typed values out of nested dicts."""
-
-    def __init__(self) -> None:
-        self.problems: list[Problem] = []
-
-    def add(self, path: str, value: Any, rule: str, fix: str = "") -> None:
-        self.problems.append(Problem(path, value, rule, fix))
-
-    def keys(self, table: Mapping[str, Any], allowed: tuple[str, ...], path: str) -> None:
-        for k in table:
-            if k not in allowed:
-                close = difflib.get_close_matches(k, allowed, n=1)
-                fix = f"did you mean '{close[0]}'?" if close else "allowed keys: " + ", ".join(allowed)
-                self.add(f"{path}.{k}" if path else k, table[k], "unknown key", fix)
-
-    def choice(self, table, key, path, options, default):
-        val = table.get(key, default)
-        if val not in options:
-            self.add(f"{path}.{key}", val, "is not a valid option",
-                     "must be one of: " + ", ".join(map(str, options)))
-            return default
-        return val
-
-    def number(self, table, key, path, default, *, lo=None, hi=None, lo_open=False, hi_open=False,
-               fix: str = ""):
-        """A finite float in [lo, hi] (open ends optional); None/default when absent."""
-        if key not in table:
-            return default
-        val = table[key]
-        where = f"{path}.{key}"
-        if isinstance(val, bool) or not isinstance(val, (int, float)):
-            self.add(where, val, "must be a number", fix or "write a plain number (no units, no quotes)")
-            return default
-        val = float(val)
-        if not math.isfinite(val):
-            self.add(where, val, "must be finite", fix or "give a finite number")
-            return default
-        bad_lo = lo is not None and (val <= lo if lo_open else val < lo)
-        bad_hi = hi is not None and (val >= hi if hi_open else val > hi)
-        if bad_lo or bad_hi:
-            rng = f"{'(' if lo_open else '['}{'-inf' if lo is None else lo}, {'inf' if hi is None else hi}{')' if hi_open else ']'}"
-            self.add(where, val, f"must be in {rng}", fix or "change the value into that range")
-            return default
-        return val
-
-    def boolean(self, table, key, path, default):
-        val = table.get(key, default)
-        if not isinstance(val, bool):
-            self.add(f"{path}.{key}", val, "must be true or false", "write true or false (no quotes)")
-            return default
-        return val
-
-
-def _table(v: _Validator, data: Mapping[str, Any], key: str) -> Mapping[str, Any]:
-    t = data.get(key, {})
-    if not isinstance(t, Mapping):
-        v.add(key, t, "must be a table", f"write it as a [{key}] section")
-        return {}
-    return t
-
-
-def _cam(v: _Validator, t: Mapping[str, Any]) -> CamSpec:
+def _cam(v: Validator, t: Mapping[str, Any]) -> CamSpec:
     v.keys(t, _CAM_KEYS, "cam")
-    kind = v.choice(t, "kind", "cam", CAM_KINDS, "disc")
-    rotation = v.choice(t, "rotation", "cam", ROTATIONS, "cw")
+    kind = v.choice(t, "kind", "cam", CamKind, CamKind.DISC)
+    rotation = v.choice(t, "rotation", "cam", Rotation, Rotation.CW)
     rpm = v.number(t, "speed_rpm", "cam", None, lo=0.0, lo_open=True, hi=1e6)
     omega = v.number(t, "omega_rad_s", "cam", None, lo=0.0, lo_open=True, hi=1e6)
     vmm = v.number(t, "speed_mm_s", "cam", None, lo=0.0, lo_open=True, hi=1e7)
+    translating = kind == CamKind.TRANSLATING
     if rpm is not None and omega is not None:
         v.add("cam.speed_rpm", rpm, "give either speed_rpm or omega_rad_s, not both", "remove one of them")
-    if kind == "translating" and (rpm is not None or omega is not None):
+    if translating and (rpm is not None or omega is not None):
         v.add("cam.speed_rpm" if rpm is not None else "cam.omega_rad_s", rpm or omega,
               "a translating cam has a linear speed", "use speed_mm_s")
-    if kind != "translating" and vmm is not None:
+    if not translating and vmm is not None:
         v.add("cam.speed_mm_s", vmm, "only translating cams have a linear speed", "use speed_rpm or omega_rad_s")
-    direction = v.choice(t, "direction", "cam", ("left", "right"), "left")
-    if "direction" in t and kind != "translating":
+    direction = v.choice(t, "direction", "cam", Direction, Direction.LEFT)
+    if "direction" in t and not translating:
         v.add("cam.direction", t["direction"], "only translating cams slide left or right",
               "use rotation = \"cw\" | \"ccw\" for rotating cams")
     given = rpm is not None or omega is not None or vmm is not None
@@ -359,74 +323,95 @@ def _cam(v: _Validator, t: Mapping[str, Any]) -> CamSpec:
     return CamSpec(kind, rotation, w, vmm, given, direction)
 
 
-_REQUIRED = {
-    ("roller", "translating"): ("base_radius_mm", "roller_radius_mm"),
-    ("knife", "translating"): ("base_radius_mm",),
-    ("roller", "oscillating"): ("base_radius_mm", "roller_radius_mm", "pivot_distance_mm", "arm_length_mm"),
-    ("knife", "oscillating"): ("base_radius_mm", "pivot_distance_mm", "arm_length_mm"),
-    ("flat", "translating"): ("base_radius_mm",),
-    ("flat", "oscillating"): ("base_radius_mm", "pivot_distance_mm"),
-}
-
-
-def _follower(v: _Validator, t: Mapping[str, Any], cam: CamSpec) -> FollowerSpec:
+# ---------------------------------------------------------------------------
+# [follower]: numbers, then the rules of the cam kind, then the keys that kind requires
+def _follower(v: Validator, t: Mapping[str, Any], cam: CamSpec) -> FollowerSpec:
     v.keys(t, _FOLLOWER_KEYS, "follower")
-    ftype = v.choice(t, "type", "follower", FOLLOWER_TYPES, "roller")
-    motion = v.choice(t, "motion", "follower", FOLLOWER_MOTIONS, "translating")
-    vals: dict[str, float | None] = {}
-    positive = ("base_radius_mm", "arm_length_mm", "cam_length_mm", "follower_distance_mm", "width_mm")
-    non_negative = ("roller_radius_mm", "pivot_distance_mm", "second_roller_radius_mm", "base_height_mm")
-    for key in _FOLLOWER_FLOATS:
-        if key in positive:
-            vals[key] = v.number(t, key, "follower", None, lo=0.0, lo_open=True, hi=1e6,
-                                 fix=f"{key} must be a positive length in mm")
-        elif key in non_negative:
-            vals[key] = v.number(t, key, "follower", None, lo=0.0, hi=1e6,
-                                 fix=f"{key} must be a length >= 0 in mm")
-        else:
-            vals[key] = v.number(t, key, "follower", None, lo=-1e6, hi=1e6)
-    if ftype == "knife":
+    ftype = v.choice(t, "type", "follower", FollowerType, FollowerType.ROLLER)
+    motion = v.choice(t, "motion", "follower", FollowerMotion, FollowerMotion.TRANSLATING)
+    vals = _follower_numbers(v, t)
+    if ftype == FollowerType.KNIFE:
         if vals["roller_radius_mm"] not in (None, 0.0):
             v.add("follower.roller_radius_mm", vals["roller_radius_mm"], "a knife-edge follower has no roller",
                   'remove roller_radius_mm or use type = "roller"')
         vals["roller_radius_mm"] = 0.0
-    if cam.kind == "translating":
-        need: tuple[str, ...] = ("roller_radius_mm", "cam_length_mm")
-        if ftype == "flat" or motion == "oscillating":
-            v.add("follower.type", ftype, "a translating cam drives a translating roller follower",
-                  'use type = "roller", motion = "translating"')
-    elif cam.kind in ("constant_width", "constant_diameter"):
-        want = "flat" if cam.kind == "constant_width" else "roller"
-        if ftype != want or motion != "translating":
-            v.add("follower.type", ftype, f"a {cam.kind.replace('_', '-')} cam has a double translating {want} "
-                  "follower", f'use type = "{want}", motion = "translating"')
-        need = ("base_radius_mm",) + (("roller_radius_mm",) if want == "roller" else ())
-        if "width_mm" in t and "follower_distance_mm" in t:
-            v.add("follower.follower_distance_mm", t["follower_distance_mm"],
-                  "give the constant width once", "keep width_mm and remove follower_distance_mm")
-        elif vals["width_mm"] is None:
-            vals["width_mm"] = vals["follower_distance_mm"]
-        if vals["width_mm"] is None and "width_mm" not in t and "follower_distance_mm" not in t:
-            v.add("follower.width_mm", None, f"is required for a {cam.kind} cam",
-                  "add width_mm = <mm> (the constant width, > 2·base_radius_mm)")
-    else:
-        need = _REQUIRED[(ftype, motion)]
-        if cam.kind == "conjugate":
-            if ftype == "knife":
-                v.add("follower.type", ftype, "conjugate cams have roller or flat followers",
-                      'use type = "roller" or "flat"')
-            need = need + (("follower_distance_mm",) if motion == "translating" else ("follower_angle_deg",))
+    rules = _FOLLOWER_RULES.get(cam.kind, _disc_follower)
+    need = rules(v, t, cam.kind, ftype, motion, vals)
     for key in need:
-        if key not in t and not (key == "roller_radius_mm" and ftype == "knife"):
+        if key not in t and not (key == "roller_radius_mm" and ftype == FollowerType.KNIFE):
             v.add(f"follower.{key}", None, f"is required for a {motion} {ftype} follower",
                   f"add {key} = <mm> to [follower]")
-    if ftype == "flat" and "roller_radius_mm" in t:
+    if ftype == FollowerType.FLAT and "roller_radius_mm" in t:
         v.add("follower.roller_radius_mm", t["roller_radius_mm"], "a flat-face follower has no roller",
               'remove it or use type = "roller"')
     return FollowerSpec(ftype, motion, **vals)
 
 
-def _motion(v: _Validator, data: Mapping[str, Any], cam: CamSpec):
+def _follower_numbers(v: Validator, t: Mapping[str, Any]) -> dict[str, float | None]:
+    """Every ``[follower]`` number (None when absent), each checked against its range."""
+    vals: dict[str, float | None] = {}
+    for key in _FOLLOWER_FLOATS:
+        if key in _POSITIVE:
+            vals[key] = v.number(t, key, "follower", None, lo=0.0, lo_open=True, hi=1e6,
+                                 fix=f"{key} must be a positive length in mm")
+        elif key in _NON_NEGATIVE:
+            vals[key] = v.number(t, key, "follower", None, lo=0.0, hi=1e6,
+                                 fix=f"{key} must be a length >= 0 in mm")
+        else:
+            vals[key] = v.number(t, key, "follower", None, lo=-1e6, hi=1e6)
+    return vals
+
+
+def _disc_follower(v: Validator, t: Mapping[str, Any], kind: CamKind, ftype: FollowerType,
+                   motion: FollowerMotion, vals: dict[str, float | None]) -> tuple[str, ...]:
+    """Disc and conjugate cams: the keys the follower needs (a conjugate pair also its second follower)."""
+    need = _REQUIRED[(ftype, motion)]
+    if kind != CamKind.CONJUGATE:
+        return need
+    if ftype == FollowerType.KNIFE:
+        v.add("follower.type", ftype, "conjugate cams have roller or flat followers", 'use type = "roller" or "flat"')
+    return need + (("follower_distance_mm",) if motion == FollowerMotion.TRANSLATING else ("follower_angle_deg",))
+
+
+def _translating_cam_follower(v: Validator, t: Mapping[str, Any], kind: CamKind, ftype: FollowerType,
+                              motion: FollowerMotion, vals: dict[str, float | None]) -> tuple[str, ...]:
+    """A translating (wedge) cam drives a translating roller."""
+    if ftype == FollowerType.FLAT or motion == FollowerMotion.OSCILLATING:
+        v.add("follower.type", ftype, "a translating cam drives a translating roller follower",
+              'use type = "roller", motion = "translating"')
+    return ("roller_radius_mm", "cam_length_mm")
+
+
+def _symmetric_follower(v: Validator, t: Mapping[str, Any], kind: CamKind, ftype: FollowerType,
+                        motion: FollowerMotion, vals: dict[str, float | None]) -> tuple[str, ...]:
+    """Constant-width (two flat faces) and constant-diameter (two rollers) cams: the width, given once."""
+    want = FollowerType.FLAT if kind == CamKind.CONSTANT_WIDTH else FollowerType.ROLLER
+    if ftype != want or motion != FollowerMotion.TRANSLATING:
+        v.add("follower.type", ftype, f"a {kind.replace('_', '-')} cam has a double translating {want} "
+              "follower", f'use type = "{want}", motion = "translating"')
+    if "width_mm" in t and "follower_distance_mm" in t:
+        v.add("follower.follower_distance_mm", t["follower_distance_mm"],
+              "give the constant width once", "keep width_mm and remove follower_distance_mm")
+    elif vals["width_mm"] is None:
+        vals["width_mm"] = vals["follower_distance_mm"]
+    if vals["width_mm"] is None and "width_mm" not in t and "follower_distance_mm" not in t:
+        v.add("follower.width_mm", None, f"is required for a {kind} cam",
+              "add width_mm = <mm> (the constant width, > 2·base_radius_mm)")
+    return ("base_radius_mm",) + (("roller_radius_mm",) if want == FollowerType.ROLLER else ())
+
+
+#: the follower rules of each cam kind (disc and conjugate cams: :func:`_disc_follower`)
+_FOLLOWER_RULES: dict[CamKind, Callable[..., tuple[str, ...]]] = {
+    CamKind.TRANSLATING: _translating_cam_follower,
+    CamKind.CONSTANT_WIDTH: _symmetric_follower,
+    CamKind.CONSTANT_DIAMETER: _symmetric_follower,
+}
+
+
+# ---------------------------------------------------------------------------
+# [[motion]] segments or a [motion_table]
+def _motion(v: Validator, data: Mapping[str, Any],
+            cam: CamSpec) -> tuple[tuple[SegmentSpec, ...] | None, dict[str, Any] | None]:
     has_seg, has_table = "motion" in data, "motion_table" in data
     if has_seg and has_table:
         v.add("motion_table", "...", "give either [[motion]] segments or a [motion_table], not both",
@@ -439,48 +424,44 @@ def _motion(v: _Validator, data: Mapping[str, Any], cam: CamSpec):
             return None, None
         return None, dict(table)
     if not has_seg:
-        if cam.kind in ("constant_width", "constant_diameter"):
-            return None, None  # the law follows from the width (see the geometry module)
-        v.add("motion", None, "the design has no motion", "add [[motion]] segments or a [motion_table]")
+        if not cam.kind.symmetric:  # a constant-width/diameter law follows from the width
+            v.add("motion", None, "the design has no motion", "add [[motion]] segments or a [motion_table]")
         return None, None
     rows = data["motion"]
     if not isinstance(rows, list) or not all(isinstance(r, Mapping) for r in rows):
         v.add("motion", rows, "must be an array of tables", "write each segment as a [[motion]] block")
         return None, None
-    span_key = "length_mm" if cam.kind == "translating" else "angle_deg"
-    other = "angle_deg" if span_key == "length_mm" else "length_mm"
+    span_key = "length_mm" if cam.kind == CamKind.TRANSLATING else "angle_deg"
+    return tuple(_segment(v, r, f"motion[{i}]", span_key) for i, r in enumerate(rows)), None
+
+
+def _segment(v: Validator, r: Mapping[str, Any], p: str, span_key: str) -> SegmentSpec:
+    """One ``[[motion]]`` segment; its span is in ``span_key`` (degrees, or mm on a translating cam)."""
+    v.keys(r, _SEGMENT_KEYS, p)
+    law = r.get("law", "dwell" if r.get("lift", 0) == 0 else None)
     laws = law_names()
-    segs = []
-    for i, r in enumerate(rows):
-        p = f"motion[{i}]"
-        v.keys(r, _SEGMENT_KEYS, p)
-        law = r.get("law", "dwell" if r.get("lift", 0) == 0 else None)
-        if law not in laws:
-            close = difflib.get_close_matches(str(law), laws, n=1)
-            v.add(f"{p}.law", law, "unknown motion law" if law is not None else "is required",
-                  f"did you mean '{close[0]}'?" if close else "use one of: " + ", ".join(laws))
-            law = "dwell"
-        lift = v.number(r, "lift", p, 0.0, lo=-1e5, hi=1e5)
-        if other in r:
-            v.add(f"{p}.{other}", r[other], f"this cam measures segments in {span_key}",
-                  f"rename it to {span_key}")
-        span_raw = r.get(span_key)
-        if span_raw == "auto":
-            span = None
-        elif span_raw is None:
-            v.add(f"{p}.{span_key}", None, "is required", f"give {span_key} (or \"auto\" for a half-period law)")
-            span = None
-        else:
-            span = v.number(r, span_key, p, None, lo=0.0, lo_open=True,
-                            hi=360.0 if span_key == "angle_deg" else 1e6)
-            if span is None:
-                span = 1.0  # already reported; keep going to collect the other problems
-        shape = r.get("shape")
-        segs.append(SegmentSpec(str(law), lift, span, shape))
-    return tuple(segs), None
+    if law not in laws:
+        close = difflib.get_close_matches(str(law), laws, n=1)
+        v.add(f"{p}.law", law, "unknown motion law" if law is not None else "is required",
+              f"did you mean '{close[0]}'?" if close else "use one of: " + ", ".join(laws))
+        law = "dwell"
+    lift = v.number(r, "lift", p, 0.0, lo=-1e5, hi=1e5)
+    other = "angle_deg" if span_key == "length_mm" else "length_mm"
+    if other in r:
+        v.add(f"{p}.{other}", r[other], f"this cam measures segments in {span_key}", f"rename it to {span_key}")
+    span_raw = r.get(span_key)
+    span = None
+    if span_raw is None:
+        v.add(f"{p}.{span_key}", None, "is required", f"give {span_key} (or \"auto\" for a half-period law)")
+    elif span_raw != "auto":
+        span = v.number(r, span_key, p, None, lo=0.0, lo_open=True, hi=360.0 if span_key == "angle_deg" else 1e6)
+        if span is None:
+            span = 1.0  # already reported; keep going to collect the other problems
+    return SegmentSpec(str(law), lift, span, r.get("shape"))
 
 
-def _manufacturing(v: _Validator, t: Mapping[str, Any], fol: FollowerSpec,
+# ---------------------------------------------------------------------------
+def _manufacturing(v: Validator, t: Mapping[str, Any], fol: FollowerSpec,
                    translating: bool = False) -> ManufacturingSpec:
     v.keys(t, _MFG_KEYS, "manufacturing")
     m = ManufacturingSpec(
@@ -496,7 +477,8 @@ def _manufacturing(v: _Validator, t: Mapping[str, Any], fol: FollowerSpec,
     )
     rb = fol.base_radius_mm
     if rb is not None and m.bore_mm >= 2 * rb:
-        v.add("manufacturing.bore_mm", m.bore_mm, f"the bore does not fit inside the base circle (diameter {2 * rb:g} mm)",
+        v.add("manufacturing.bore_mm", m.bore_mm,
+              f"the bore does not fit inside the base circle (diameter {2 * rb:g} mm)",
               "use a smaller bore or a larger base_radius_mm")
     if translating:
         for key in ("bore_mm", "hub_diameter_mm", "hub_length_mm"):
@@ -508,11 +490,40 @@ def _manufacturing(v: _Validator, t: Mapping[str, Any], fol: FollowerSpec,
     return m
 
 
-def _dynamics(v: _Validator, data: Mapping[str, Any], cam: CamSpec, fol: FollowerSpec) -> DynamicsSpec | None:
+# ---------------------------------------------------------------------------
+# [dynamics]: the keys of the follower's motion, form closure, the speed, then the numbers
+def _dynamics(v: Validator, data: Mapping[str, Any], cam: CamSpec, fol: FollowerSpec) -> DynamicsSpec | None:
     if "dynamics" not in data:
         return None
-    t = _table(v, data, "dynamics")
-    osc = fol.motion == "oscillating" and cam.kind != "translating"
+    t = v.table(data, "dynamics")
+    osc = fol.motion == FollowerMotion.OSCILLATING and cam.kind != CamKind.TRANSLATING
+    own = _DYN_OSCILLATING if osc else _DYN_TRANSLATING
+    _dynamics_keys(v, t, osc)
+    if cam.kind.form_closed:
+        for k in (own[1], own[2], "safety_force_n"):
+            if k in t:
+                v.add(f"dynamics.{k}", t[k], f"a {cam.kind.replace('_', '-')} cam drives its follower both ways "
+                      "(form closure): it has no return spring and cannot jump", f"remove {k}")
+    if not cam.speed_given:
+        key = "speed_mm_s" if cam.kind == CamKind.TRANSLATING else "speed_rpm"
+        v.add(f"cam.{key}", None, "dynamics needs the cam speed", f"add {key} = ... to [cam]")
+    m = v.number(t, own[0], "dynamics", None, lo=0.0, lo_open=True, hi=1e9,
+                 fix=f"give the {'arm inertia about its pivot' if osc else 'moving mass'} (> 0)")
+    if own[0] not in t:
+        v.add(f"dynamics.{own[0]}", None, "is required", f"add {own[0]} = ... ("
+              f"{'the arm and roller about the pivot' if osc else 'follower, spring share and attached parts'})")
+    values = _dynamics_values(v, t, own)
+    if values[4] and fol.type == FollowerType.ROLLER and (fol.roller_radius_mm or 0.0) > 0:
+        v.add("dynamics.friction_coefficient", values[4], "a roller rolls on the cam (no sliding friction is "
+              "modelled)", "remove friction_coefficient, or model a knife edge or flat face")
+    if m is None:
+        return None
+    motion = FollowerMotion.OSCILLATING if osc else FollowerMotion.TRANSLATING
+    return DynamicsSpec(motion, m, *values)
+
+
+def _dynamics_keys(v: Validator, t: Mapping[str, Any], osc: bool) -> None:
+    """Unknown keys, and the keys of the other follower motion named as such."""
     own, other = (_DYN_OSCILLATING, _DYN_TRANSLATING) if osc else (_DYN_TRANSLATING, _DYN_OSCILLATING)
     kind = "an oscillating" if osc else "a translating"
     for k in t:
@@ -520,35 +531,20 @@ def _dynamics(v: _Validator, data: Mapping[str, Any], cam: CamSpec, fol: Followe
             v.add(f"dynamics.{k}", t[k], f"is for {'translating' if osc else 'oscillating'} followers",
                   f"{kind} follower takes: " + ", ".join(own))
     v.keys({k: t[k] for k in t if k not in other}, own + _DYN_COMMON, "dynamics")
-    if cam.kind in ("conjugate", "constant_width", "constant_diameter"):
-        for k in (own[1], own[2], "safety_force_n"):
-            if k in t:
-                v.add(f"dynamics.{k}", t[k], f"a {cam.kind.replace('_', '-')} cam drives its follower both ways "
-                      "(form closure): it has no return spring and cannot jump", f"remove {k}")
-    if not cam.speed_given:
-        key = "speed_mm_s" if cam.kind == "translating" else "speed_rpm"
-        v.add(f"cam.{key}", None, "dynamics needs the cam speed", f"add {key} = ... to [cam]")
+
+
+def _dynamics_values(v: Validator, t: Mapping[str, Any], own: tuple[str, ...]) -> tuple[float, ...]:
+    """Spring rate, preload, damping, external load, friction coefficient and safety force."""
     big = 1e9
-    m = v.number(t, own[0], "dynamics", None, lo=0.0, lo_open=True, hi=big,
-                 fix=f"give the {'arm inertia about its pivot' if osc else 'moving mass'} (> 0)")
-    if own[0] not in t:
-        v.add(f"dynamics.{own[0]}", None, "is required",
-              f"add {own[0]} = ... ({'the arm and roller about the pivot' if osc else 'follower, spring share and attached parts'})")
-    rate = v.number(t, own[1], "dynamics", 0.0, lo=0.0, hi=big)
-    pre = v.number(t, own[2], "dynamics", 0.0, lo=-big, hi=big)
-    damp = v.number(t, own[3], "dynamics", 0.0, lo=0.0, hi=big)
-    ext = v.number(t, own[4], "dynamics", 0.0, lo=-big, hi=big)
-    mu = v.number(t, "friction_coefficient", "dynamics", 0.0, lo=0.0, hi=2.0)
-    fs = v.number(t, "safety_force_n", "dynamics", 0.0, lo=0.0, hi=big)
-    if mu and fol.type == "roller" and (fol.roller_radius_mm or 0.0) > 0:
-        v.add("dynamics.friction_coefficient", mu, "a roller rolls on the cam (no sliding friction is modelled)",
-              "remove friction_coefficient, or model a knife edge or flat face")
-    if m is None:
-        return None
-    return DynamicsSpec("oscillating" if osc else "translating", m, rate, pre, damp, ext, mu, fs)
+    return (v.number(t, own[1], "dynamics", 0.0, lo=0.0, hi=big),
+            v.number(t, own[2], "dynamics", 0.0, lo=-big, hi=big),
+            v.number(t, own[3], "dynamics", 0.0, lo=0.0, hi=big),
+            v.number(t, own[4], "dynamics", 0.0, lo=-big, hi=big),
+            v.number(t, "friction_coefficient", "dynamics", 0.0, lo=0.0, hi=2.0),
+            v.number(t, "safety_force_n", "dynamics", 0.0, lo=0.0, hi=big))
 
 
-def _outputs(v: _Validator, t: Mapping[str, Any]) -> OutputsSpec:
+def _outputs(v: Validator, t: Mapping[str, Any]) -> OutputsSpec:
     v.keys(t, _OUTPUT_KEYS, "outputs")
     gcode = t.get("gcode", False)
     if gcode is False:
@@ -566,10 +562,10 @@ def _outputs(v: _Validator, t: Mapping[str, Any]) -> OutputsSpec:
     return OutputsSpec(gcode=post, **flags)
 
 
-def _symmetric_law(spec: DesignSpec):
+# ---------------------------------------------------------------------------
+# the motion program
+def _symmetric_law(spec: DesignSpec) -> MotionProgram:
     """The fixed constant-width/diameter law: SHM rise, dwell, SHM return, dwell; h = width − 2·Rb."""
-    from .program import MotionProgram
-
     f = spec.follower
     h = (f.width_mm or 0.0) - (f.base_radius_mm or 0.0) * 2
     r = f.rise_deg or 120.0
@@ -581,16 +577,11 @@ def _symmetric_law(spec: DesignSpec):
     return MotionProgram.from_segments([("simple_harmonic", h, r), *dwell, ("simple_harmonic", -h, r), *dwell])
 
 
-def _build_motion(spec: DesignSpec):
-    from .program import SegmentInput, TWO_PI, build_program
-
-    if spec.motion_table is not None:
-        from .knots import load_motion_table
-
-        base = Path(spec.base_dir) if spec.base_dir else None
-        return load_motion_table(spec.motion_table, base_dir=base).program()
+def _build_motion(spec: DesignSpec) -> MotionProgram:
+    if spec.knot_table is not None:
+        return spec.knot_table.program()
     if spec.motion is None:
-        if spec.cam.kind in ("constant_width", "constant_diameter"):
+        if spec.cam.kind.symmetric:
             return _symmetric_law(spec)
         raise SpecError(Problem("motion", None, f"no motion law for a {spec.cam.kind} cam",
                                 "add [[motion]] segments"), spec.source)

@@ -5,7 +5,7 @@ figure or a page is made.
 
 Examples
 --------
->>> from camfab.design.spec import load_design
+>>> from camfab.formats import load_design
 >>> from camfab.design.assemble import geometry_from_spec, check_design
 >>> from camfab.report import render_report, write_files
 >>> spec = load_design("camfab/templates/examples/ejemplo9rt.toml")          # doctest: +SKIP

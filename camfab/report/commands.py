@@ -17,6 +17,7 @@ import sys
 from pathlib import Path
 
 from ..errors import MissingDependencyError
+from ..formats import load_design, resolve_design_path
 
 __all__ = ["checked_design", "design_report_files", "cmd_compare", "cmd_report", "require_report_dependencies"]
 
@@ -63,12 +64,11 @@ def _compare_args(p: argparse.ArgumentParser) -> None:
 
 def cmd_compare(args: argparse.Namespace) -> int:
     """``camfab compare FILE FILE… -o DIR``: writes ``compare.html`` and ``plots/``; exit 0."""
-    from ..cli import _load
     from .compare import render_comparison
     from .html import write_files
 
     require_report_dependencies()
-    items = [checked_design(_load(f)) for f in args.files]
+    items = [checked_design(load_design(resolve_design_path(f))) for f in args.files]
     paths = write_files(render_comparison(items, standalone=args.standalone), args.out)
     for spec, _, rep in items:
         print(f"{spec.name}: {rep.verdict}")
@@ -86,11 +86,10 @@ def _report_args(p: argparse.ArgumentParser) -> None:
 
 def cmd_report(args: argparse.Namespace) -> int:
     """``camfab report FILE -o DIR``: writes ``report.html`` and ``plots/``; exit 1 if unacceptable."""
-    from ..cli import _load
     from .html import render_report, write_files
 
     require_report_dependencies()
-    spec, geometry, report = checked_design(_load(args.file))
+    spec, geometry, report = checked_design(load_design(resolve_design_path(args.file)))
     paths = write_files(render_report(spec, geometry, report, standalone=args.standalone), args.out)
     print(f"{spec.name}: {report.verdict}")
     print(f"wrote {Path(paths[0])} (+{len(paths) - 1} plot files)", file=sys.stderr)

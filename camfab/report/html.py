@@ -238,7 +238,7 @@ def _inputs(spec) -> list[dict[str, Any]]:
     groups = [{"title": "Cam", "rows": cam}, {"title": "Follower", "rows": fol},
               {"title": "Manufacturing", "rows": mfg}, {"title": "Checks", "rows": checks}]
     if spec.dynamics is not None:
-        from ..design.xlsx_design import dynamics_items
+        from ..design.spec import dynamics_items
 
         groups.append({"title": "Dynamics", "rows": [(k, f"{v:g}") for k, v in dynamics_items(spec.dynamics)]})
     if spec.motion_table is not None:

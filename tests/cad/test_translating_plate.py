@@ -11,8 +11,9 @@ from camfab.cad.export import build_artifacts, cam_shapes
 from camfab.cad.plate import PlateSpec, plate_volume
 from camfab.cli import main
 from camfab.design.assemble import geometry_from_spec
-from camfab.design.spec import design_from_dict, load_design
+from camfab.design.spec import design_from_dict
 from camfab.errors import GeometryError, SpecError
+from camfab.formats import load_design
 from camfab.gcode import Job, dumps, parse, verify
 from camfab.gcode.cam import cam_program, signed_distance
 from camfab.offset.cutter import offset_curve, pitch_curve, profile_curve, tool_centre_path

@@ -15,8 +15,9 @@ from camfab.design.mechanisms import OscillatingFlat, OscillatingRoller, Transla
     TranslatingRoller
 from camfab.design.profile import CamGeometry, integrate
 from camfab.design.program import MotionProgram
-from camfab.design.spec import design_from_dict, load_design
+from camfab.design.spec import design_from_dict
 from camfab.errors import SpecError
+from camfab.formats import load_design
 from camfab.units import RPM
 
 from ..conftest import EXAMPLES

@@ -10,15 +10,10 @@ import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from camfab.design.knots import (
-    KnotTable,
-    KnotWarning,
-    load_motion_table,
-    read_knots_csv,
-    read_knots_xlsx,
-)
+from camfab.design.knots import KnotFile, KnotTable, KnotWarning, build_knot_table
 from camfab.design.program import MotionProgram
 from camfab.errors import SpecError
+from camfab.formats import load_design, load_motion_table, read_knot_file, read_knots_csv, read_knots_xlsx
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "camfab" / "templates" / "examples"
 VALVE_UNITS = {"angle": "deg", "s": "m", "v": "m/s", "a": "m/s2"}
@@ -56,7 +51,7 @@ RAD_UNITS = {"angle": "deg", "s": "mm", "v": "mm/rad", "a": "mm/rad2", "j": "mm/
 
 
 def table(rows, degree=5, units=RAD_UNITS, **kw) -> KnotTable:
-    return load_motion_table({"rows": rows, "units": units, "degree": degree, **kw})
+    return build_knot_table({"rows": rows, "units": units, "degree": degree, **kw})
 
 
 def assert_reproduces_knots(t: KnotTable, prog: MotionProgram) -> None:
@@ -145,7 +140,7 @@ def test_dense_smooth_knots_raise_no_warning():
 def test_time_units_equal_per_radian_units():
     rows_m = [[0, 0, 0, 0], [20, 0, 0, 0], [30, 0.0005, 0.4744, 1017.9], [110, 0.009, 0, 0],
               [130, 0.009, 0, 0], [200, 0, 0, 0]]
-    a = load_motion_table({"rows": rows_m, "units": VALVE_UNITS, "speed_rpm": 1500})
+    a = build_knot_table({"rows": rows_m, "units": VALVE_UNITS, "speed_rpm": 1500})
     w = OMEGA_1500
     rows_mm = [[th, s * 1e3, v * 1e3 / w, acc * 1e3 / w**2] for th, s, v, acc in rows_m]
     b = table(rows_mm)
@@ -173,9 +168,9 @@ def test_every_unit_spelling_converts_to_mm_per_radian():
 
 
 def test_default_units_and_derived_family():
-    t = load_motion_table({"rows": [[0, 0, 0, 0], [180, 1, 0, 0]]})
+    t = build_knot_table({"rows": [[0, 0, 0, 0], [180, 1, 0, 0]]})
     assert dict(t.units) == {"angle": "deg", "s": "mm", "v": "mm/deg", "a": "mm/deg2", "j": "mm/deg3"}
-    t = load_motion_table({"rows": [[0, 0, 0, 0, 0], [180, 1, 0, 0, 0]], "degree": 7, "speed_rpm": 100,
+    t = build_knot_table({"rows": [[0, 0, 0, 0, 0], [180, 1, 0, 0, 0]], "degree": 7, "speed_rpm": 100,
                            "units": {"s": "m", "a": "m/s2"}})
     assert t.units["v"] == "m/s" and t.units["j"] == "m/s3"
 
@@ -258,18 +253,17 @@ def test_full_precision_reconstruction_is_consistent():
            170: 4.530, 180: 2.122, 192: 0.395, 194: 0.279, 196: 0.155, 198: 0.039}
     printed = read_knots_csv(EXAMPLES / "valve_puntos_ej1.csv")
     rows = [[r[0], rec.get(r[0], r[1] * 1e3) / 1e3, *r[2:]] for r in printed]
-    t = load_motion_table({"rows": rows, "units": VALVE_UNITS, "speed_rpm": 1500})
+    t = build_knot_table({"rows": rows, "units": VALVE_UNITS, "speed_rpm": 1500})
     assert t.warnings() == []
     assert t.program().peaks("exact")[0].min >= -1e-12
 
 
 def test_shipped_toml_example_uses_the_consistent_reconstruction():
-    from camfab.design.spec import load_design
-
     spec = load_design(EXAMPLES / "valve_exhaust_ej1.toml")
     assert spec.name == "ValveExhaustEj1" and spec.follower.base_radius_mm == 24.0
-    t = load_motion_table(spec.motion_table, base_dir=EXAMPLES)
+    t = spec.knot_table
     assert t.source == str(EXAMPLES / "valve_recon_ej1.csv")
+    assert spec.sources == (str(EXAMPLES / "valve_exhaust_ej1.toml"), t.source)
     assert t.warnings() == []
     # every printed (rounded) value is reproduced by the reconstruction
     printed = valve("valve_puntos_ej1.csv").values
@@ -313,22 +307,22 @@ GOOD = [[0, 0, 0, 0], [90, 5, 0, 0], [180, 0, 0, 0]]
 def test_each_rule_names_its_field(change, pattern):
     spec = {"rows": GOOD, **change}
     with pytest.raises(SpecError, match=pattern):
-        load_motion_table(spec)
+        build_knot_table(spec)
 
 
 def test_radian_tables_are_checked_against_two_pi():
-    ok = load_motion_table({"rows": [[0, 0, 0, 0], [math.pi, 5, 0, 0], [2 * math.pi, 0, 0, 0]],
+    ok = build_knot_table({"rows": [[0, 0, 0, 0], [math.pi, 5, 0, 0], [2 * math.pi, 0, 0, 0]],
                             "units": {"angle": "rad"}})
     assert ok.closed
     with pytest.raises(SpecError, match=r"rows\[2\]\[0\].*6\.28318"):
-        load_motion_table({"rows": [[0, 0, 0, 0], [3, 5, 0, 0], [7, 0, 0, 0]], "units": {"angle": "rad"}})
+        build_knot_table({"rows": [[0, 0, 0, 0], [3, 5, 0, 0], [7, 0, 0, 0]], "units": {"angle": "rad"}})
 
 
 def test_all_problems_are_reported_at_once():
     spec = {"rows": [[5, -1, 0, 0], [3, 2, float("nan"), 0], [90, 1]], "units": {"v": "m/s", "s": "ft"},
             "degree": 4, "extra": 1}
     with pytest.raises(SpecError) as exc:
-        load_motion_table(spec)
+        build_knot_table(spec)
     paths = {p.path for p in exc.value.problems}
     assert paths >= {"motion_table.extra", "motion_table.degree", "motion_table.units.s",
                      "motion_table.speed_rpm", "motion_table.rows[2]", "motion_table.rows[1][2]",
@@ -450,6 +444,45 @@ def test_file_rows_are_validated_with_the_file_named(tmp_path):
     f.write_text("0,0,0,0\n90,-1,0,0\n", encoding="utf-8")
     with pytest.raises(SpecError, match=r"(?s)bad_rows\.csv.*rows\[1\]\[1\] = -1\.0"):
         load_motion_table({"file": str(f)})
+
+
+def test_knot_file_is_read_into_a_value_the_core_validates(tmp_path):
+    f = tmp_path / "k.csv"
+    f.write_text("angle,s,v,a\n0,0,0,0\n90,5,0,0\n180,0,0,0\n", encoding="utf-8")
+    kf = read_knot_file("k.csv", tmp_path)
+    assert kf == KnotFile("k.csv", str(f), ((0, 0, 0, 0), (90, 5, 0, 0), (180, 0, 0, 0)))
+    assert str(kf) == "k.csv"
+    t = build_knot_table({"file": kf})
+    assert t.source == str(f) and float(t.program()(np.pi / 2)[0]) == pytest.approx(5.0)
+    missing = read_knot_file("gone.csv", tmp_path)
+    assert missing.rows is None and [p.path for p in missing.problems] == ["motion_table.file"]
+    with pytest.raises(SpecError, match=r"gone\.csv.*file not found") as exc:
+        build_knot_table({"file": missing, "degree": 3})
+    assert [p.path for p in exc.value.problems] == ["motion_table.file", "motion_table.degree"]
+
+
+def test_the_core_reads_no_file(tmp_path, monkeypatch):
+    (tmp_path / "k.csv").write_text("0,0,0,0\n90,5,0,0\n", encoding="utf-8")
+    monkeypatch.chdir(tmp_path)  # the file is there, yet the core does not open it
+    with pytest.raises(SpecError, match=r"motion_table\.file = 'k\.csv'.*has not been read.*camfab\.formats"):
+        build_knot_table({"file": "k.csv"})
+    with pytest.raises(SpecError, match=r"motion_table\.file = 3.*must be a path"):
+        build_knot_table({"file": 3})
+
+
+def test_a_design_reads_its_knot_file_once(monkeypatch):
+    import camfab.formats.knot_files as knot_files
+    from camfab.design.assemble import check_design
+    from camfab.formats import design_to_xlsx
+
+    calls = []
+    real = knot_files.read_knots
+    monkeypatch.setattr(knot_files, "read_knots", lambda *a, **k: calls.append(a) or real(*a, **k))
+    spec = load_design(EXAMPLES / "valve_exhaust_ej1.toml")
+    check_design(spec)
+    design_to_xlsx(spec)
+    assert spec.program() is spec.program() and spec.knot_table is spec.knot_table
+    assert len(calls) == 1
 
 
 # ---------------------------------------------------------------------------

@@ -425,7 +425,7 @@ def test_fixed_frame_sample_is_the_cam_frame_sample_turned_back(name):
     frame-independent quantity agrees to rounding — for every example, conjugate second profiles
     (mirrored contacts) included."""
     from camfab.design.assemble import geometry_from_spec
-    from camfab.design.spec import load_design
+    from camfab.formats import load_design
 
     g = geometry_from_spec(load_design(EXAMPLES / f"{name}.toml"))
     x = np.linspace(0.0, g.period, 1001) if not g.closed else np.linspace(-1.0, 7.5, 1001)

@@ -6,8 +6,9 @@ import math
 import numpy as np
 import pytest
 
-from camfab.design.spec import design_from_dict, load_design
+from camfab.design.spec import design_from_dict
 from camfab.errors import SpecError
+from camfab.formats import load_design
 from tests.conftest import EXAMPLES, base_design
 
 
@@ -194,3 +195,50 @@ def test_constant_width_too_narrow():
                     follower={"type": "flat", "motion": "translating", "base_radius_mm": 40.0, "width_mm": 70.0})
     del d["motion"]
     assert "follower.width_mm" in str(_problems(d))
+
+
+def test_kinds_are_the_shared_enums():
+    from camfab.design.kinds import CamKind, FollowerMotion, FollowerType, LiftUnit, Rotation
+
+    spec = design_from_dict(base_design(cam={"kind": "disc", "rotation": "ccw"}))
+    assert spec.cam.kind is CamKind.DISC and spec.cam.rotation is Rotation.CCW
+    assert spec.follower.type is FollowerType.ROLLER and spec.follower.motion is FollowerMotion.TRANSLATING
+    assert spec.follower.lift_unit is LiftUnit.MM and spec.cam.kind == "disc"
+    err = _problems(base_design(cam={"kind": "disk"}))
+    assert "must be one of: disc, conjugate, constant_width, constant_diameter, translating" in str(err)
+
+
+def test_a_spec_holds_no_folder_and_knows_its_sources(tmp_path):
+    import dataclasses
+
+    from camfab.formats import design_from_data
+
+    spec = load_design(EXAMPLES / "ejemplo9rt.toml")
+    assert "base_dir" not in {f.name for f in dataclasses.fields(spec)}
+    assert spec.sources == (str(EXAMPLES / "ejemplo9rt.toml"),) and design_from_dict(base_design()).sources == ()
+    (tmp_path / "k.csv").write_text("0,0,0,0\n90,5,0,0\n180,0,0,0\n", encoding="utf-8")
+    d = base_design(motion_table={"file": "k.csv"})
+    del d["motion"]
+    spec = design_from_data(d, source=str(tmp_path / "d.toml"), base_dir=tmp_path)
+    assert spec.sources == (str(tmp_path / "d.toml"), str(tmp_path / "k.csv"))
+    assert spec.motion_table["file"].name == "k.csv" and spec.knot_table.source == str(tmp_path / "k.csv")
+    (tmp_path / "k.csv").unlink()  # nothing is read again
+    assert float(spec.program()(math.pi / 2)[0]) == pytest.approx(5.0)
+
+
+def test_knot_file_problems_keep_the_file_and_the_design_source(tmp_path):
+    p = tmp_path / "d.toml"
+    p.write_text('[follower]\ntype = "flat"\nbase_radius_mm = 30.0\n[motion_table]\nfile = "none.csv"\n',
+                 encoding="utf-8")
+    with pytest.raises(SpecError) as info:
+        load_design(p)
+    assert info.value.source == str(p)
+    assert [q.path for q in info.value.problems] == ["motion_table.file"]
+    assert info.value.problems[0].value == str(tmp_path / "none.csv") and "file not found" in str(info.value)
+
+
+def test_design_from_dict_refuses_an_unread_knot_file():
+    d = base_design(motion_table={"file": "puntos.csv"})
+    del d["motion"]
+    err = _problems(d)
+    assert [p.path for p in err.problems] == ["motion_table.file"] and "camfab.formats" in str(err)

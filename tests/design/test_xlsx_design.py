@@ -7,17 +7,17 @@ import io
 import numpy as np
 import pytest
 
-from camfab.design.spec import design_from_dict, load_design
-from camfab.design.xlsx_design import design_to_xlsx, load_design_xlsx
+from camfab.design.spec import design_from_dict
 from camfab.errors import SpecError
+from camfab.formats import design_to_xlsx, load_design, load_design_xlsx
 from tests.conftest import EXAMPLES, base_design
 
 openpyxl = pytest.importorskip("openpyxl")
 
 
 def _bare(spec, *, table=True):
-    """The spec without its origin (source file and folder), optionally without the motion table."""
-    out = dataclasses.replace(spec, source=None, base_dir=None)
+    """The spec without its origin (source file), optionally without the motion table."""
+    out = dataclasses.replace(spec, source=None)
     return out if table else dataclasses.replace(out, motion_table=None)
 
 
@@ -63,7 +63,7 @@ def test_round_trip_toml_example(tmp_path):
     spec = load_design(EXAMPLES / "ejemplo9rt.toml")
     back = load_design_xlsx(_write(tmp_path, design_to_xlsx(spec)))
     assert _bare(back) == _bare(spec)
-    assert back.source.endswith("design.xlsx") and back.base_dir == str(tmp_path)
+    assert back.source == str(tmp_path / "design.xlsx") and back.sources == (back.source,)
 
 
 @pytest.mark.parametrize("design", [

@@ -9,7 +9,7 @@ import pytest
 
 from camfab.cli import main
 from camfab.design.assemble import geometry_from_spec
-from camfab.design.spec import load_design
+from camfab.formats import load_design
 from camfab.gcode import Job, dumps, parse, verify
 from camfab.gcode.cam import cam_program, signed_distance
 from camfab.offset.cutter import offset_curve, profile_curve

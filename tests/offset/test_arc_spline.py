@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from camfab.design.assemble import geometry_from_spec
-from camfab.design.spec import design_from_dict, load_design
+from camfab.design.spec import design_from_dict
+from camfab.formats import load_design
 from camfab.offset.cutter import pitch_curve, profile_curve
 from camfab.offset.discretize import arcs
 

@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import pytest
 
-from camfab.design.spec import design_from_dict, load_design
+from camfab.design.spec import design_from_dict
+from camfab.formats import load_design
 from camfab.report.commands import checked_design
 from camfab.report.html import render_report, write_files
 

@@ -16,9 +16,9 @@ import pytest
 
 from camfab.design.assemble import loads_from_spec
 from camfab.design.dynamics import ContactDynamics
-from camfab.design.spec import design_from_dict, load_design
-from camfab.design.xlsx_design import design_rows, design_to_xlsx, load_design_xlsx
+from camfab.design.spec import design_from_dict
 from camfab.errors import SpecError
+from camfab.formats import design_from_data, design_rows, design_to_xlsx, load_design, load_design_xlsx
 from camfab.report._common import sample_grid
 from camfab.report.commands import checked_design
 from camfab.report.html import render_report
@@ -300,14 +300,14 @@ FULL_OSCILLATING = {"inertia_kg_m2": 0.03, "spring_rate_nm_per_deg": 0.05, "spri
 
 
 def _bare(spec):
-    return dataclasses.replace(spec, source=None, base_dir=None, motion_table=None)
+    return dataclasses.replace(spec, source=None, motion_table=None)
 
 
 @pytest.mark.parametrize("path, over", [(VALVE, None), (PRESS, None), (VALVE, FULL_TRANSLATING),
                                         (PRESS, FULL_OSCILLATING)], ids=["valve", "press", "valve-all", "press-all"])
 def test_xlsx_design_round_trip_keeps_dynamics(tmp_path, path, over):
     data = _toml(path, **({"dynamics": over} if over else {}))
-    spec = design_from_dict(data, source=str(path), base_dir=path.parent)
+    spec = design_from_data(data, source=str(path), base_dir=path.parent)
     keys = {k: v for k, v in design_rows(spec)[0] if k.startswith("dynamics.")}
     file = tmp_path / "d.xlsx"
     file.write_bytes(design_to_xlsx(spec))

@@ -31,8 +31,8 @@ any case) is converted, except for the free-text keys ``name``,
 ``description``, ``manufacturing.material`` and ``motion_table.file``.
 A relative ``motion_table.file`` is resolved against the workbook's folder.
 
-The dict is validated by :func:`~camfab.design.spec.design_from_dict`, so the
-rules and messages are those of TOML files; every problem's field path is
+The dict is validated by :func:`~camfab.formats.toml_design.design_from_data`,
+so the rules and messages are those of TOML files; every problem's field path is
 followed by the cell it came from, e.g.
 ``follower.base_radius_mm [design!B7] = -3.0: must be in (0.0, 1000000.0]``.
 """
@@ -41,21 +41,24 @@ from __future__ import annotations
 import io
 import math
 import re
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from ..design.knots import KnotFile
+from ..design.spec import CamSpec, DesignSpec, FollowerSpec, ManufacturingSpec, OutputsSpec, dynamics_items
 from ..errors import Problem, SpecError
+from ..report.xlsx import FIXED_DATE, fixed_zip
 from ..units import RPM
-from .spec import _DYN_OSCILLATING, _DYN_TRANSLATING, DesignSpec, DynamicsSpec, design_from_dict
+from .toml_design import design_from_data
 
-__all__ = ["load_design_xlsx", "design_to_xlsx", "design_rows", "dynamics_items", "SEGMENT_COLUMNS",
-           "KNOT_COLUMNS"]
+__all__ = ["load_design_xlsx", "design_to_xlsx", "design_rows", "SEGMENT_COLUMNS", "KNOT_COLUMNS"]
 
 SEGMENT_COLUMNS = ("law", "lift", "angle_deg", "length_mm", "shape")
 KNOT_COLUMNS = ("angle", "s", "v", "a", "j")
 _TEXT_KEYS = {"name", "description", "manufacturing.material", "motion_table.file"}
 _FIX_FORMAT = ("save it as an .xlsx workbook with a 'design' sheet of key/value rows "
-               "(see camfab.design.xlsx_design), or use a TOML design file")
+               "(see camfab.formats.xlsx_design), or use a TOML design file")
 
 
 # ---------------------------------------------------------------------------
@@ -100,7 +103,7 @@ def load_design_xlsx(path: str | Path) -> DesignSpec:
         raise SpecError(problems, str(p))
     data.setdefault("name", p.stem)
     try:
-        return design_from_dict(data, source=str(p), base_dir=p.parent)
+        return design_from_data(data, source=str(p), base_dir=p.parent)
     except SpecError as exc:
         raise SpecError([_locate(q, cells) for q in exc.problems], str(p)) from None
 
@@ -288,95 +291,113 @@ def _locate(problem: Problem, cells: dict[str, str]) -> Problem:
 # writing
 def _num(v: Any) -> Any:
     """A float that survives openpyxl's ``%.16g`` as a number; else its exact repr as text."""
-    if isinstance(v, float) and not v.is_integer() and float("%.16g" % v) != v:
+    if isinstance(v, float) and not v.is_integer() and float(f"{v:.16g}") != v:
         return repr(v)
     return v
 
 
-def dynamics_items(d: DynamicsSpec) -> list[tuple[str, float]]:
-    """The ``[dynamics]`` keys (as in the TOML file, units in the names) and values of a spec."""
-    own = _DYN_OSCILLATING if d.motion == "oscillating" else _DYN_TRANSLATING
-    vals = (d.inertia, d.spring_rate, d.spring_preload, d.damping, d.external)
-    return [*zip(own, vals), ("friction_coefficient", d.friction_coefficient), ("safety_force_n", d.safety_force_n)]
-
-
 def design_rows(spec: DesignSpec) -> tuple[list[tuple[str, Any]], list[dict[str, Any]] | None,
-                                                     list[list[Any]] | None]:
+                                           list[list[Any]] | None]:
     """The ``design`` key/value rows, the ``motion`` segments and the ``knots`` rows of a spec.
 
-    A ``motion_table.file`` is read and written inline as ``knots`` rows, so
+    The rows of a ``motion_table.file`` are written inline as ``knots`` rows, so
     the workbook stands alone.
     """
     kv: list[tuple[str, Any]] = [("name", spec.name)]
     if spec.description:
         kv.append(("description", spec.description))
-    cam = spec.cam
-    kv.append(("cam.kind", cam.kind))
-    if spec.is_translating_cam:
+    kv += _cam_rows(spec.cam, spec.is_translating_cam)
+    kv += _follower_rows(spec.follower)
+    kv += _manufacturing_rows(spec.manufacturing)
+    kv += _output_rows(spec.outputs)
+    if spec.pressure_angle_limit_deg is not None:
+        kv.append(("checks.pressure_angle_limit_deg", _num(spec.pressure_angle_limit_deg)))
+    kv.append(("checks.face_margin_mm", _num(spec.face_margin_mm)))
+    if spec.dynamics is not None:
+        kv += [(f"dynamics.{k}", _num(v)) for k, v in dynamics_items(spec.dynamics)]
+    segs = None if spec.motion is None else _segment_rows(spec)
+    knots = None
+    if spec.motion_table is not None:
+        table_kv, knots = _table_rows(spec.motion_table)
+        kv += table_kv
+    return kv, segs, knots
+
+
+def _cam_rows(cam: CamSpec, translating: bool) -> list[tuple[str, Any]]:
+    """``cam.*``: the kind, the sense of motion and the speed (rpm when it survives the round trip)."""
+    kv: list[tuple[str, Any]] = [("cam.kind", str(cam.kind))]
+    if translating:
         if cam.direction != "left":
-            kv.append(("cam.direction", cam.direction))
+            kv.append(("cam.direction", str(cam.direction)))
         if cam.speed_given:
             kv.append(("cam.speed_mm_s", _num(cam.speed_mm_s)))
-    else:
-        kv.append(("cam.rotation", cam.rotation))
-        if cam.speed_given:
-            rpm = float("%.16g" % (cam.omega_rad_s / RPM))
-            if rpm * RPM == cam.omega_rad_s:
-                kv.append(("cam.speed_rpm", rpm))
-            else:
-                kv.append(("cam.omega_rad_s", _num(cam.omega_rad_s)))
-    f = spec.follower
-    kv += [("follower.type", f.type), ("follower.motion", f.motion)]
+        return kv
+    kv.append(("cam.rotation", str(cam.rotation)))
+    if cam.speed_given:
+        rpm = float(f"{cam.omega_rad_s / RPM:.16g}")
+        if rpm * RPM == cam.omega_rad_s:
+            kv.append(("cam.speed_rpm", rpm))
+        else:
+            kv.append(("cam.omega_rad_s", _num(cam.omega_rad_s)))
+    return kv
+
+
+def _follower_rows(f: FollowerSpec) -> list[tuple[str, Any]]:
+    """``follower.*``: type, motion and every dimension given."""
+    kv: list[tuple[str, Any]] = [("follower.type", str(f.type)), ("follower.motion", str(f.motion))]
     for name in ("base_radius_mm", "roller_radius_mm", "offset_mm", "pivot_distance_mm", "arm_length_mm",
                  "face_offset_mm", "follower_distance_mm", "second_roller_radius_mm", "follower_angle_deg",
                  "cam_length_mm", "base_height_mm", "width_mm", "rise_deg"):
         v = getattr(f, name)
         if v is not None:
             kv.append((f"follower.{name}", _num(v)))
-    m = spec.manufacturing
-    for name in ("thickness_mm", "bore_mm", "keyway", "hub_diameter_mm", "hub_length_mm", "tool_diameter_mm",
-                 "tolerance_mm"):
-        v = getattr(m, name)
-        if v is not None:
-            kv.append((f"manufacturing.{name}", _num(v)))
+    return kv
+
+
+def _manufacturing_rows(m: ManufacturingSpec) -> list[tuple[str, Any]]:
+    """``manufacturing.*``: every value given, the material when named."""
+    kv = [(f"manufacturing.{name}", _num(getattr(m, name)))
+          for name in ("thickness_mm", "bore_mm", "keyway", "hub_diameter_mm", "hub_length_mm", "tool_diameter_mm",
+                       "tolerance_mm") if getattr(m, name) is not None]
     if m.material:
         kv.append(("manufacturing.material", m.material))
-    o = spec.outputs
-    for name in ("dxf", "step", "stl"):
-        kv.append((f"outputs.{name}", getattr(o, name)))
-    kv.append(("outputs.gcode", o.gcode if o.gcode is not None else False))
-    for name in ("report", "xlsx", "drawing", "lift_table"):
-        kv.append((f"outputs.{name}", getattr(o, name)))
-    if spec.pressure_angle_limit_deg is not None:
-        kv.append(("checks.pressure_angle_limit_deg", _num(spec.pressure_angle_limit_deg)))
-    kv.append(("checks.face_margin_mm", _num(spec.face_margin_mm)))
-    if spec.dynamics is not None:
-        kv += [(f"dynamics.{k}", _num(v)) for k, v in dynamics_items(spec.dynamics)]
-    segs = knots = None
-    if spec.motion is not None:
-        span = "length_mm" if spec.is_translating_cam else "angle_deg"
-        segs = []
-        for s in spec.motion:
-            seg: dict[str, Any] = {"law": s.law, "lift": _num(s.lift), span: "auto" if s.span is None else _num(s.span)}
-            if s.shape is not None:
-                seg["shape"] = s.shape
-            segs.append(seg)
-    if spec.motion_table is not None:
-        table = dict(spec.motion_table)
-        if "file" in table:
-            from .knots import read_knots
+    return kv
 
-            file = Path(table.pop("file"))
-            if not file.is_absolute() and spec.base_dir:
-                file = Path(spec.base_dir) / file
-            table["rows"] = read_knots(file)
-        knots = [[_num(float(x)) if isinstance(x, float) else x for x in r] for r in table.pop("rows")]
-        for key, v in table.items():
-            if isinstance(v, dict):
-                kv += [(f"motion_table.{key}.{k}", _num(x)) for k, x in v.items()]
-            else:
-                kv.append((f"motion_table.{key}", _num(v)))
-    return kv, segs, knots
+
+def _output_rows(o: OutputsSpec) -> list[tuple[str, Any]]:
+    """``outputs.*``: every flag, the G-code post (or false)."""
+    kv: list[tuple[str, Any]] = [(f"outputs.{name}", getattr(o, name)) for name in ("dxf", "step", "stl")]
+    kv.append(("outputs.gcode", o.gcode if o.gcode is not None else False))
+    kv += [(f"outputs.{name}", getattr(o, name)) for name in ("report", "xlsx", "drawing", "lift_table")]
+    return kv
+
+
+def _segment_rows(spec: DesignSpec) -> list[dict[str, Any]]:
+    """The ``motion`` sheet: one dict per segment (law, lift, span or ``auto``, shape when given)."""
+    span = "length_mm" if spec.is_translating_cam else "angle_deg"
+    segs = []
+    for s in spec.motion or ():
+        seg: dict[str, Any] = {"law": s.law, "lift": _num(s.lift), span: "auto" if s.span is None else _num(s.span)}
+        if s.shape is not None:
+            seg["shape"] = s.shape
+        segs.append(seg)
+    return segs
+
+
+def _table_rows(motion_table: Mapping[str, Any]) -> tuple[list[tuple[str, Any]], list[list[Any]]]:
+    """``motion_table.*`` key/value rows (units, speed, degree) and the knot rows, a file's rows inline."""
+    table = dict(motion_table)
+    file = table.pop("file", None)
+    if isinstance(file, KnotFile):
+        table["rows"] = file.rows or ()
+    knots = [[_num(float(x)) if isinstance(x, float) else x for x in r] for r in table.pop("rows")]
+    kv: list[tuple[str, Any]] = []
+    for key, v in table.items():
+        if isinstance(v, dict):
+            kv += [(f"motion_table.{key}.{k}", _num(x)) for k, x in v.items()]
+        else:
+            kv.append((f"motion_table.{key}", _num(v)))
+    return kv, knots
 
 
 def design_to_xlsx(spec: DesignSpec) -> bytes:
@@ -392,8 +413,6 @@ def design_to_xlsx(spec: DesignSpec) -> bytes:
     """
     from openpyxl import Workbook
     from openpyxl.styles import Font
-
-    from ..report.xlsx import FIXED_DATE, fixed_zip
 
     kv, segs, knots = design_rows(spec)
     wb = Workbook()

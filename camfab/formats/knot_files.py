@@ -1,0 +1,305 @@
+"""Knot tables from files: the rows ``(angle, s, v, a[, j])`` of a CSV/text file or an xlsx sheet.
+
+A design's ``[motion_table]`` may name a ``file`` instead of giving ``rows``.
+:func:`resolve_knot_file` reads it once, relative to the design file's folder,
+and puts a :class:`~camfab.design.knots.KnotFile` (the name as written, the file
+read and its rows, or why it could not be read) in place of the name; the
+design core then validates those rows exactly like inline rows, naming the file.
+Rows are counted from 0 after any header, as for inline rows.
+
+File formats
+------------
+``.csv .txt .dat .tsv`` are text; ``.xlsx .xlsm`` are read with openpyxl.
+
+* Text: lines starting with ``#`` or ``%`` and blank lines are skipped; the
+  first remaining line is a header when it is not numeric (so a MATLAB
+  ``PUNTOS=`` paste works).  Separators: ``;`` if any line has one, else ``,``
+  if any line has one, else whitespace.  Decimal commas are accepted only
+  where they cannot be separators: in ``;``-separated files, and in
+  whitespace-separated files whose commas, taken as separators, would not
+  give numbers (``22 0,5 0,39 1875,3``).  A comma file is always read as
+  comma-separated with decimal points.  Trailing separators are ignored.
+* xlsx: the first sheet; empty rows are skipped; a first row holding text is
+  a header.  Columns A–D are angle, s, v, a; column E is j when any data row
+  has a number there; further columns are ignored.  Numeric text cells are
+  accepted (a decimal comma in a cell is unambiguous).
+
+Every failure is a :class:`~camfab.errors.SpecError` whose problem names the
+field (``motion_table.file``), the file, and the line or cells at fault.
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any, cast
+
+from ..design.knots import KnotFile, KnotTable, build_knot_table
+from ..errors import Problem, SpecError
+
+__all__ = [
+    "TEXT_SUFFIXES",
+    "XLSX_SUFFIXES",
+    "load_motion_table",
+    "read_knot_file",
+    "read_knots",
+    "read_knots_csv",
+    "read_knots_xlsx",
+    "resolve_knot_file",
+]
+
+TEXT_SUFFIXES = (".csv", ".txt", ".dat", ".tsv")
+XLSX_SUFFIXES = (".xlsx", ".xlsm")
+
+
+# ---------------------------------------------------------------------------
+# a [motion_table] with a file
+def resolve_knot_file(table: Any, base_dir: str | Path | None = None, *,
+                      path: str = "motion_table") -> Any:
+    """The ``[motion_table]`` with its ``file`` read (a :class:`KnotFile` in place of the name).
+
+    Parameters
+    ----------
+    table : Any
+        The ``[motion_table]`` section as written.
+    base_dir : str or Path, optional
+        Folder a relative ``file`` is resolved against: the design file's folder
+        (default: the current directory).
+    path : str
+        Field path used in messages.
+
+    Returns
+    -------
+    Any
+        A new dict when a file was read; otherwise ``table`` itself (no file,
+        inline rows as well, or a ``file`` that is not a path: the core names
+        those problems).
+    """
+    if not isinstance(table, Mapping) or "rows" in table:
+        return table
+    name = table.get("file")
+    if not isinstance(name, (str, Path)) or not str(name):
+        return table
+    return {**table, "file": read_knot_file(name, base_dir, field=f"{path}.file")}
+
+
+def read_knot_file(name: str | Path, base_dir: str | Path | None = None, *,
+                   field: str = "motion_table.file") -> KnotFile:
+    """Read the knot file ``name`` (relative to ``base_dir``) into a :class:`KnotFile`.
+
+    A file that cannot be read gives a ``KnotFile`` without rows that carries the
+    problems, so that the core reports them with the design's other problems.
+    """
+    file = Path(name)
+    if not file.is_absolute() and base_dir is not None:
+        file = Path(base_dir) / file
+    try:
+        rows = read_knots(file, field=field)
+    except SpecError as exc:
+        return KnotFile(str(name), str(file), None, tuple(exc.problems))
+    return KnotFile(str(name), str(file), tuple(tuple(r) for r in rows))
+
+
+def load_motion_table(table: Mapping[str, Any], *, base_dir: str | Path | None = None,
+                      path: str = "motion_table") -> KnotTable:
+    """Build a :class:`KnotTable` from a ``[motion_table]`` dict, reading its ``file`` if it has one.
+
+    Parameters
+    ----------
+    table : dict
+        ``{"rows": [[angle, s, v, a(, j)], ...]}`` or ``{"file": "puntos.csv"}``,
+        plus optional ``units`` (dict), ``speed_rpm`` (float) and ``degree``
+        (5 or 7).
+    base_dir : str or Path, optional
+        Folder a relative ``file`` is resolved against (default: the current
+        directory).
+    path : str
+        Field path used in messages.
+
+    Raises
+    ------
+    SpecError
+        With every problem found, each naming its field path (and the file).
+    """
+    return build_knot_table(resolve_knot_file(table, base_dir, path=path), path=path)
+
+
+# ---------------------------------------------------------------------------
+# readers
+def _is_real(x: Any) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+def _file_error(fld: str, file: Path, rule: str, fix: str) -> SpecError:
+    return SpecError(Problem(fld, str(file), rule, fix), str(file))
+
+
+def read_knots(path: str | Path, *, field: str = "motion_table.file") -> list[list[float]]:
+    """Read knot rows from a text (CSV) or xlsx file, chosen by its suffix.
+
+    Raises
+    ------
+    SpecError
+        Unknown suffix, missing or unreadable file (naming the file).
+    """
+    file = Path(path)
+    suffix = file.suffix.lower()
+    if suffix in XLSX_SUFFIXES:
+        return read_knots_xlsx(file, field=field)
+    if suffix in TEXT_SUFFIXES:
+        return read_knots_csv(file, field=field)
+    raise _file_error(field, file, f"unknown knot-file type '{file.suffix}'",
+                      "use one of: " + ", ".join(TEXT_SUFFIXES + XLSX_SUFFIXES))
+
+
+def _number(tok: str, decimal_comma: bool) -> float:
+    t = tok.strip()
+    if decimal_comma and "," in t:
+        if "." in t or t.count(",") > 1:
+            raise ValueError(t)
+        t = t.replace(",", ".")
+    return float(t)
+
+
+def _split(line: str, sep: str | None, decimal_comma: bool) -> list[float]:
+    toks = line.split(sep)
+    while sep and toks and not toks[-1].strip():
+        toks.pop()
+    return [_number(t, decimal_comma) for t in toks]
+
+
+def _dialects(lines: Sequence[str]) -> list[tuple[str | None, bool]]:
+    if any(";" in ln for ln in lines):
+        return [(";", True)]
+    if any("," in ln for ln in lines):
+        return [(",", False), (None, True)]
+    return [(None, False)]
+
+
+def _parse_rows(lines: list[tuple[int, str]], sep: str | None, dc: bool) -> list[list[float]]:
+    """Rows of one dialect; the first line may be a header.  ValueError("line N: ...")."""
+    rows = []
+    for i, (no, text) in enumerate(lines):
+        try:
+            rows.append(_split(text, sep, dc))
+        except ValueError:
+            if i == 0 and len(lines) > 1:
+                continue  # header
+            raise ValueError(f"line {no}: {text.strip()!r} is not a row of numbers") from None
+    return rows
+
+
+def _parse_lines(lines: list[tuple[int, str]]) -> list[list[float]]:
+    """Rows from (line number, text) pairs, trying each plausible dialect."""
+    err: ValueError | None = None
+    for sep, dc in _dialects([t for _, t in (lines[1:] or lines)]):
+        try:
+            return _parse_rows(lines, sep, dc)
+        except ValueError as exc:
+            err = err or exc
+    assert err is not None
+    raise err
+
+
+def read_knots_csv(path: str | Path, *, field: str = "motion_table.file") -> list[list[float]]:
+    """Read knot rows from a text file (CSV, ``;``- or whitespace-separated).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file; see the module docstring for the accepted formats.
+    field : str
+        Field path used in messages.
+
+    Returns
+    -------
+    list of list of float
+        One list per data row (the header, comments and blank lines dropped).
+
+    Raises
+    ------
+    SpecError
+        Missing, undecodable or non-numeric file, naming the file and the line.
+    """
+    file = Path(path)
+    try:
+        text = file.read_text(encoding="utf-8-sig")
+    except FileNotFoundError:
+        raise _file_error(field, file, "file not found", "check the path (relative paths are "
+                          "resolved against the design file's folder)") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise _file_error(field, file, f"cannot read the file as UTF-8 text ({exc.__class__.__name__})",
+                          "save the knot table as a UTF-8 CSV") from None
+    lines = [(no, ln) for no, ln in enumerate(text.splitlines(), 1)
+             if ln.strip() and not ln.lstrip().startswith(("#", "%"))]
+    if not lines:
+        raise _file_error(field, file, "the file holds no knot rows", "add rows: angle, s, v, a[, j]")
+    try:
+        rows = _parse_lines(lines)
+    except ValueError as exc:
+        raise _file_error(field, file, str(exc), "write one knot per line: angle, s, v, a[, j] "
+                          "(separated by ',', ';' or spaces; one optional header line)") from None
+    return rows
+
+
+def _cell_number(x: Any) -> float | None:
+    if _is_real(x):
+        return float(x)
+    if isinstance(x, str) and x.strip():
+        try:
+            return _number(x, True)
+        except ValueError:
+            return None
+    return None
+
+
+def read_knots_xlsx(path: str | Path, *, field: str = "motion_table.file") -> list[list[float]]:
+    """Read knot rows from the first sheet of an xlsx workbook.
+
+    Columns A–D are angle, s, v, a and column E is j when any data row has a
+    number there; a first row holding text is a header; empty rows are skipped.
+
+    Raises
+    ------
+    SpecError
+        Missing or corrupt workbook, or non-numeric cells (naming the cells).
+    """
+    from openpyxl.utils import get_column_letter
+
+    file = Path(path)
+    cells = _xlsx_cells(file, field)
+    cells = [(no, r) for no, r in cells if any(c is not None and str(c).strip() for c in r)]
+    if cells and any(isinstance(c, str) and _cell_number(c) is None for c in cells[0][1]):
+        cells = cells[1:]
+    if not cells:
+        raise _file_error(field, file, "the first sheet holds no knot rows",
+                          "put angle, s, v, a[, j] in columns A–E")
+    width = 5 if any(len(r) > 4 and _cell_number(r[4]) is not None for _, r in cells) else 4
+    rows: list[list[float | None]] = []
+    bad: list[str] = []
+    for no, r in cells:
+        vals = [_cell_number(r[k]) if k < len(r) else None for k in range(width)]
+        bad += [f"{get_column_letter(k + 1)}{no}" for k, v in enumerate(vals) if v is None]
+        rows.append(vals)
+    if bad:
+        listed = ", ".join(bad[:20]) + (" …" if len(bad) > 20 else "")
+        raise _file_error(field, file, f"cells are not numbers: {listed}",
+                          f"fill columns A–{get_column_letter(width)} with numbers (angle, s, v, a[, j])")
+    return cast(list[list[float]], rows)  # no None left: every cell is a number
+
+
+def _xlsx_cells(file: Path, fld: str) -> list[tuple[int, tuple[Any, ...]]]:
+    """(row number, values) of the first sheet; SpecError if the workbook cannot be read."""
+    import openpyxl
+
+    if not file.is_file():
+        raise _file_error(fld, file, "file not found", "check the path (relative paths are resolved "
+                          "against the design file's folder)")
+    try:
+        wb = openpyxl.load_workbook(file, read_only=True, data_only=True)
+        try:
+            return [(no, tuple(r)) for no, r in enumerate(wb.worksheets[0].iter_rows(values_only=True), 1)]
+        finally:
+            wb.close()
+    except Exception as exc:  # openpyxl raises many types for a damaged file
+        raise _file_error(fld, file, f"not a readable xlsx workbook ({exc.__class__.__name__}: {exc})",
+                          "re-save it as .xlsx from a spreadsheet program, or export the table as CSV") from None

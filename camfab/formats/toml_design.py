@@ -1,0 +1,69 @@
+"""TOML design files → :class:`~camfab.design.spec.DesignSpec`, and design dicts with the files they name.
+
+A design is read once: the TOML text is parsed, the knot file its ``[motion_table]``
+names is read relative to the design file's folder, and the data are handed to
+:func:`camfab.design.spec.design_from_dict`, which validates them.  The spec
+records the files it was built from (:attr:`~camfab.design.spec.DesignSpec.sources`).
+"""
+from __future__ import annotations
+
+import tomllib
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from ..design.spec import DesignSpec, design_from_dict
+from ..errors import Problem, SpecError
+from .knot_files import resolve_knot_file
+
+__all__ = ["design_from_data", "load_design_toml"]
+
+
+def load_design_toml(path: str | Path) -> DesignSpec:
+    """Read and validate a TOML design file (its name defaults to the file's stem).
+
+    Raises
+    ------
+    SpecError
+        A missing, unreadable or non-TOML file (naming the file and the line), or every problem
+        of the design.
+    """
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise SpecError(Problem("file", str(p), "no such design file", "check the path"), str(p)) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SpecError(Problem("file", str(p), f"cannot be read ({exc})",
+                                "give a UTF-8 TOML design file"), str(p)) from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SpecError(Problem("file", p.name, f"is not valid TOML: {exc}",
+                                "fix the TOML syntax at the line named"), str(p)) from None
+    data.setdefault("name", p.stem)
+    return design_from_data(data, source=str(p), base_dir=p.parent)
+
+
+def design_from_data(data: Mapping[str, Any], *, source: str | None = None,
+                     base_dir: str | Path | None = None) -> DesignSpec:
+    """Validate a design dict (the TOML structure), reading the knot file its ``[motion_table]`` names.
+
+    Parameters
+    ----------
+    data : Mapping
+        The design.
+    source : str, optional
+        The design file, named in messages.
+    base_dir : str or Path, optional
+        Folder a relative ``motion_table.file`` is resolved against (the design file's folder;
+        default: the current directory).
+
+    Raises
+    ------
+    SpecError
+        Every problem found, the knot file's included.
+    """
+    if "motion_table" in data:
+        data = {**data, "motion_table": resolve_knot_file(data["motion_table"], base_dir)}
+    return design_from_dict(data, source=source)
