@@ -33,7 +33,8 @@ from typing import Any, Callable
 import numpy as np
 
 from .motion_report import Finding, MotionReport, analyse_motion, verdict_of
-from .profile import CamGeometry, Contact, OscillatingRollerContact, _cross
+from .profile import CamGeometry, Contact, cross as _cross
+from .rollers import OscillatingRollerContact
 from .solvers import (_bracket_min, _bracket_root, _channel_solvers, _default_step, _ExtremaPlan, _extrema_steps,
                       _extremum_steps, _gather, _integrate_steps, _mapped, _sampling, _run)
 

@@ -37,7 +37,7 @@ __all__ = [
 ]
 
 CAM_KINDS = ("disc", "conjugate", "constant_width", "constant_diameter", "translating")
-FOLLOWER_TYPES = ("roller", "flat", "knife")
+FOLLOWER_TYPES = ("roller", "flat", "knife", "curved")
 FOLLOWER_MOTIONS = ("translating", "oscillating")
 ROTATIONS = ("cw", "ccw")
 POSTS = ("linuxcnc", "fanuc", "grbl")
@@ -48,7 +48,7 @@ _CAM_KEYS = ("kind", "rotation", "direction", "speed_rpm", "omega_rad_s", "speed
 _FOLLOWER_FLOATS = ("base_radius_mm", "roller_radius_mm", "offset_mm", "pivot_distance_mm",
                     "arm_length_mm", "face_offset_mm", "follower_distance_mm",
                     "second_roller_radius_mm", "follower_angle_deg", "cam_length_mm",
-                    "base_height_mm", "width_mm", "rise_deg")
+                    "base_height_mm", "width_mm", "rise_deg", "face_radius_mm")
 _FOLLOWER_KEYS = ("type", "motion", *_FOLLOWER_FLOATS)
 _SEGMENT_KEYS = ("law", "lift", "angle_deg", "length_mm", "shape")
 _MFG_KEYS = ("thickness_mm", "bore_mm", "keyway", "hub_diameter_mm", "hub_length_mm",
@@ -99,6 +99,7 @@ class FollowerSpec:
     base_height_mm: float | None = None
     width_mm: float | None = None
     rise_deg: float | None = None
+    face_radius_mm: float | None = None
 
     @property
     def lift_unit(self) -> str:
@@ -366,6 +367,8 @@ _REQUIRED = {
     ("knife", "oscillating"): ("base_radius_mm", "pivot_distance_mm", "arm_length_mm"),
     ("flat", "translating"): ("base_radius_mm",),
     ("flat", "oscillating"): ("base_radius_mm", "pivot_distance_mm"),
+    ("curved", "translating"): ("base_radius_mm", "face_radius_mm"),
+    ("curved", "oscillating"): ("base_radius_mm", "face_radius_mm", "pivot_distance_mm"),
 }
 
 
@@ -374,7 +377,8 @@ def _follower(v: _Validator, t: Mapping[str, Any], cam: CamSpec) -> FollowerSpec
     ftype = v.choice(t, "type", "follower", FOLLOWER_TYPES, "roller")
     motion = v.choice(t, "motion", "follower", FOLLOWER_MOTIONS, "translating")
     vals: dict[str, float | None] = {}
-    positive = ("base_radius_mm", "arm_length_mm", "cam_length_mm", "follower_distance_mm", "width_mm")
+    positive = ("base_radius_mm", "arm_length_mm", "cam_length_mm", "follower_distance_mm", "width_mm",
+                "face_radius_mm")
     non_negative = ("roller_radius_mm", "pivot_distance_mm", "second_roller_radius_mm", "base_height_mm")
     for key in _FOLLOWER_FLOATS:
         if key in positive:
@@ -392,7 +396,7 @@ def _follower(v: _Validator, t: Mapping[str, Any], cam: CamSpec) -> FollowerSpec
         vals["roller_radius_mm"] = 0.0
     if cam.kind == "translating":
         need: tuple[str, ...] = ("roller_radius_mm", "cam_length_mm")
-        if ftype == "flat" or motion == "oscillating":
+        if ftype in ("flat", "curved") or motion == "oscillating":
             v.add("follower.type", ftype, "a translating cam drives a translating roller follower",
                   'use type = "roller", motion = "translating"')
     elif cam.kind in ("constant_width", "constant_diameter"):
@@ -412,17 +416,21 @@ def _follower(v: _Validator, t: Mapping[str, Any], cam: CamSpec) -> FollowerSpec
     else:
         need = _REQUIRED[(ftype, motion)]
         if cam.kind == "conjugate":
-            if ftype == "knife":
+            if ftype in ("knife", "curved"):
                 v.add("follower.type", ftype, "conjugate cams have roller or flat followers",
                       'use type = "roller" or "flat"')
+                need = ()
             need = need + (("follower_distance_mm",) if motion == "translating" else ("follower_angle_deg",))
     for key in need:
         if key not in t and not (key == "roller_radius_mm" and ftype == "knife"):
             v.add(f"follower.{key}", None, f"is required for a {motion} {ftype} follower",
                   f"add {key} = <mm> to [follower]")
-    if ftype == "flat" and "roller_radius_mm" in t:
-        v.add("follower.roller_radius_mm", t["roller_radius_mm"], "a flat-face follower has no roller",
+    if ftype in ("flat", "curved") and "roller_radius_mm" in t:
+        v.add("follower.roller_radius_mm", t["roller_radius_mm"], f"a {ftype}-face follower has no roller",
               'remove it or use type = "roller"')
+    if ftype != "curved" and "face_radius_mm" in t:
+        v.add("follower.face_radius_mm", t["face_radius_mm"], "only a curved-face follower has a face radius",
+              'remove it or use type = "curved"')
     return FollowerSpec(ftype, motion, **vals)
 
 
