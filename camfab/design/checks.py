@@ -163,7 +163,7 @@ def check(geometry: CamGeometry, *, pressure_angle_limit_deg: float | None = Non
                 lim = DEFAULT_PRESSURE_LIMIT_DEG["oscillating" if isinstance(c, OscillatingRollerContact)
                                                  else "translating"]
             planners.append(_pressure(c, tag, to_user, lim, summary))
-        else:
+        if c.has_face:
             planners.append(_face(c, tag, to_user, face_margin_mm, summary))
     planners.append(_extent(geometry, summary))
     for found in _schedule(planners):

@@ -18,7 +18,10 @@ for every sliding face, against the velocity of the follower's material point at
   rigid on the arm: ``C = pivot + (f + R)·n(ξ)`` — an arm of length A = f + R (> 0) at the angle ξ + 90° from
   the line to the cam centre.  At S = 0 the face touches the base circle, |C| = R_b + R:
   ``sin ξ₀ = ((R_b + R)² − m² − A²)/(2·m·A)``, which needs |A − m| < R_b + R < A + m.  Contact position:
-  the distance of P from V along the face's tangent, ``(P − V)·J·n(ξ)``, measured as for the flat face.
+  the arc length R·ψ from V along the face, ψ the angle from the contact normal to n(ξ) — signed as the flat
+  face's ``(P − V)·J·n(ξ)``, which it equals to first order.  The pad is the part of the circle that arc
+  spans; a realistic finger places C above the cam (f = √(m² + (R_b + R)²) − R), so the contact runs well
+  away from V.
 
 **The flat face is the limit R → ∞** (f, e fixed): C recedes to infinity, the circle near the contact tends
 to the face line (sag d²/2R), ξ₀ → arcsin((R_b − f)/m), and the profile, contact position and pressure angle
@@ -74,8 +77,10 @@ class OscillatingCurvedContact(OscillatingRollerContact):
         return (*path, zeta - math.pi / 2)  # the arm angle reported is the face angle ξ, as for flat faces
 
     def _face_position(self, cx, cy, nx, ny, xi) -> np.ndarray:
-        # n(ξ) = (C − pivot)/A, so (P − V)·J·n(ξ) = R·(n_x·cos ξ − n_y·sin ξ) = R·(n_x·C_y − n_y·(C_x − m))/A
-        return self.roller_radius * (nx * cy - ny * (cx - self.m)) / self.a
+        # the arc length R·ψ from the vertex V, ψ the angle from the contact normal n to n(ξ) = (C − pivot)/A:
+        # sin ψ = n × n(ξ) = (n_x·C_y − n_y·(C_x − m))/A, cos ψ = n·n(ξ)
+        dx = cx - self.m
+        return self.roller_radius * np.arctan2(nx * cy - ny * dx, nx * dx + ny * cy)
 
     def _force_velocity(self, cx, cy, nx, ny, vx, vy):
         # the follower's material point at the contact P = C − R·n turns clockwise about the pivot

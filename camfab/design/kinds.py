@@ -62,6 +62,11 @@ class FollowerType(StrEnum):
     #: a convex circular face (mushroom or finger follower)
     CURVED = "curved"
 
+    @property
+    def title(self) -> str:
+        """The follower's name in words: "roller", "flat-face", "knife-edge" or "curved-face"."""
+        return {"roller": "roller", "flat": "flat-face", "knife": "knife-edge", "curved": "curved-face"}[self.value]
+
 
 class FollowerMotion(StrEnum):
     """``[follower] motion``."""
