@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from bench_profile import OSC_ROWS, ROWS, best
-from camfab.design.desmodromic import ConjugateTranslatingRoller, desmodromic_geometry
+from camfab.design.mechanisms import ConjugateTranslatingRoller
 from camfab.design.dynamics import ContactDynamics, Loads, analyse_dynamics, pair_of
 from camfab.design.mechanisms import OscillatingRoller, TranslatingFlat, TranslatingRoller
 from camfab.design.profile import CamGeometry
@@ -39,7 +39,7 @@ def main() -> None:
              Loads(0.02, 30.0, 20.0, safety_force_n=50.0)),
             ("translating flat", CamGeometry(TranslatingFlat(80.0), prog),
              Loads(0.3, 20000.0, 400.0, damping=20.0, friction_coefficient=0.05, safety_force_n=50.0)),
-            ("conjugate roller pair", desmodromic_geometry(ConjugateTranslatingRoller(40.0, 8.0, 110.0), prog),
+            ("conjugate roller pair", ConjugateTranslatingRoller(40.0, 8.0, 110.0).geometry(prog),
              Loads(0.3, damping=20.0)))
     print(f"12-segment cam, {a.n:,} angles, 600 rpm; motion engine S..S''' {t_motion * 1e3:.1f} ms")
     print(f"{'mechanism':<24}{'forces ms':>11}{'ratio':>8}{'analysis ms':>13}")

@@ -12,64 +12,12 @@ from ..errors import SpecError
 from .checks import Report, check
 from .dynamics import ContactDynamics, DynamicsReport, Loads, PairDynamics, analyse_dynamics, pair_of
 from .motion_report import Finding
-from .mechanisms import OscillatingFlat, OscillatingRoller, TranslatingCamRoller, TranslatingFlat, TranslatingRoller
+from .mechanisms import geometry_from_spec, mechanism_from_spec
 from .profile import CamGeometry
-from .desmodromic import (ConjugateOscillatingFlat, ConjugateOscillatingRoller, ConjugateTranslatingFlat,
-                          ConjugateTranslatingRoller, ConstantDiameterCam, ConstantWidthCam, desmodromic_geometry)
 from .spec import DesignSpec, DynamicsSpec
-
-DESMODROMIC = (ConjugateTranslatingFlat, ConjugateTranslatingRoller, ConjugateOscillatingFlat,
-               ConjugateOscillatingRoller, ConstantWidthCam, ConstantDiameterCam)
 
 __all__ = ["mechanism_from_spec", "geometry_from_spec", "check_design", "knot_findings", "loads_from_spec",
            "dynamics_of", "dynamics_model", "is_form_closed"]
-
-
-def mechanism_from_spec(spec: DesignSpec):
-    """The mechanism dataclass described by ``[cam]`` and ``[follower]``."""
-    f, rot = spec.follower, spec.cam.rotation
-    kind = spec.cam.kind
-    if kind == "translating":
-        return TranslatingCamRoller(f.roller_radius_mm or 0.0, f.base_height_mm or 0.0, spec.cam.direction)
-    rr = 0.0 if f.type == "knife" else (f.roller_radius_mm or 0.0)
-    if kind == "constant_width":
-        return ConstantWidthCam(f.base_radius_mm, f.width_mm, f.rise_deg or 120.0, rot)
-    if kind == "constant_diameter":
-        return ConstantDiameterCam(f.base_radius_mm, rr, f.width_mm, f.rise_deg or 120.0, f.offset_mm or 0.0, rot)
-    if kind == "conjugate":
-        return _conjugate(f, rr, rot)
-    if f.type in ("roller", "knife"):
-        if f.motion == "translating":
-            return TranslatingRoller(f.base_radius_mm, rr, f.offset_mm or 0.0, rot)
-        return OscillatingRoller(f.base_radius_mm, rr, f.pivot_distance_mm, f.arm_length_mm, rot)
-    if f.motion == "translating":
-        return TranslatingFlat(f.base_radius_mm, f.face_offset_mm or 0.0, rot)
-    return OscillatingFlat(f.base_radius_mm, f.pivot_distance_mm, f.face_offset_mm or 0.0, rot)
-
-
-def _conjugate(f, rr: float, rot: str):
-    if f.motion == "translating":
-        if f.type == "flat":
-            return ConjugateTranslatingFlat(f.base_radius_mm, f.follower_distance_mm, rot)
-        return ConjugateTranslatingRoller(f.base_radius_mm, rr, f.follower_distance_mm, f.second_roller_radius_mm,
-                                          f.offset_mm or 0.0, rot)
-    if f.type == "flat":
-        return ConjugateOscillatingFlat(f.base_radius_mm, f.pivot_distance_mm, f.face_offset_mm or 0.0,
-                                        f.follower_angle_deg, rot)
-    return ConjugateOscillatingRoller(f.base_radius_mm, rr, f.pivot_distance_mm, f.arm_length_mm,
-                                      f.follower_angle_deg, f.second_roller_radius_mm, rot)
-
-
-def geometry_from_spec(spec: DesignSpec) -> CamGeometry:
-    """The exact :class:`CamGeometry`; every geometry problem raised as one :class:`SpecError`."""
-    mech = mechanism_from_spec(spec)
-    try:
-        if isinstance(mech, DESMODROMIC):
-            bore = spec.manufacturing.bore_mm or None
-            return desmodromic_geometry(mech, spec.program(), bore_mm=bore)
-        return CamGeometry(mech, spec.program())
-    except SpecError as exc:
-        raise SpecError(exc.problems, spec.source) from None
 
 
 def check_design(spec: DesignSpec, *, tool_radius_mm: float | None = None) -> Report:

@@ -33,7 +33,8 @@ from typing import Any, Callable
 import numpy as np
 
 from .motion_report import Finding, MotionReport, analyse_motion, verdict_of
-from .profile import CamGeometry, Contact, OscillatingRollerContact, _cross
+from .profile import CamGeometry, Contact, cross as _cross
+from .rollers import OscillatingRollerContact
 from .solvers import (_bracket_min, _bracket_root, _channel_solvers, _default_step, _ExtremaPlan, _extrema_steps,
                       _extremum_steps, _gather, _integrate_steps, _mapped, _sampling, _run)
 
@@ -162,7 +163,7 @@ def check(geometry: CamGeometry, *, pressure_angle_limit_deg: float | None = Non
                 lim = DEFAULT_PRESSURE_LIMIT_DEG["oscillating" if isinstance(c, OscillatingRollerContact)
                                                  else "translating"]
             planners.append(_pressure(c, tag, to_user, lim, summary))
-        else:
+        if c.has_face:
             planners.append(_face(c, tag, to_user, face_margin_mm, summary))
     planners.append(_extent(geometry, summary))
     for found in _schedule(planners):

@@ -295,7 +295,7 @@ def analyse_dynamics(geometry: CamGeometry, loads: Loads, speed: float, *, prelo
     root refinement.  ``speed`` is ω (rad/s), or mm/s for a translating cam.
     """
     if form_closed is None:
-        from .desmodromic import DesmodromicGeometry
+        from .conjugate import DesmodromicGeometry
 
         form_closed = isinstance(geometry, DesmodromicGeometry)
     if not form_closed and len(geometry.profiles) != 1:

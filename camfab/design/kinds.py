@@ -59,6 +59,13 @@ class FollowerType(StrEnum):
     ROLLER = "roller"
     FLAT = "flat"
     KNIFE = "knife"
+    #: a convex circular face (mushroom or finger follower)
+    CURVED = "curved"
+
+    @property
+    def title(self) -> str:
+        """The follower's name in words: "roller", "flat-face", "knife-edge" or "curved-face"."""
+        return {"roller": "roller", "flat": "flat-face", "knife": "knife-edge", "curved": "curved-face"}[self.value]
 
 
 class FollowerMotion(StrEnum):
@@ -90,7 +97,8 @@ class Direction(StrEnum):
 class ContactKind(StrEnum):
     """The shape of the follower surface that envelopes a profile."""
 
-    #: a circle of fixed radius about a point of the follower (roller; knife edge = radius 0)
+    #: a circle of fixed radius about a point of the follower (roller; knife edge = radius 0; a curved
+    #: face, which slides)
     ROLLER = "roller"
     #: a straight face
     FLAT = "flat"

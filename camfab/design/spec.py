@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import difflib
 import functools
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -22,6 +22,7 @@ from ..units import DEG, RPM
 from .kinds import CamKind, Direction, FollowerMotion, FollowerType, LiftUnit, Rotation
 from .knots import KnotFile, KnotTable, build_knot_table
 from .laws import law_names
+from .mechanisms import MECHANISMS, mechanism_class
 from .program import TWO_PI, MotionProgram, SegmentInput, build_program
 from .validator import Validator
 
@@ -46,20 +47,12 @@ _CAM_KEYS = ("kind", "rotation", "direction", "speed_rpm", "omega_rad_s", "speed
 _FOLLOWER_FLOATS = ("base_radius_mm", "roller_radius_mm", "offset_mm", "pivot_distance_mm",
                     "arm_length_mm", "face_offset_mm", "follower_distance_mm",
                     "second_roller_radius_mm", "follower_angle_deg", "cam_length_mm",
-                    "base_height_mm", "width_mm", "rise_deg")
+                    "base_height_mm", "width_mm", "rise_deg", "face_radius_mm")
 _FOLLOWER_KEYS = ("type", "motion", *_FOLLOWER_FLOATS)
 #: [follower] lengths that must be > 0, and those that may be 0 (the others lie in ±1e6)
-_POSITIVE = ("base_radius_mm", "arm_length_mm", "cam_length_mm", "follower_distance_mm", "width_mm")
+_POSITIVE = ("base_radius_mm", "arm_length_mm", "cam_length_mm", "follower_distance_mm", "width_mm",
+             "face_radius_mm")
 _NON_NEGATIVE = ("roller_radius_mm", "pivot_distance_mm", "second_roller_radius_mm", "base_height_mm")
-#: [follower] keys a disc (or conjugate) cam needs, by follower type and motion
-_REQUIRED: dict[tuple[str, str], tuple[str, ...]] = {
-    ("roller", "translating"): ("base_radius_mm", "roller_radius_mm"),
-    ("knife", "translating"): ("base_radius_mm",),
-    ("roller", "oscillating"): ("base_radius_mm", "roller_radius_mm", "pivot_distance_mm", "arm_length_mm"),
-    ("knife", "oscillating"): ("base_radius_mm", "pivot_distance_mm", "arm_length_mm"),
-    ("flat", "translating"): ("base_radius_mm",),
-    ("flat", "oscillating"): ("base_radius_mm", "pivot_distance_mm"),
-}
 _SEGMENT_KEYS = ("law", "lift", "angle_deg", "length_mm", "shape")
 _MFG_KEYS = ("thickness_mm", "bore_mm", "keyway", "hub_diameter_mm", "hub_length_mm",
              "tool_diameter_mm", "tolerance_mm", "material")
@@ -109,6 +102,7 @@ class FollowerSpec:
     base_height_mm: float | None = None
     width_mm: float | None = None
     rise_deg: float | None = None
+    face_radius_mm: float | None = None
 
     @property
     def lift_unit(self) -> LiftUnit:
@@ -335,16 +329,31 @@ def _follower(v: Validator, t: Mapping[str, Any], cam: CamSpec) -> FollowerSpec:
             v.add("follower.roller_radius_mm", vals["roller_radius_mm"], "a knife-edge follower has no roller",
                   'remove roller_radius_mm or use type = "roller"')
         vals["roller_radius_mm"] = 0.0
-    rules = _FOLLOWER_RULES.get(cam.kind, _disc_follower)
-    need = rules(v, t, cam.kind, ftype, motion, vals)
-    for key in need:
-        if key not in t and not (key == "roller_radius_mm" and ftype == FollowerType.KNIFE):
-            v.add(f"follower.{key}", None, f"is required for a {motion} {ftype} follower",
-                  f"add {key} = <mm> to [follower]")
-    if ftype == FollowerType.FLAT and "roller_radius_mm" in t:
-        v.add("follower.roller_radius_mm", t["roller_radius_mm"], "a flat-face follower has no roller",
-              'remove it or use type = "roller"')
+    family = mechanism_class(cam.kind, ftype, motion)
+    if family is None:
+        v.add("follower.type", f"{motion} {ftype}", f"a {cam.kind.replace('_', '-')} cam has no {motion} {ftype} "
+              "follower", "use one of: " + ", ".join(_followers_of(cam.kind)))
+        return FollowerSpec(ftype, motion, **vals)
+    if cam.kind.symmetric:
+        _width_once(v, t, cam.kind, vals)
+    for key in family.required:
+        if key not in t and not (key == "roller_radius_mm" and ftype == FollowerType.KNIFE) and not (
+                key == "width_mm" and vals["width_mm"] is not None):
+            v.add(f"follower.{key}", None, f"is required for a {cam.kind.replace('_', '-')} cam with a {motion} "
+                  f"{ftype} follower", f"add {key} = <{'degrees' if key.endswith('_deg') else 'mm'}> to [follower]")
+    used = set(family.required) | set(family.optional) | {"type", "motion"}
+    if cam.kind.symmetric:
+        used.add("follower_distance_mm")  # the constant width's other name
+    for key in t:
+        if key in _FOLLOWER_KEYS and key not in used and not (key == "roller_radius_mm" and vals[key] == 0.0):
+            v.add(f"follower.{key}", t[key], f"is not used by a {cam.kind.replace('_', '-')} cam with a {motion} "
+                  f"{ftype} follower", "remove it (it would be ignored), or check the follower type and motion")
     return FollowerSpec(ftype, motion, **vals)
+
+
+def _followers_of(kind: CamKind) -> list[str]:
+    """The follower types and motions a cam kind has families for ("translating roller", …)."""
+    return sorted(f"{m.value} {t.value}" for k, t, m in MECHANISMS if k == kind)
 
 
 def _follower_numbers(v: Validator, t: Mapping[str, Any]) -> dict[str, float | None]:
@@ -362,33 +371,8 @@ def _follower_numbers(v: Validator, t: Mapping[str, Any]) -> dict[str, float | N
     return vals
 
 
-def _disc_follower(v: Validator, t: Mapping[str, Any], kind: CamKind, ftype: FollowerType,
-                   motion: FollowerMotion, vals: dict[str, float | None]) -> tuple[str, ...]:
-    """Disc and conjugate cams: the keys the follower needs (a conjugate pair also its second follower)."""
-    need = _REQUIRED[(ftype, motion)]
-    if kind != CamKind.CONJUGATE:
-        return need
-    if ftype == FollowerType.KNIFE:
-        v.add("follower.type", ftype, "conjugate cams have roller or flat followers", 'use type = "roller" or "flat"')
-    return need + (("follower_distance_mm",) if motion == FollowerMotion.TRANSLATING else ("follower_angle_deg",))
-
-
-def _translating_cam_follower(v: Validator, t: Mapping[str, Any], kind: CamKind, ftype: FollowerType,
-                              motion: FollowerMotion, vals: dict[str, float | None]) -> tuple[str, ...]:
-    """A translating (wedge) cam drives a translating roller."""
-    if ftype == FollowerType.FLAT or motion == FollowerMotion.OSCILLATING:
-        v.add("follower.type", ftype, "a translating cam drives a translating roller follower",
-              'use type = "roller", motion = "translating"')
-    return ("roller_radius_mm", "cam_length_mm")
-
-
-def _symmetric_follower(v: Validator, t: Mapping[str, Any], kind: CamKind, ftype: FollowerType,
-                        motion: FollowerMotion, vals: dict[str, float | None]) -> tuple[str, ...]:
-    """Constant-width (two flat faces) and constant-diameter (two rollers) cams: the width, given once."""
-    want = FollowerType.FLAT if kind == CamKind.CONSTANT_WIDTH else FollowerType.ROLLER
-    if ftype != want or motion != FollowerMotion.TRANSLATING:
-        v.add("follower.type", ftype, f"a {kind.replace('_', '-')} cam has a double translating {want} "
-              "follower", f'use type = "{want}", motion = "translating"')
+def _width_once(v: Validator, t: Mapping[str, Any], kind: CamKind, vals: dict[str, float | None]) -> None:
+    """Constant-width/diameter cams: the width, given once (``width_mm`` or ``follower_distance_mm``)."""
     if "width_mm" in t and "follower_distance_mm" in t:
         v.add("follower.follower_distance_mm", t["follower_distance_mm"],
               "give the constant width once", "keep width_mm and remove follower_distance_mm")
@@ -397,15 +381,6 @@ def _symmetric_follower(v: Validator, t: Mapping[str, Any], kind: CamKind, ftype
     if vals["width_mm"] is None and "width_mm" not in t and "follower_distance_mm" not in t:
         v.add("follower.width_mm", None, f"is required for a {kind} cam",
               "add width_mm = <mm> (the constant width, > 2·base_radius_mm)")
-    return ("base_radius_mm",) + (("roller_radius_mm",) if want == FollowerType.ROLLER else ())
-
-
-#: the follower rules of each cam kind (disc and conjugate cams: :func:`_disc_follower`)
-_FOLLOWER_RULES: dict[CamKind, Callable[..., tuple[str, ...]]] = {
-    CamKind.TRANSLATING: _translating_cam_follower,
-    CamKind.CONSTANT_WIDTH: _symmetric_follower,
-    CamKind.CONSTANT_DIAMETER: _symmetric_follower,
-}
 
 
 # ---------------------------------------------------------------------------

@@ -13,11 +13,12 @@ from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 
 from camfab.design.checks import Code, check
-from camfab.design.desmodromic import (ComplementMotion, ConjugateOscillatingFlat, ConjugateOscillatingRoller,
-                                       ConjugateTranslatingFlat, ConjugateTranslatingRoller, ConstantDiameterCam,
-                                       ConstantWidthCam, desmodromic_geometry, follower_limits, lift_of,
-                                       minimum_follower_distance)
+from camfab.design.conjugate import (ComplementMotion, ConjugateOscillatingFlat, ConjugateOscillatingRoller,
+                                     ConjugateTranslatingFlat, ConjugateTranslatingRoller, follower_limits, lift_of,
+                                     minimum_follower_distance)
 from camfab.design.mechanisms import TranslatingFlat
+from camfab.design.symmetric import ConstantDiameterCam, ConstantWidthCam
+from camfab.design.profile import CamGeometry
 from camfab.design.program import MotionProgram
 from camfab.errors import SpecError
 
@@ -58,7 +59,7 @@ def _cross(a, b):
                                            (25, 80, 180, "ccw"), (50, 101, 150, "cw")])
 def test_constant_width_keeps_width(rb, w, rise, rot):
     mech = ConstantWidthCam(rb, w, rise, rot)
-    g = desmodromic_geometry(mech)
+    g = mech.geometry()
     assert len(g.profiles) == 1 and mech.lift_mm == pytest.approx(w - 2 * rb)
     x = _angles(g)
     np.testing.assert_allclose(g.width(x), w, atol=1e-9, rtol=0)
@@ -82,16 +83,15 @@ def test_constant_width_is_its_own_conjugate():
     """With d = W the conjugate construction gives R_b2 = R_b and P2(θ) = P1(θ+π) (spec §11)."""
     for rot in ("cw", "ccw"):
         cw = ConstantWidthCam(40, 100, 120, rot)
-        one = desmodromic_geometry(cw)
-        pair = desmodromic_geometry(ConjugateTranslatingFlat(40, 100, rot), cw.program())
-        assert ConjugateTranslatingFlat(40, 100, rot).second_base_radius_mm(cw.program()) == pytest.approx(40)
+        one = cw.geometry()
+        pair = ConjugateTranslatingFlat(40, 100, rot).geometry(cw.default_program())
+        assert ConjugateTranslatingFlat(40, 100, rot).second_base_radius_mm(cw.default_program()) == pytest.approx(40)
         x = np.linspace(0, 2 * np.pi, 3601)
         np.testing.assert_allclose(pair.evaluate(x, 1).point, one.evaluate(x + np.pi).point, atol=1e-9)
         np.testing.assert_allclose(pair.evaluate(x, 1).normal, one.evaluate(x + np.pi).normal, atol=1e-12)
         cd = ConstantDiameterCam(40, 10, 100, 120, 0.0, rot)
-        one = desmodromic_geometry(cd)
-        pair = desmodromic_geometry(ConjugateTranslatingRoller(40, 10, cd.constant_distance_mm, rotation=rot),
-                                    cd.program())
+        one = cd.geometry()
+        pair = ConjugateTranslatingRoller(40, 10, cd.constant_distance_mm, rotation=rot).geometry(cd.default_program())
         np.testing.assert_allclose(pair.evaluate(x, 1).point, one.evaluate(x + np.pi).point, atol=1e-9)
         np.testing.assert_allclose(pair.evaluate(x, 1).pitch, one.evaluate(x + np.pi).pitch, atol=1e-9)
 
@@ -101,7 +101,7 @@ def test_constant_diameter_roller_centre_distance(rot):
     """Exact invariant: the roller-centre distance 2R_p + h = W + 2R_r (spec D9); the contact
     points are W apart only where S' = 0 (100.0 … 100.6 mm for R_b 40, R_r 10, h 20)."""
     mech = ConstantDiameterCam(40, 10, 100, 120, 0.0, rot)
-    g = desmodromic_geometry(mech)
+    g = mech.geometry()
     assert mech.constant_distance_mm == 120 and mech.lift_mm == 20
     x = _angles(g)
     np.testing.assert_allclose(g.width(x), 120, atol=1e-9, rtol=0)
@@ -116,7 +116,7 @@ def test_constant_diameter_roller_centre_distance(rot):
 
 
 def test_constant_width_check_accepts_acceleration_jump():
-    g = desmodromic_geometry(ConstantWidthCam(40, 100))
+    g = ConstantWidthCam(40, 100).geometry()
     r = check(g, allow_acceleration_jump=True)
     acc = r.by_code(Code.ACCELERATION_DISCONTINUITY)
     assert len(acc) == 4 and all(f.severity == "warning" for f in acc)
@@ -124,7 +124,7 @@ def test_constant_width_check_accepts_acceleration_jump():
     strict = check(g)
     assert all(f.severity == "error" for f in strict.by_code(Code.ACCELERATION_DISCONTINUITY))
     assert strict.verdict == "unacceptable"
-    rd = check(desmodromic_geometry(ConstantDiameterCam(40, 10, 100)), allow_acceleration_jump=True)
+    rd = check(ConstantDiameterCam(40, 10, 100).geometry(), allow_acceleration_jump=True)
     assert rd.verdict == "not_for_high_speed" and rd.summary["pressure_angle_deg"]["max"] < 30
 
 
@@ -145,7 +145,7 @@ PAIRS = [
 
 @pytest.mark.parametrize("mech,prog", PAIRS)
 def test_second_law_and_base_radius(mech, prog):
-    g = desmodromic_geometry(mech, prog)
+    g = mech.geometry(prog)
     h = lift_of(prog)
     x = np.linspace(0, 2 * np.pi, 7201)
     np.testing.assert_allclose(g.second_program(x), h - prog(x), atol=1e-12)
@@ -158,7 +158,7 @@ def test_second_law_and_base_radius(mech, prog):
 @pytest.mark.parametrize("mech,prog", [p for p in PAIRS if isinstance(p[0], ConjugateTranslatingFlat)])
 def test_conjugate_flat_keeps_face_distance(mech, prog):
     """Support of cam 1 along +Y(φ) plus support of cam 2 along −Y(φ) = d, to 1e-9."""
-    g = desmodromic_geometry(mech, prog)
+    g = mech.geometry(prog)
     d = mech.follower_distance_mm
     x = _angles(g, 20001)
     a, b = g.evaluate(x, 0), g.evaluate(x, 1)
@@ -180,7 +180,7 @@ def test_conjugate_flat_keeps_face_distance(mech, prog):
 
 @pytest.mark.parametrize("mech,prog", [p for p in PAIRS if isinstance(p[0], ConjugateTranslatingRoller)])
 def test_conjugate_roller_keeps_centre_distance(mech, prog):
-    g = desmodromic_geometry(mech, prog)
+    g = mech.geometry(prog)
     x = _angles(g, 20001)
     a, b = g.evaluate(x, 0), g.evaluate(x, 1)
     np.testing.assert_allclose(np.hypot(*(a.pitch - b.pitch).T), mech.follower_distance_mm, atol=1e-9, rtol=0)
@@ -207,7 +207,7 @@ def test_conjugate_roller_keeps_centre_distance(mech, prog):
 
 @pytest.mark.parametrize("mech,prog", [p for p in PAIRS if p[0].motion == "oscillating"])
 def test_oscillating_pair_keeps_follower_angle(mech, prog):
-    g = desmodromic_geometry(mech, prog)
+    g = mech.geometry(prog)
     x = _angles(g, 20001)
     a, b = g.evaluate(x, 0), g.evaluate(x, 1)
     beta = mech.follower_angle_deg
@@ -251,11 +251,11 @@ def test_spec_formulas_translating_pairs():
     th = np.linspace(0.01, 2 * np.pi - 0.01, 721)
     S, S1 = E9.evaluate(th, (0, 1))
     rb, d = 100.0, 210.0
-    g = desmodromic_geometry(ConjugateTranslatingFlat(rb, d, "ccw"), E9)
+    g = ConjugateTranslatingFlat(rb, d, "ccw").geometry(E9)
     np.testing.assert_allclose(g.evaluate(th, 0).point, _S_theta(np.stack([S1, rb + S], 1), th), atol=1e-10)
     np.testing.assert_allclose(g.evaluate(th, 1).point, _S_theta(np.stack([S1, rb - d + S], 1), th), atol=1e-10)
     rb, rr, eps, dc, rr2 = 35.0, 7.0, 4.0, 110.0, 6.0
-    g = desmodromic_geometry(ConjugateTranslatingRoller(rb, rr, dc, rr2, eps, "ccw"), E9)
+    g = ConjugateTranslatingRoller(rb, rr, dc, rr2, eps, "ccw").geometry(E9)
     d0 = math.sqrt((rb + rr) ** 2 - eps**2)
     z = np.zeros_like(th)
     for k, (dy, r) in enumerate([(d0, rr), (d0 - dc, rr2)]):
@@ -269,7 +269,7 @@ def test_spec_formulas_oscillating_pairs():
     th = np.linspace(0.01, 2 * np.pi - 0.01, 721)
     phi, phi1 = E2.evaluate(th, (0, 1)) * DEG
     l1, rb, beta = 100.0, 40.0, 60.0 * DEG
-    g = desmodromic_geometry(ConjugateOscillatingFlat(rb, l1, 0.0, 60.0, "ccw"), E2)
+    g = ConjugateOscillatingFlat(rb, l1, 0.0, 60.0, "ccw").geometry(E2)
     g1 = math.asin(rb / l1)
     for k, d in enumerate([g1 + phi, g1 - beta + phi]):
         l3 = l1 * np.cos(d) / (phi1 + 1)
@@ -277,7 +277,7 @@ def test_spec_formulas_oscillating_pairs():
         np.testing.assert_allclose(g.evaluate(th, k).point, op, atol=1e-9)
     a, rr, rr2 = 90.0, 10.0, 6.0
     mech = ConjugateOscillatingRoller(rb, rr, l1, a, 95.0, rr2, "ccw")
-    g = desmodromic_geometry(mech, E2)
+    g = mech.geometry(E2)
     g1 = math.acos((l1**2 + a**2 - (rb + rr) ** 2) / (2 * l1 * a))
     for k, (d, r) in enumerate([(g1 + phi, rr), (g1 - 95 * DEG + phi, rr2)]):
         C = np.stack([l1 - a * np.cos(d), a * np.sin(d)], 1)
@@ -293,7 +293,7 @@ def test_ejemplo8da():
     """Conjugate R_b 80 for follower distance 225 with double harmonic ±100/180 ⇔ initial R_b 45."""
     mech = ConjugateTranslatingFlat(45, 225)
     assert mech.second_base_radius_mm(DA8) == pytest.approx(80.0, abs=1e-12)
-    g = desmodromic_geometry(mech, DA8)
+    g = mech.geometry(DA8)
     assert g.radius_extremes(1).min == pytest.approx(80.0, abs=1e-9)
     assert g.radius_extremes(1).max == pytest.approx(180.0, abs=1e-9)
     s2 = g.second_program.evaluate(np.array([0.0, 0.1, 179.9 * DEG, 180 * DEG, 270 * DEG]), (0, 1))
@@ -302,7 +302,7 @@ def test_ejemplo8da():
     # the reverse: the conjugate (R_b 80) as initial cam gives back R_b 45 and the original profile
     back = ConjugateTranslatingFlat(80, 225)
     assert back.second_base_radius_mm(g.second_program) == pytest.approx(45.0, abs=1e-12)
-    gb = desmodromic_geometry(back, g.second_program)
+    gb = back.geometry(g.second_program)
     x = np.linspace(0, 2 * np.pi, 3601)
     # (the whole mechanism turned by 180°: cam 2 of one is cam 1 of the other, rotated by π)
     np.testing.assert_allclose(gb.evaluate(x, 0).point, -g.evaluate(x, 1).point, atol=1e-9)
@@ -317,7 +317,7 @@ def test_ejemplo7crt_distance_380():
     """P4567 ±20/36 ×5 with a 380 mm follower distance (initial geometry assumed: R_b 150, R_r 20)."""
     prog = MotionProgram.from_segments([("poly4567", 20 * (-1) ** k, 36) for k in range(10)])
     mech = ConjugateTranslatingRoller(150, 20, 380)
-    g = desmodromic_geometry(mech, prog)
+    g = mech.geometry(prog)
     np.testing.assert_allclose(g.follower_distance(np.linspace(0, 7, 1001)), 380, atol=1e-9)
     assert mech.second_base_radius_mm(prog) == pytest.approx(380 - 170 - 20 - 20)
     assert g.second_program(0.0)[0] == pytest.approx(20)  # the conjugate starts at a peak (descent first)
@@ -339,12 +339,12 @@ def test_minimum_follower_distance_enforced(mech, prog, field):
     lo, hi = follower_limits(mech, prog)
     assert math.isfinite(lo) and lo > 0
     ok = replace(mech, **{field: lo + 1e-5})
-    g = desmodromic_geometry(ok, prog)
+    g = ok.geometry(prog)
     assert not _second_cam_errors(check(g))
     assert g.radius_extremes(1).min > -1e-9
     bad = replace(mech, **{field: lo - 1e-5})
     with pytest.raises(SpecError) as err:
-        desmodromic_geometry(bad, prog)
+        bad.geometry(prog)
     (p,) = err.value.problems
     assert p.path == f"follower.{field}" and "minimum" in p.rule and f"{lo:.9g}" in p.fix
     # just below: the second cam is really degenerate (cusp, undercut or R_b2 <= 0)
@@ -357,8 +357,8 @@ def test_minimum_follower_distance_enforced(mech, prog, field):
         assert bad_geom
     if math.isfinite(hi):  # oscillating pairs: an upper bound too (arm 2 must stay on its side)
         with pytest.raises(SpecError, match="maximum"):
-            desmodromic_geometry(replace(mech, **{field: hi + 1e-5}), prog)
-        desmodromic_geometry(replace(mech, **{field: hi - 1e-5}), prog)
+            replace(mech, **{field: hi + 1e-5}).geometry(prog)
+        replace(mech, **{field: hi - 1e-5}).geometry(prog)
 
 
 def test_minimum_distance_closed_form_and_bore():
@@ -370,9 +370,9 @@ def test_minimum_distance_closed_form_and_bore():
     assert minimum_follower_distance(mech, E9) == pytest.approx(55 + k, abs=1e-6)
     assert minimum_follower_distance(mech, E9, bore_mm=2 * (k + 20)) == pytest.approx(55 + k + 20, abs=1e-9)
     with pytest.raises(SpecError, match="bore radius"):
-        desmodromic_geometry(ConjugateTranslatingFlat(45, 55 + k + 19), E9, bore_mm=2 * (k + 20))
+        ConjugateTranslatingFlat(45, 55 + k + 19).geometry(E9, bore_mm=2 * (k + 20))
     with pytest.raises(SpecError, match="no follower_angle_deg"):  # no angle puts face 2 far enough
-        desmodromic_geometry(ConjugateOscillatingFlat(40, 100, 5, 80), E2, bore_mm=500)
+        ConjugateOscillatingFlat(40, 100, 5, 80).geometry(E2, bore_mm=500)
 
 
 # ---------------------------------------------------------------------------
@@ -409,29 +409,29 @@ def test_refusals(mech, path, rule):
     assert any(p.path == path and rule in p.rule and p.fix for p in probs), probs
     prog = E2 if mech.motion == "oscillating" else (None if hasattr(mech, "width_mm") else E9)
     with pytest.raises(SpecError, match=path.replace(".", r"\.")):
-        desmodromic_geometry(mech, prog)
+        mech.geometry(prog)
 
 
 def test_refusals_depending_on_motion():
     bad = MotionProgram.from_segments([("cycloidal", 20, 120), ("dwell", 0, 60), ("poly345", -20, 120),
                                        ("dwell", 0, 60)])  # S(θ) + S(θ+π) ≠ h
     with pytest.raises(SpecError, match=r"motion.*S\(θ\) \+ S\(θ\+180°\)"):
-        desmodromic_geometry(ConstantWidthCam(40, 80.0 + 20), bad)
+        ConstantWidthCam(40, 80.0 + 20).geometry(bad)
     with pytest.raises(SpecError, match="motion"):  # right shape, wrong lift for the width
-        desmodromic_geometry(ConstantWidthCam(40, 110), ConstantWidthCam(40, 100).program())
-    desmodromic_geometry(ConstantWidthCam(40, 100), ConstantWidthCam(40, 100).program())  # the law itself is fine
+        ConstantWidthCam(40, 110).geometry(ConstantWidthCam(40, 100).default_program())
+    ConstantWidthCam(40, 100).geometry(ConstantWidthCam(40, 100).default_program())  # the law itself is fine
     with pytest.raises(SpecError, match="one revolution"):
-        desmodromic_geometry(ConjugateTranslatingFlat(45, 200), MotionProgram.from_segments(
+        ConjugateTranslatingFlat(45, 200).geometry(MotionProgram.from_segments(
             [("cycloidal", 5, 20), ("cycloidal", -5, 20)], unit="mm"))
     with pytest.raises(SpecError, match=r"past perpendicular"):  # follower 1's own limits
-        desmodromic_geometry(ConjugateOscillatingFlat(40, 100, 0, 150), MotionProgram.from_segments(
+        ConjugateOscillatingFlat(40, 100, 0, 150).geometry(MotionProgram.from_segments(
             [("cycloidal", 70, 180), ("cycloidal", -70, 180)]))
-    with pytest.raises(SpecError, match="needs follower 1's motion"):
-        desmodromic_geometry(ConjugateTranslatingFlat(45, 200))
+    with pytest.raises(SpecError, match="needs a motion program"):
+        ConjugateTranslatingFlat(45, 200).geometry()
+    with pytest.raises(TypeError, match="mechanism.geometry"):  # a pair's geometry is the pair's type
+        CamGeometry(ConjugateTranslatingFlat(45, 225), DA8)
     with pytest.raises(TypeError):
-        desmodromic_geometry(TranslatingFlat(40), E9)
-    with pytest.raises(TypeError):
-        desmodromic_geometry(ConjugateTranslatingFlat(45, 225), DA8).width(0.0)
+        ConjugateTranslatingFlat(45, 225).geometry(DA8).width(0.0)
     probs = ConstantDiameterCam(-1, -1, 1, 0, 3.0, "x").validate()
     assert {"cam.rotation", "follower.base_radius_mm", "follower.rise_deg"} <= {p.path for p in probs}
 
@@ -542,7 +542,7 @@ _KNIFE_ARM = (ConjugateOscillatingRoller(100.0, 0.0, 100.0, 100.0, 74.1103822501
 @example(_KNIFE_ARM)
 def test_both_profiles_match_finite_differences(design):
     mech, prog = design
-    g = desmodromic_geometry(mech, prog)
+    g = mech.geometry(prog)
     h = 1e-4
     x = _away(g, np.linspace(0.013, 2 * np.pi - 0.013, 151), h)
     for k in range(len(g.profiles)):
@@ -561,7 +561,7 @@ def test_both_profiles_match_finite_differences(design):
 @pytest.mark.parametrize("mech,prog", PAIRS + [(ConstantWidthCam(40, 100, 120, "ccw"), None),
                                                (ConstantDiameterCam(35, 8, 90), None)])
 def test_fixed_designs_match_finite_differences(mech, prog):
-    g = desmodromic_geometry(mech, prog)
+    g = mech.geometry(prog)
     x = _away(g, np.linspace(0.013, 2 * np.pi - 0.013, 301), 1e-4)
     for k in range(len(g.profiles)):
         _check_contact(g, k, x, 1e-4)

@@ -291,9 +291,9 @@ def test_examples_with_dynamics_hold_their_safety_force(name):
 
 # ---------------------------------------------------------------------------
 # form-closed followers: conjugate pairs, constant width and constant diameter
-from camfab.design.desmodromic import (ConjugateOscillatingFlat, ConjugateOscillatingRoller,  # noqa: E402
-                                       ConjugateTranslatingFlat, ConjugateTranslatingRoller, ConstantDiameterCam,
-                                       ConstantWidthCam, desmodromic_geometry)
+from camfab.design.mechanisms import (ConjugateOscillatingFlat, ConjugateOscillatingRoller,  # noqa: E402
+                                      ConjugateTranslatingFlat, ConjugateTranslatingRoller, ConstantDiameterCam,
+                                      ConstantWidthCam)
 from camfab.design.dynamics import pair_of  # noqa: E402
 
 E9 = MotionProgram.from_segments([("modified_sine", 10, 50), ("dwell", 0, 40), ("cycloidal", -10, 50),
@@ -317,7 +317,7 @@ def test_form_closed_power_balance_and_load_sharing(mech, prog, L):
     """Follower 1 carries G where G > 0 and follower 2 where G < 0 (never both); the drive torque from
     both contacts' forces on the cam balances G·q̇₁ plus the friction loss — an independent check that
     follower 2's contact (mirrored conjugate, or the same profile half a turn on) is mapped right."""
-    g = desmodromic_geometry(mech, prog)
+    g = mech.geometry(prog)
     pair = pair_of(g, L, W)
     x = np.linspace(0.0, 2 * np.pi, 1441)[:-1] + 1e-3
     s = pair.evaluate(x)
@@ -345,7 +345,7 @@ def test_constant_width_shm_loads_and_reversals():
     """Constant width, SHM rise 120°: G = m·S″·ω², so follower 1 pushes while S″ > 0 and follower 2 while
     S″ < 0; the load crosses at the SHM mid-points 60° and 240° only (the dwells carry nothing)."""
     mech = ConstantWidthCam(40, 100, 120)
-    g = desmodromic_geometry(mech)
+    g = mech.geometry()
     rep = analyse_dynamics(g, Loads(0.4), W)
     h = 20.0  # width − 2·Rb
     peak = 0.4 * (h / 2) * (math.pi / (120 * math.pi / 180)) ** 2 * 1e-3 * W * W  # m·(h/2)(π/β)²·ω²

@@ -242,3 +242,46 @@ def test_design_from_dict_refuses_an_unread_knot_file():
     del d["motion"]
     err = _problems(d)
     assert [p.path for p in err.problems] == ["motion_table.file"] and "camfab.formats" in str(err)
+
+
+# ---------------------------------------------------------------------------
+# the follower keys come from the mechanism registry: what each family needs, and nothing it ignores
+_TWO = [{"law": "cycloidal", "lift": 5.0, "angle_deg": 180.0}, {"law": "cycloidal", "lift": -5.0, "angle_deg": 180.0}]
+
+
+@pytest.mark.parametrize("motion,follower,path", [
+    ("translating", {"base_radius_mm": 30.0}, "follower.face_radius_mm"),
+    ("oscillating", {"base_radius_mm": 30.0, "face_radius_mm": 40.0}, "follower.pivot_distance_mm"),
+    ("translating", {"base_radius_mm": 30.0, "face_radius_mm": 40.0, "roller_radius_mm": 3.0},
+     "follower.roller_radius_mm"),
+    ("translating", {"base_radius_mm": 30.0, "face_radius_mm": 0.0}, "follower.face_radius_mm"),
+])
+def test_curved_face_follower_keys(motion, follower, path):
+    data = {"follower": {"type": "curved", "motion": motion, **follower}, "motion": _TWO}
+    with pytest.raises(SpecError) as info:
+        design_from_dict(data)
+    assert path in {p.path for p in info.value.problems}
+
+
+def test_curved_face_follower_design():
+    spec = design_from_dict({"follower": {"type": "curved", "motion": "oscillating", "base_radius_mm": 18.0,
+                                          "face_radius_mm": 25.0, "pivot_distance_mm": 60.0,
+                                          "face_offset_mm": 44.8}, "motion": _TWO})
+    assert spec.follower.face_radius_mm == 25.0 and spec.program().axis.lift_unit == "deg"
+
+
+def test_unused_follower_keys_are_refused_not_ignored():
+    data = {"follower": {"type": "flat", "base_radius_mm": 30.0, "arm_length_mm": 50.0}, "motion": _TWO}
+    with pytest.raises(SpecError) as info:
+        design_from_dict(data)
+    (p,) = info.value.problems
+    assert p.path == "follower.arm_length_mm" and "not used" in p.rule and p.fix
+
+
+def test_a_combination_without_a_family_lists_the_ones_that_exist():
+    data = {"cam": {"kind": "conjugate"}, "follower": {"type": "curved", "base_radius_mm": 30.0,
+                                                       "face_radius_mm": 20.0}, "motion": _TWO}
+    with pytest.raises(SpecError) as info:
+        design_from_dict(data)
+    (p,) = info.value.problems
+    assert p.path == "follower.type" and "translating roller" in p.fix and "curved" not in p.fix

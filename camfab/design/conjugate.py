@@ -1,81 +1,69 @@
-"""Desmodromic cams: conjugate pairs, constant-width and constant-diameter cams
-(``spec/profiles.md`` §2, §7–§12; ``spec/camdas-reference.md`` §1.1, §1.2, §1.10).
+"""Conjugate cams: two cams on one shaft driving one rigid double follower, both ways (form closure).
 
-A rigid double follower is driven positively in both directions.  Conjugate
-pairs have two cams on one shaft (two planes), one per follower; constant-width
-and constant-diameter cams are the special case where both followers touch the
-same profile.
+A rigid double follower is driven positively in both directions: follower 1 touches cam 1, follower 2 touches
+cam 2 in a second plane.  The constant-width and constant-diameter cams (:mod:`camfab.design.symmetric`) are
+the special case where both followers touch the same profile; they share :class:`DesmodromicGeometry`.
 
 Conventions and derivation
 --------------------------
-camfab's single convention applies (``design.md`` §3, :mod:`camfab.design.profile`):
-cam centre at the origin, follower 1 above the cam along +Y at cam angle 0,
-``rotation="cw"`` by default.  The Cardona & Clos matrix ``[S_θ] = R(−θ)`` of
-spec §7–§10 is camfab's ``rotation="ccw"`` (spec D5); the tests check the spec's
-formulas against the ``ccw`` cams.
+camfab's single convention applies (:mod:`camfab.design.mechanism`): cam centre at the origin, follower 1
+above the cam along +Y at cam angle 0, ``rotation="cw"`` by default.  (The Cardona & Clos rotation matrix
+``[S_θ] = R(−θ)`` of the source's conjugate-cam chapter is camfab's ``rotation="ccw"``; the tests check the
+source's formulas against the ``ccw`` cams.)
 
-Follower 2 sits on the far side of the line through the cam centre
-perpendicular to follower 1 (translating: below the cam centre on the same
-axis x = ε; oscillating: arm 2 on the same pivot, β clockwise-*before* arm 1,
-i.e. below the line of centres).  Mirroring the mechanism in that line (y → −y)
-turns follower 2 into an ordinary single follower above the cam on a cam that
-turns the *other* way; hence (M = diag(1, −1) in the cam frame)::
+Follower 2 sits on the far side of the line through the cam centre perpendicular to follower 1 (translating:
+below the cam centre on the same axis x = ε; oscillating: arm 2 on the same pivot, β clockwise-*before*
+arm 1, i.e. below the line of centres).  Mirroring the mechanism in that line (y → −y) turns follower 2 into
+an ordinary single follower above the cam on a cam that turns the *other* way; hence (M = diag(1, −1) in the
+cam frame)::
 
     profile 2(φ) = M · profile(mirrored follower 2, sense −σ, law S₂)(φ)
 
-and the rigid follower gives the complementary law ``S₂(φ) = h − S₁(φ)``
-(h = max S₁), measured from cam 2's own base/prime circle: it starts with a
-descent (CAM-DAS Ejemplo7CRT/8DA).  Curvature and pressure angle are invariant
-under the mirror; normals and points are mirrored.  Second-cam geometry:
+and the rigid follower gives the complementary law ``S₂(φ) = h − S₁(φ)`` (h = max S₁), measured from cam 2's
+own base/prime circle: it starts with a descent (CAM-DAS Ejemplo7CRT/8DA).  Curvature and pressure angle are
+invariant under the mirror; normals and points are mirrored.  Second-cam geometry:
 
 * translating flat: ``R_b2 = d − R_b1 − h`` (d = face-to-face distance);
-* translating roller: roller centres at distance d on the axis x = ε,
-  ``a₂ = d − √(R_p1² − ε²) − h``, ``R_p2 = √(a₂² + ε²)``, ``R_b2 = R_p2 − R_r2``;
-* oscillating (β = angle at the pivot between arm/face 1 and arm/face 2):
-  mirrored arm angle ``ξ₂′ = β − ξ₁ = ξ₂₀′ + S₂`` with ``ξ₂₀′ = β − ξ₁₀ − h``;
-  flat ``R_b2 = f + m sin ξ₂₀′``, roller ``R_p2² = A² + m² − 2Am cos ξ₂₀′``
-  (spec D4: the roller case is derived here, the source formula is unusable).
+* translating roller: roller centres at distance d on the axis x = ε, ``a₂ = d − √(R_p1² − ε²) − h``,
+  ``R_p2 = √(a₂² + ε²)``, ``R_b2 = R_p2 − R_r2``;
+* oscillating (β = angle at the pivot between arm/face 1 and arm/face 2): mirrored arm angle
+  ``ξ₂′ = β − ξ₁ = ξ₂₀′ + S₂`` with ``ξ₂₀′ = β − ξ₁₀ − h``; flat ``R_b2 = f + m sin ξ₂₀′``, roller
+  ``R_p2² = A² + m² − 2Am cos ξ₂₀′`` (derived here by the law of cosines in the pivot triangle; the source's
+  formula for this case is unusable).
 
-The *minimum admissible follower distance* (oscillating: follower angle) is
-the value below which the second cam cannot be made: its base radius reaches 0
-(or the bore radius), its profile cusps/undercuts (flat ρ₂ ≤ 0, roller convex
-pitch radius ≤ R_r2), or the second follower cannot exist (a₂ ≤ 0, arm 2 not
-below the line of centres).  It is computed by root finding on that margin and
-enforced with a :class:`~camfab.errors.Problem` naming the field.
-
-Constant width (double flat yoke): ``width_mm`` is the distance between the
-parallel faces, exactly constant; lift ``h = W − 2R_b``.  Constant diameter
-(double roller, offset 0): the user gives CAM-DAS's width ``W = 2R_b + h``
-(contact-point distance at the dwells); the *exactly* constant distance is the
-roller-centre distance ``W + 2R_r = 2R_p + h`` (spec D9) — the contact-point
-distance varies where S′ ≠ 0.  Both use SHM rise over ``rise_deg``, dwell,
-SHM return over ``rise_deg``, dwell, so that ``S(θ) + S(θ + π) = h``.
+The *minimum admissible follower distance* (oscillating: follower angle) is the value below which the second
+cam cannot be made: its base radius reaches 0 (or the bore radius), its profile cusps/undercuts (flat ρ₂ ≤ 0,
+roller convex pitch radius ≤ R_r2), or the second follower cannot exist (a₂ ≤ 0, arm 2 not below the line of
+centres).  It is computed by root finding on that margin and enforced with a
+:class:`~camfab.errors.Problem` naming the field.
 """
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields, replace
-from typing import Any
+from dataclasses import dataclass, replace
+from typing import Any, ClassVar
 
 import numpy as np
 from scipy.optimize import brentq
 
-from ..errors import Problem, SpecError
-from .mechanisms import (Mechanism, OscillatingFlat, OscillatingRoller, TranslatingFlat, TranslatingRoller,
-                         _finite, _positive, _rotation)
-from .profile import (CamGeometry, Contact, OscillatingFlatContact, OscillatingRollerContact, ProfileSample,
-                      TranslatingFlatContact, TranslatingRollerContact, _contact, extremum)
-from .program import MotionProgram
+from ..errors import Problem
+from .faces import OscillatingFlat, OscillatingFlatContact, TranslatingFlat, TranslatingFlatContact
+from .kinds import CamKind, FollowerMotion, FollowerType
+from .mechanism import Mechanism, finite_fields, require_rotation
+from .profile import CamGeometry, Contact, MotionLike, ProfileSample
+from .rollers import OscillatingRoller, OscillatingRollerContact, TranslatingRoller, TranslatingRollerContact
+from .solvers import extremum
 
 __all__ = [
     "ConjugateTranslatingFlat", "ConjugateTranslatingRoller", "ConjugateOscillatingFlat", "ConjugateOscillatingRoller",
-    "ConstantWidthCam", "ConstantDiameterCam", "ComplementMotion", "SecondTranslatingFlatContact",
-    "SecondTranslatingRollerContact", "SecondOscillatingFlatContact", "SecondOscillatingRollerContact",
-    "DesmodromicGeometry", "desmodromic_geometry", "follower_limits", "minimum_follower_distance", "lift_of",
+    "ComplementMotion", "SecondTranslatingFlatContact", "SecondTranslatingRollerContact",
+    "SecondOscillatingFlatContact", "SecondOscillatingRollerContact", "DesmodromicGeometry", "FormClosed",
+    "follower_limits", "minimum_follower_distance", "lift_of",
 ]
 
 _K = math.pi / 180.0
 _MX = np.array([1.0, -1.0])
+
 
 
 # ---------------------------------------------------------------------------
@@ -154,13 +142,72 @@ class SecondOscillatingRollerContact(_Second, OscillatingRollerContact):
 
 
 # ---------------------------------------------------------------------------
-class _Desmodromic(Mechanism):
+class DesmodromicGeometry(CamGeometry):
+    """A :class:`CamGeometry` of a desmodromic cam with the double follower's checks.
+
+    Profiles: conjugate pairs have two (cam 1, cam 2, one cam frame);
+    constant-width/diameter cams have one, touched by follower 2 at φ + π.
+    """
+
+    @property
+    def second_program(self):
+        """Follower 2's law S₂ = h − S₁ of a conjugate pair (None for one profile)."""
+        return self.profiles[1].motion if len(self.profiles) > 1 else None
+
+    def _pair(self, phi) -> tuple[ProfileSample, ProfileSample]:
+        phi = np.atleast_1d(np.asarray(phi, dtype=float))
+        if len(self.profiles) == 1:
+            return self.evaluate(phi), self.evaluate(phi + math.pi)
+        return self.evaluate(phi, 0), self.evaluate(phi, 1)
+
+    def follower_distance(self, phi) -> np.ndarray:
+        """Distance kept by the translating double follower, measured on the geometry (mm):
+        face gap (distance between the tangents at both contacts) or roller-centre distance."""
+        a, b = self._pair(phi)
+        if a.pitch is not None:
+            return np.hypot(*(a.pitch - b.pitch).T)
+        return ((a.point - b.point) * a.normal).sum(axis=1)
+
+    def width(self, phi) -> np.ndarray:
+        """Constant-width cam: distance between the parallel tangents at φ and φ + π;
+        constant-diameter cam: roller-centre distance (pitch chord through the centre)."""
+        if len(self.profiles) != 1:
+            raise TypeError("width() applies to constant-width and constant-diameter cams")
+        return self.follower_distance(phi)
+
+    def contact_distance(self, phi) -> np.ndarray:
+        """Distance between the two contact points (mm; not constant for rollers where S′ ≠ 0)."""
+        a, b = self._pair(phi)
+        return np.hypot(*(a.point - b.point).T)
+
+    def follower_angle(self, phi) -> np.ndarray:
+        """Oscillating pairs: angle β (degrees) at the pivot between arm/face 1 and 2, from the geometry."""
+        a, b = self._pair(phi)
+        sx = self.profiles[0].sense * np.atleast_1d(np.asarray(phi, dtype=float))
+        if a.pitch is not None:  # arms: pivot → roller centres (pivot turned into the cam frame)
+            pv = self.mechanism.pivot_distance_mm * np.stack([np.cos(sx), np.sin(sx)], axis=1)
+            u, v, turn = a.pitch - pv, b.pitch - pv, 0.0
+        else:  # faces: their normals are π − β apart
+            u, v, turn = a.normal, b.normal, math.pi
+        ang = np.arctan2(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0], (u * v).sum(1))
+        return np.degrees(np.mod(turn + ang, 2 * math.pi))
+
+
+# ---------------------------------------------------------------------------
+class FormClosed(Mechanism):
+    """Base of the form-closed families (conjugate pairs, constant width/diameter): one rigid double
+    follower driven both ways, measured by :class:`DesmodromicGeometry`."""
+
+    geometry_class: ClassVar[type[CamGeometry]] = DesmodromicGeometry
+
+
+class _Desmodromic(FormClosed):
     """Base of the conjugate pairs.  Subclasses give ``first_mechanism()`` (follower 1
     as a single-follower mechanism), ``_span(h)`` (open interval of the free
     parameter q in which follower 2 exists) and ``_second(program, h, q)`` →
     (contact 2 or None, R_b2, existence margin > 0)."""
 
-    design_kind = "conjugate"
+    cam_kind: ClassVar[CamKind] = CamKind.CONJUGATE
     #: the free parameter bounded by the minimum follower distance (angle)
     _free_field = "follower_distance_mm"
 
@@ -189,14 +236,8 @@ class _Desmodromic(Mechanism):
         return self._free_field.rsplit("_", 1)[1]
 
     def _static(self, p: list[Problem]) -> bool:
-        _rotation(p, self.rotation)
-        for f in fields(self):
-            v = getattr(self, f.name)
-            if f.name.endswith(("_mm", "_deg")) and v is not None and (
-                    not isinstance(v, (int, float)) or not math.isfinite(v)):
-                unit = "mm" if f.name.endswith("_mm") else "degrees"
-                p.append(Problem(f"follower.{f.name}", v, f"must be a finite number ({unit})", f"give {f.name}"))
-        if p:
+        require_rotation(p, self.rotation)
+        if not finite_fields(self, p, ("_mm", "_deg")) or p:
             return False
         p += [q for q in self.first_mechanism().validate() if q.path != "cam.rotation"]
         return not p
@@ -205,9 +246,19 @@ class _Desmodromic(Mechanism):
         """Base radius R_b2 (mm) of the second cam for this follower distance/angle."""
         return self._second(program, lift_of(program), self._free())[1]
 
-    def contacts(self, program) -> list[Contact]:
-        """[contact 1, contact 2] (no validation)."""
-        return [_contact(self.first_mechanism(), program), self._second(program, lift_of(program), self._free())[0]]
+    def first_mechanism(self) -> Mechanism:  # pragma: no cover - abstract
+        """Follower 1 as a single-follower mechanism."""
+        raise NotImplementedError
+
+    def _span(self, h: float) -> tuple[float, float]:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def _second(self, program, h: float, q: float) -> tuple[Any, float, float]:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def contacts(self, program: MotionLike) -> tuple[Contact, ...]:
+        """(contact 1, contact 2) (no validation)."""
+        return (self.first_mechanism().contacts(program)[0], self._second(program, lift_of(program), self._free())[0])
 
     def validate_motion(self, program, *, bore_mm: float | None = None) -> list[Problem]:
         """Follower 1's limits plus the enforced follower distance (angle) window."""
@@ -322,7 +373,7 @@ def _second_roller_ok(mech, p: list[Problem]) -> bool:
 # ---------------------------------------------------------------------------
 @dataclass(frozen=True)
 class ConjugateTranslatingFlat(_Desmodromic):
-    """Conjugate pair, double translating flat follower (spec §7).
+    """Conjugate pair, double translating flat follower.
 
     Parameters
     ----------
@@ -338,9 +389,15 @@ class ConjugateTranslatingFlat(_Desmodromic):
     base_radius_mm: float
     follower_distance_mm: float
     rotation: str = "cw"
-    follower = "flat"
+    follower: ClassVar[FollowerType] = FollowerType.FLAT
+    required: ClassVar[tuple[str, ...]] = ("base_radius_mm", "follower_distance_mm")
 
-    def first_mechanism(self):
+    @classmethod
+    def from_spec(cls, spec: Any) -> ConjugateTranslatingFlat:
+        f = spec.follower
+        return cls(f.base_radius_mm, f.follower_distance_mm, spec.cam.rotation)
+
+    def first_mechanism(self) -> Mechanism:
         return TranslatingFlat(self.base_radius_mm, 0.0, self.rotation)
 
     def _span(self, h):
@@ -353,7 +410,7 @@ class ConjugateTranslatingFlat(_Desmodromic):
 
 @dataclass(frozen=True)
 class ConjugateTranslatingRoller(_Desmodromic):
-    """Conjugate pair, double translating roller follower (spec §8, §2.2).
+    """Conjugate pair, double translating roller follower.
 
     Parameters
     ----------
@@ -361,7 +418,7 @@ class ConjugateTranslatingRoller(_Desmodromic):
         R_b1 (> 0) and R_r1 (>= 0) of follower 1 (above the cam).
     follower_distance_mm : float
         Constant roller-centre distance d (mm; CAM-DAS "distance between
-        followers", spec §2.2 ``d_c = 2R_p + S_max`` for equal cams).
+        followers", ``d_c = 2R_p + S_max`` for equal cams).
     second_roller_radius_mm : float, optional
         R_r2 (default R_r1).
     offset_mm : float
@@ -375,8 +432,16 @@ class ConjugateTranslatingRoller(_Desmodromic):
     second_roller_radius_mm: float | None = None
     offset_mm: float = 0.0
     rotation: str = "cw"
+    required: ClassVar[tuple[str, ...]] = ("base_radius_mm", "roller_radius_mm", "follower_distance_mm")
+    optional: ClassVar[tuple[str, ...]] = ("second_roller_radius_mm", "offset_mm")
 
-    def first_mechanism(self):
+    @classmethod
+    def from_spec(cls, spec: Any) -> ConjugateTranslatingRoller:
+        f = spec.follower
+        return cls(f.base_radius_mm, f.roller_radius_mm or 0.0, f.follower_distance_mm, f.second_roller_radius_mm,
+                   f.offset_mm or 0.0, spec.cam.rotation)
+
+    def first_mechanism(self) -> Mechanism:
         return TranslatingRoller(self.base_radius_mm, self.roller_radius_mm, self.offset_mm, self.rotation)
 
     def _d0(self):
@@ -399,7 +464,7 @@ class ConjugateTranslatingRoller(_Desmodromic):
 
 @dataclass(frozen=True)
 class ConjugateOscillatingFlat(_Desmodromic):
-    """Conjugate pair, double oscillating flat follower (spec §9).
+    """Conjugate pair, double oscillating flat follower.
 
     Parameters
     ----------
@@ -420,11 +485,19 @@ class ConjugateOscillatingFlat(_Desmodromic):
     face_offset_mm: float
     follower_angle_deg: float
     rotation: str = "cw"
-    follower = "flat"
-    motion = "oscillating"
+    follower: ClassVar[FollowerType] = FollowerType.FLAT
+    motion: ClassVar[FollowerMotion] = FollowerMotion.OSCILLATING
+    required: ClassVar[tuple[str, ...]] = ("base_radius_mm", "pivot_distance_mm", "follower_angle_deg")
+    optional: ClassVar[tuple[str, ...]] = ("face_offset_mm",)
     _free_field = "follower_angle_deg"
 
-    def first_mechanism(self):
+    @classmethod
+    def from_spec(cls, spec: Any) -> ConjugateOscillatingFlat:
+        f = spec.follower
+        return cls(f.base_radius_mm, f.pivot_distance_mm, f.face_offset_mm or 0.0, f.follower_angle_deg,
+                   spec.cam.rotation)
+
+    def first_mechanism(self) -> Mechanism:
         return OscillatingFlat(self.base_radius_mm, self.pivot_distance_mm, self.face_offset_mm, self.rotation)
 
     def _span(self, h):
@@ -441,7 +514,7 @@ class ConjugateOscillatingFlat(_Desmodromic):
 
 @dataclass(frozen=True)
 class ConjugateOscillatingRoller(_Desmodromic):
-    """Conjugate pair, double oscillating roller follower (spec §10, derived: D4).
+    """Conjugate pair, double oscillating roller follower (the second cam derived in the module notes).
 
     Two arms of length A on one pivot at a fixed angle β; arm 2 below the line
     of centres; cam 2 is the envelope of roller 2.
@@ -451,7 +524,7 @@ class ConjugateOscillatingRoller(_Desmodromic):
     base_radius_mm, roller_radius_mm : float
         R_b1 (> 0), R_r1 (>= 0) of follower 1.
     pivot_distance_mm, arm_length_mm : float
-        m and A, as :class:`~camfab.design.mechanisms.OscillatingRoller`.
+        m and A, as :class:`~camfab.design.rollers.OscillatingRoller`.
     follower_angle_deg : float
         β (degrees) between the two arms; bounded by :func:`follower_limits`.
     second_roller_radius_mm : float, optional
@@ -466,10 +539,19 @@ class ConjugateOscillatingRoller(_Desmodromic):
     follower_angle_deg: float
     second_roller_radius_mm: float | None = None
     rotation: str = "cw"
-    motion = "oscillating"
+    motion: ClassVar[FollowerMotion] = FollowerMotion.OSCILLATING
+    required: ClassVar[tuple[str, ...]] = ("base_radius_mm", "roller_radius_mm", "pivot_distance_mm",
+                                           "arm_length_mm", "follower_angle_deg")
+    optional: ClassVar[tuple[str, ...]] = ("second_roller_radius_mm",)
     _free_field = "follower_angle_deg"
 
-    def first_mechanism(self):
+    @classmethod
+    def from_spec(cls, spec: Any) -> ConjugateOscillatingRoller:
+        f = spec.follower
+        return cls(f.base_radius_mm, f.roller_radius_mm or 0.0, f.pivot_distance_mm, f.arm_length_mm,
+                   f.follower_angle_deg, f.second_roller_radius_mm, spec.cam.rotation)
+
+    def first_mechanism(self) -> Mechanism:
         return OscillatingRoller(self.base_radius_mm, self.roller_radius_mm, self.pivot_distance_mm,
                                  self.arm_length_mm, self.rotation)
 
@@ -494,217 +576,3 @@ class ConjugateOscillatingRoller(_Desmodromic):
         c = SecondOscillatingRollerContact(ComplementMotion(program, h), m, a, xi, self.second_roller_mm,
                                            sense=self.sense) if exist > 0 else None
         return c, rp2 - self.second_roller_mm, exist
-
-
-# ---------------------------------------------------------------------------
-class _Symmetric(Mechanism):
-    """Constant-width / constant-diameter cam: one profile, S(θ) + S(θ + π) = h."""
-
-    def validate(self) -> list[Problem]:
-        p: list[Problem] = []
-        _rotation(p, self.rotation)
-        if not _finite(self, p):
-            return p
-        _positive(p, "base_radius_mm", self.base_radius_mm)
-        rb2 = 2 * self.base_radius_mm
-        if self.width_mm <= rb2:
-            p.append(Problem("follower.width_mm", self.width_mm,
-                             f"the width must exceed the base diameter 2·R_b = {rb2:.6g} mm (lift = width − 2·R_b)",
-                             f"use width_mm > {rb2:.6g}, or a smaller base circle"))
-        r = self.rise_deg
-        if not isinstance(r, (int, float)) or not 0.0 < r <= 180.0:
-            p.append(Problem("follower.rise_deg", r, "the rise (and return) must span more than 0° and at most 180°",
-                             "use rise_deg in (0, 180]; 120 is the CAM-DAS law"))
-        if not p and getattr(self, "roller_radius_mm", 0.0) < 0:
-            p.append(Problem("follower.roller_radius_mm", self.roller_radius_mm, "must be >= 0 mm",
-                             "give roller_radius_mm >= 0"))
-        if not p and getattr(self, "offset_mm", 0.0) != 0:
-            p.append(Problem("follower.offset_mm", self.offset_mm,
-                             "a constant-diameter cam needs offset 0: with an offset the lower roller would need a "
-                             "second, different profile", "set offset_mm = 0, or use ConjugateTranslatingRoller"))
-        return p
-
-    @property
-    def lift_mm(self) -> float:
-        """h = width − 2·R_b (mm)."""
-        return self.width_mm - 2 * self.base_radius_mm
-
-    def program(self) -> MotionProgram:
-        """The fixed law: SHM rise h over rise_deg, dwell, SHM return over rise_deg, dwell."""
-        h, r = self.lift_mm, float(self.rise_deg)
-        dwell = [("dwell", 0.0, 180.0 - r)] if r < 180.0 else []
-        return MotionProgram.from_segments([("simple_harmonic", h, r), *dwell, ("simple_harmonic", -h, r), *dwell])
-
-    def validate_motion(self, program, **_: Any) -> list[Problem]:
-        """Enforce S(θ) + S(θ + π) = h with min S = 0 and h = width − 2·R_b (to 1e-9 mm)."""
-        p = super().validate_motion(program)
-        if p:
-            return p
-        x = np.linspace(0.0, math.pi, 20001)
-        s = program.evaluate(np.r_[x, x + math.pi], (0,))[0]
-        tol = 1e-9 * max(1.0, self.lift_mm)
-        err = np.abs(s[: x.size] + s[x.size:] - self.lift_mm).max()
-        if err > tol or abs(s.min()) > tol:
-            p.append(Problem("motion", round(float(err), 12),
-                             f"a constant-width/diameter cam needs S(θ) + S(θ+180°) = h = width − 2·R_b = "
-                             f"{self.lift_mm:.6g} mm with min S = 0",
-                             "use the built-in law (omit the program) or make the return the mirror of the rise"))
-        return p
-
-
-@dataclass(frozen=True)
-class ConstantWidthCam(_Symmetric):
-    """Constant-width cam with a double translating flat follower (spec §11).
-
-    Parameters
-    ----------
-    base_radius_mm : float
-        R_b (> 0).
-    width_mm : float
-        Distance W between the two parallel faces (> 2·R_b), exactly constant:
-        the cam's width between parallel tangents.  Lift h = W − 2·R_b.
-    rise_deg : float
-        SHM rise (and return) span in degrees, in (0, 180] (dwells of 180 − rise).
-    rotation : {"cw", "ccw"}
-    """
-
-    base_radius_mm: float
-    width_mm: float
-    rise_deg: float = 120.0
-    rotation: str = "cw"
-    follower = "flat"
-    design_kind = "constant_width"
-
-    @property
-    def constant_distance_mm(self) -> float:
-        """The exactly constant distance: face gap W (mm)."""
-        return self.width_mm
-
-    def contacts(self, program) -> list[Contact]:
-        return [TranslatingFlatContact(program, self.base_radius_mm, 0.0, self.sense)]
-
-
-@dataclass(frozen=True)
-class ConstantDiameterCam(_Symmetric):
-    """Constant-diameter cam with a double translating roller follower (spec §12).
-
-    Parameters
-    ----------
-    base_radius_mm, roller_radius_mm : float
-        R_b (> 0) and R_r (>= 0).
-    width_mm : float
-        CAM-DAS "constant width" W = 2·R_b + h (> 2·R_b): the contact-point
-        distance at the dwells.  The exactly constant distance is the
-        roller-centre distance ``W + 2·R_r`` (:attr:`constant_distance_mm`).
-    rise_deg : float
-        As :class:`ConstantWidthCam`.
-    offset_mm : float
-        Must be 0: with an offset the lower roller meets a different curve.
-    rotation : {"cw", "ccw"}
-    """
-
-    base_radius_mm: float
-    roller_radius_mm: float
-    width_mm: float
-    rise_deg: float = 120.0
-    offset_mm: float = 0.0
-    rotation: str = "cw"
-    design_kind = "constant_diameter"
-
-    @property
-    def constant_distance_mm(self) -> float:
-        """Roller-centre distance 2·R_p + h = W + 2·R_r (mm), exactly constant."""
-        return self.width_mm + 2 * self.roller_radius_mm
-
-    def contacts(self, program) -> list[Contact]:
-        rp = self.base_radius_mm + self.roller_radius_mm
-        return [TranslatingRollerContact(program, rp, self.roller_radius_mm, 0.0, self.sense)]
-
-
-# ---------------------------------------------------------------------------
-class DesmodromicGeometry(CamGeometry):
-    """A :class:`CamGeometry` of a desmodromic cam with the double follower's checks.
-
-    Profiles: conjugate pairs have two (cam 1, cam 2, one cam frame);
-    constant-width/diameter cams have one, touched by follower 2 at φ + π.
-    """
-
-    @property
-    def second_program(self):
-        """Follower 2's law S₂ = h − S₁ of a conjugate pair (None for one profile)."""
-        return self.profiles[1].motion if len(self.profiles) > 1 else None
-
-    def _pair(self, phi) -> tuple[ProfileSample, ProfileSample]:
-        phi = np.atleast_1d(np.asarray(phi, dtype=float))
-        if len(self.profiles) == 1:
-            return self.evaluate(phi), self.evaluate(phi + math.pi)
-        return self.evaluate(phi, 0), self.evaluate(phi, 1)
-
-    def follower_distance(self, phi) -> np.ndarray:
-        """Distance kept by the translating double follower, measured on the geometry (mm):
-        face gap (distance between the tangents at both contacts) or roller-centre distance."""
-        a, b = self._pair(phi)
-        if a.pitch is not None:
-            return np.hypot(*(a.pitch - b.pitch).T)
-        return ((a.point - b.point) * a.normal).sum(axis=1)
-
-    def width(self, phi) -> np.ndarray:
-        """Constant-width cam: distance between the parallel tangents at φ and φ + π;
-        constant-diameter cam: roller-centre distance (pitch chord through the centre)."""
-        if not isinstance(self.mechanism, _Symmetric):
-            raise TypeError("width() applies to constant-width and constant-diameter cams")
-        return self.follower_distance(phi)
-
-    def contact_distance(self, phi) -> np.ndarray:
-        """Distance between the two contact points (mm; not constant for rollers where S′ ≠ 0)."""
-        a, b = self._pair(phi)
-        return np.hypot(*(a.point - b.point).T)
-
-    def follower_angle(self, phi) -> np.ndarray:
-        """Oscillating pairs: angle β (degrees) at the pivot between arm/face 1 and 2, from the geometry."""
-        a, b = self._pair(phi)
-        sx = self.profiles[0].sense * np.atleast_1d(np.asarray(phi, dtype=float))
-        if a.pitch is not None:  # arms: pivot → roller centres (pivot turned into the cam frame)
-            pv = self.mechanism.pivot_distance_mm * np.stack([np.cos(sx), np.sin(sx)], axis=1)
-            u, v, turn = a.pitch - pv, b.pitch - pv, 0.0
-        else:  # faces: their normals are π − β apart
-            u, v, turn = a.normal, b.normal, math.pi
-        ang = np.arctan2(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0], (u * v).sum(1))
-        return np.degrees(np.mod(turn + ang, 2 * math.pi))
-
-
-def desmodromic_geometry(mechanism, program=None, *, bore_mm: float | None = None) -> DesmodromicGeometry:
-    """Validate and build a desmodromic cam.
-
-    Parameters
-    ----------
-    mechanism : one of the classes of this module
-    program : MotionProgram, optional
-        Follower 1's law (mm, or degrees for oscillating pairs).  Constant
-        width/diameter cams build their fixed law when omitted; a given one
-        must satisfy S(θ) + S(θ+π) = width − 2·R_b.
-    bore_mm : float, optional
-        Shaft bore diameter: the second cam's base radius must exceed bore/2.
-
-    Returns
-    -------
-    DesmodromicGeometry
-
-    Raises
-    ------
-    SpecError
-        Every problem found (field paths ``follower.*``, ``cam.rotation``, ``motion``).
-    """
-    if not isinstance(mechanism, (_Desmodromic, _Symmetric)):
-        raise TypeError(f"unsupported mechanism {type(mechanism).__name__}")
-    problems = mechanism.validate()
-    if not problems:
-        if program is None:
-            if not isinstance(mechanism, _Symmetric):
-                raise SpecError(Problem("motion", None, "a conjugate pair needs follower 1's motion program",
-                                        "pass a MotionProgram"))
-            program = mechanism.program()
-        problems = mechanism.validate_motion(program, bore_mm=bore_mm)
-    if problems:
-        raise SpecError(problems)
-    return DesmodromicGeometry.from_contacts(mechanism.contacts(program), mechanism, program)
