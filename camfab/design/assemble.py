@@ -9,9 +9,9 @@ import dataclasses
 import math
 
 from ..errors import SpecError
-from .checks import Report, check
-from .dynamics import ContactDynamics, DynamicsReport, Loads, PairDynamics, analyse_dynamics, pair_of
-from .motion_report import Finding
+from ..results import CheckReport, DynamicsReport, Finding
+from .checks import check
+from .dynamics import ContactDynamics, Loads, PairDynamics, analyse_dynamics, pair_of
 from .mechanisms import OscillatingFlat, OscillatingRoller, TranslatingCamRoller, TranslatingFlat, TranslatingRoller
 from .profile import CamGeometry
 from .desmodromic import (ConjugateOscillatingFlat, ConjugateOscillatingRoller, ConjugateTranslatingFlat,
@@ -72,9 +72,9 @@ def geometry_from_spec(spec: DesignSpec) -> CamGeometry:
         raise SpecError(exc.problems, spec.source) from None
 
 
-def check_design(spec: DesignSpec, *, tool_radius_mm: float | None = None) -> Report:
-    """Geometry + checks + verdict for a design (the ``camfab check`` report), knot-table
-    consistency warnings included."""
+def check_design(spec: DesignSpec, *, tool_radius_mm: float | None = None) -> CheckReport:
+    """Geometry + checks + verdict for a design (the ``camfab check`` report), the follower
+    dynamics and the knot-table consistency warnings included."""
     geom = geometry_from_spec(spec)
     report = check(geom, pressure_angle_limit_deg=spec.pressure_angle_limit_deg,
                    allow_acceleration_jump=spec.cam.kind in ("constant_width", "constant_diameter"),
@@ -83,10 +83,10 @@ def check_design(spec: DesignSpec, *, tool_radius_mm: float | None = None) -> Re
     extra = knot_findings(spec)
     if spec.dynamics is not None:
         dyn = dynamics_of(spec, geom)
-        report = dataclasses.replace(report, summary={**report.summary, "dynamics": dyn.summary})
+        report = dataclasses.replace(report, dynamics=dyn.summary)
         extra = list(dyn.findings) + extra
     if extra:
-        report = dataclasses.replace(report, findings=tuple(report.findings) + tuple(extra))
+        report = dataclasses.replace(report, findings=report.findings + tuple(extra))
     return report
 
 
@@ -133,5 +133,4 @@ def knot_findings(spec: DesignSpec) -> list[Finding]:
     from .knots import load_motion_table
 
     base = Path(spec.base_dir) if spec.base_dir else None
-    return [Finding(w.code, "warning", w.from_deg, w.to_deg, w.implied_peak, w.knot_max, w.message)
-            for w in load_motion_table(spec.motion_table, base_dir=base).warnings()]
+    return load_motion_table(spec.motion_table, base_dir=base).warnings()
