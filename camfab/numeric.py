@@ -12,9 +12,10 @@ problem's trial points depend only on its batch: a search gives the same result 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Callable, NamedTuple, Sequence
+from typing import NamedTuple
 
 import numpy as np
 
@@ -89,7 +90,7 @@ def _grid(key: bytes, step: float) -> Grid:
     edges = np.frombuffer(key, dtype=float)
     eps = 1e-11 * max(edges[-1] - edges[0], 1.0)
     parts, lo, hi = [], [], []
-    for a, b in zip(edges[:-1], edges[1:]):
+    for a, b in zip(edges[:-1], edges[1:], strict=True):
         if b - a > 4 * eps:
             parts.append(np.linspace(a + eps, b - eps, max(8, int(math.ceil((b - a) / step))) + 1))
             lo.append(a + eps)
@@ -179,8 +180,8 @@ def _neighbours(P: np.ndarray, F: np.ndarray, j: np.ndarray):
     sample on each side (position, value), or the chosen sample itself where there is none."""
     r = np.arange(len(P))
     xj, fj = P[r, j], F[r, j]
-    li = np.argmax(np.where(P < xj[:, None], P, -np.inf), axis=1)  # positions are finite
-    ri = np.argmin(np.where(P > xj[:, None], P, np.inf), axis=1)
+    li = np.argmax(np.where(xj[:, None] > P, P, -np.inf), axis=1)  # positions are finite
+    ri = np.argmin(np.where(xj[:, None] < P, P, np.inf), axis=1)
     pl, pr = P[r, li], P[r, ri]
     hl, hr = pl < xj, pr > xj
     return (np.where(hl, pl, xj), np.where(hl, F[r, li], fj), xj, fj,
@@ -238,7 +239,7 @@ def _solve(f: Function, mins: _Minima | None = None, roots: _Roots | None = None
                 u = A - FA * (B - A) / (FB - FA)
                 u = np.where(np.isfinite(u), u, 0.5 * (A + B))
                 parts.append((u, A, B, np.full(ract.size, _XTOL), base + roots.batch[ract], roots.row[ract]))  # type: ignore
-        u, a, b, tol, batch, row = (np.concatenate(t) for t in zip(*parts))
+        u, a, b, tol, batch, row = (np.concatenate(t) for t in zip(*parts, strict=True))
         pts = _trials(u, a, b, tol, batch)
         V = np.asarray(f(pts.ravel()), dtype=float).reshape(-1, pts.size)
         Y = V[row[:, None], np.arange(pts.size).reshape(pts.shape)]
@@ -264,8 +265,7 @@ def _candidates(grid: Grid, v: np.ndarray) -> np.ndarray:
     """Indices of the :data:`_KEEP` smallest local minima of v (NaN-free) within the intervals
     (stable by value; the first and last sample of an interval compare one-sidedly)."""
     le_prev, le_next = np.empty(v.size, dtype=bool), np.empty(v.size, dtype=bool)
-    np.less_equal(v[1:], v[:-1], out=le_prev[1:])
-    np.less_equal(v[:-1], v[1:], out=le_next[:-1])
+    np.less_equal(v[1:], v[:-1], out=le_prev[1:]), np.less_equal(v[:-1], v[1:], out=le_next[:-1])
     le_prev[grid.starts] = True  # the first sample of an interval (and of the grid)
     le_next[grid.starts[1:] - 1] = True  # the last one
     le_next[-1] = True
@@ -277,7 +277,7 @@ def _prepare(searches: Sequence[_Search], dense: Sequence[np.ndarray | None], ba
     """The candidates of every search (``dense[i]``: its row of f at its grid, None for an empty grid)
     and their refinement brackets, search i in batch ``batch0 + i``: ``(plans, minima tuples)``."""
     plans, parts, off = [], [], 0
-    for i, (s, y) in enumerate(zip(searches, dense)):
+    for i, (s, y) in enumerate(zip(searches, dense, strict=True)):
         if not s.grid.x.size:
             plans.append(None)
             continue
@@ -301,7 +301,7 @@ def _finish(searches: Sequence[_Search], plans: list, mins: _Minima | None, offs
     ``mins`` on).  Equal extrema (to rounding, e.g. repeated lobes) resolve to the smallest
     parameter, not to whichever rounding favoured."""
     out = []
-    for s, plan in zip(searches, plans):
+    for s, plan in zip(searches, plans, strict=True):
         if plan is None:
             out.append(Optimum(0.0, float(s.sign * math.inf)))
             continue
@@ -348,7 +348,7 @@ def _sign_pairs(x: np.ndarray, v: np.ndarray, starts: np.ndarray, batch: int, ro
     inner[starts[1:] - 1] = False
     q = np.flatnonzero(((v[:-1] > 0) != (v[1:] > 0)) & inner)
     if known:
-        q = q[[(a, b) not in known for a, b in zip(x[q].tolist(), x[q + 1].tolist())]]
+        q = q[[(a, b) not in known for a, b in zip(x[q].tolist(), x[q + 1].tolist(), strict=True)]]
     return x[q], v[q], x[q + 1], v[q + 1], np.full(q.size, batch), np.full(q.size, row)
 
 
@@ -372,7 +372,8 @@ def _refine_roots(f: Function, parts: list[tuple], mins: _Minima | None, found: 
     if mins is not None or roots is not None:
         _solve(f, mins, roots)
     if roots is not None:
-        for a, b, j, x in zip(roots.a0.tolist(), roots.b0.tolist(), roots.batch.tolist(), roots.best().tolist()):
+        for a, b, j, x in zip(roots.a0.tolist(), roots.b0.tolist(), roots.batch.tolist(), roots.best().tolist(),
+                               strict=True):
             found[j][(a, b)] = x
 
 
@@ -452,7 +453,7 @@ def _worst_values(f: Function, step: float, raw: list, rows: Sequence[int], edge
     (a wrapping range in its two pieces, sampled at the parent's spacing: one call of f for all)."""
     tol = 1e-9 * max(edges[-1] - edges[0], 1.0)
     spans, searches = [], []
-    for r, row in zip(raw, rows):
+    for r, row in zip(raw, rows, strict=True):
         spans.append([])
         for lo, hi, subs in _merged_ranges(r, edges, closed, tol):
             spans[-1].append((lo, hi, len(searches), len(subs)))
@@ -460,7 +461,8 @@ def _worst_values(f: Function, step: float, raw: list, rows: Sequence[int], edge
     grids = list({id(s.grid): s.grid for s in searches if s.grid.x.size}.values())
     xs = np.concatenate([g.x for g in grids]) if grids else np.empty(0)
     V = np.asarray(f(xs), dtype=float).reshape(-1, xs.size) if grids else None
-    cols = dict(zip([id(g) for g in grids], np.split(np.arange(xs.size), np.cumsum([g.x.size for g in grids])[:-1])))
+    offs = np.cumsum([0] + [g.x.size for g in grids])
+    cols = {id(g): np.arange(o, o + g.x.size) for g, o in zip(grids, offs[:-1], strict=True)}
     plans, parts = _prepare(searches, [V[s.row, cols[id(s.grid)]] if s.grid.x.size else None  # type: ignore
                                        for s in searches])
     mins = _Minima(parts) if parts else None
@@ -524,8 +526,8 @@ def extrema(f: Function, edges, maximize: Sequence[bool], *, rows: Sequence[int]
             values: np.ndarray | None = None, step: float | None = None) -> list[Optimum]:
     """Global extrema of rows of ``f`` between the same breakpoints, searched together (:func:`search`):
     search i finds the largest (``maximize[i]``) or smallest value of row ``rows[i]`` (default i)."""
-    rows = range(len(maximize)) if rows is None else rows
-    return search(f, edges, extrema=list(zip(rows, maximize)), values=values, step=step)[0]
+    pairs = list(zip(range(len(maximize)) if rows is None else rows, maximize, strict=True))
+    return search(f, edges, extrema=pairs, values=values, step=step)[0]
 
 
 def extremum(f: Function, edges, *, maximize: bool = False, step: float | None = None,

@@ -28,6 +28,7 @@ from typing import Callable, Iterable
 from . import __version__
 from .io import atomic_write
 from .jobs import JobRequest
+from .results import Verdict
 
 __all__ = ["discover", "input_key", "package", "exit_status", "MANIFEST", "INDEX"]
 
@@ -113,7 +114,7 @@ def _build(args: tuple) -> dict:
         folder = Path(out) / _folder_name(spec.name)
         req = request_from_outputs(spec, **overrides)
         res = run_design(spec, folder, req)
-        entry.update(status="unacceptable" if res.verdict == "unacceptable" else "ok", verdict=res.verdict,
+        entry.update(status="unacceptable" if res.verdict == Verdict.UNACCEPTABLE else "ok", verdict=str(res.verdict),
                      tolerance_mm=res.tol, withheld=res.withheld, timings=res.timings,
                      folder=str(folder.relative_to(out)),
                      files=[_file_entry(p, Path(out), res.deviations.get(n)) for n, p in sorted(res.files.items())])

@@ -8,9 +8,10 @@ JSON keys say ``_deg`` either way).
 """
 from __future__ import annotations
 
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from enum import StrEnum
-from typing import Any, Iterable, Iterator
+from typing import Any
 
 import numpy as np
 

@@ -11,11 +11,18 @@ import math
 from ..errors import SpecError
 from ..results import CheckReport, DynamicsReport, Finding
 from .checks import check
+from .desmodromic import (
+    ConjugateOscillatingFlat,
+    ConjugateOscillatingRoller,
+    ConjugateTranslatingFlat,
+    ConjugateTranslatingRoller,
+    ConstantDiameterCam,
+    ConstantWidthCam,
+    desmodromic_geometry,
+)
 from .dynamics import ContactDynamics, Loads, PairDynamics, analyse_dynamics, pair_of
 from .mechanisms import OscillatingFlat, OscillatingRoller, TranslatingCamRoller, TranslatingFlat, TranslatingRoller
 from .profile import CamGeometry
-from .desmodromic import (ConjugateOscillatingFlat, ConjugateOscillatingRoller, ConjugateTranslatingFlat,
-                          ConjugateTranslatingRoller, ConstantDiameterCam, ConstantWidthCam, desmodromic_geometry)
 from .spec import DesignSpec, DynamicsSpec
 
 DESMODROMIC = (ConjugateTranslatingFlat, ConjugateTranslatingRoller, ConjugateOscillatingFlat,

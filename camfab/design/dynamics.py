@@ -40,14 +40,23 @@ angle; D does not depend on the speed).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 
 from .. import numeric
-from ..results import DynamicsReport, DynamicsSummary, Extreme, Finding, IssueCode, JumpSpeed, Maximum, Preload, \
-    Severity
+from ..results import (
+    DynamicsReport,
+    DynamicsSummary,
+    Extreme,
+    Finding,
+    IssueCode,
+    JumpSpeed,
+    Maximum,
+    Preload,
+    Severity,
+)
 from ..units import DEG, RPM
 from .desmodromic import DesmodromicGeometry
 from .profile import CamGeometry, Contact
@@ -322,7 +331,7 @@ def _searches(dyn: ContactDynamics | PairDynamics, form_closed: bool, fs: float,
     with np.errstate(invalid="ignore"):  # the per-angle jump speed is +inf where N never drops
         found, ranges = numeric.search(rows, edges, extrema=[(names.index(n), mx) for n, mx in spec],
                                        ranges=range(len(names), len(names) + len(picks)), closed=closed)
-    return dict(zip(spec, found)), ranges
+    return dict(zip(spec, found, strict=True)), ranges
 
 
 def analyse_dynamics(geometry: CamGeometry, loads: Loads, speed: float, *, preload_unit: str = "N",
@@ -393,7 +402,7 @@ def _reversals(first, second, c) -> list[Finding]:
     out: list[Finding] = []
     if len({k for _, _, k in runs}) < 2:
         return out
-    for (lo, hi, k), (lo2, _, k2) in zip(runs, runs[1:] + runs[:1]):
+    for (_, hi, k), (lo2, _, k2) in zip(runs, runs[1:] + runs[:1], strict=True):
         if k != k2:
             a, b = _user(c, hi), _user(c, lo2)
             where = f"at {a:.2f} {unit}" if abs(b - a) < 1e-9 else f"between {a:.2f} and {b:.2f} {unit}"

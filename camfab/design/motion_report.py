@@ -77,8 +77,8 @@ def _jump_finding(order: int, at: float, jumps, speed: float, unit: str, allow_a
     elif code is IssueCode.ACCELERATION_DISCONTINUITY and allow_acc:
         sev, effect = Severity.WARNING, "accepted for constant-width/diameter cams (low speed only)"
     else:
-        sev, effect = Severity.ERROR, "infinite " + (
-            "acceleration" if code is IssueCode.VELOCITY_DISCONTINUITY else "jerk") + " in theory: the cam is unacceptable"
+        word2 = "acceleration" if code is IssueCode.VELOCITY_DISCONTINUITY else "jerk"
+        sev, effect = Severity.ERROR, f"infinite {word2} in theory: the cam is unacceptable"
     units = {1: f"{unit}/s", 2: f"{unit}/s2", 3: f"{unit}/s3"}[k]
     msg = f"{word} jumps by {size:.6g} {units} at {at:.6g} ({where}); {effect}"
     return Finding(code, sev, at, at, size, 0.0, msg)

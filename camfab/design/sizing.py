@@ -20,13 +20,14 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
+
 from ..errors import SpecError
 from ..numeric import extremum, root
 from .checks import DEFAULT_PRESSURE_LIMIT_DEG
-from .mechanisms import (Mechanism, OscillatingFlat, OscillatingRoller, TranslatingFlat, TranslatingRoller)
+from .mechanisms import Mechanism, OscillatingFlat, OscillatingRoller, TranslatingFlat, TranslatingRoller
 from .profile import CamGeometry, MotionLike
 
 __all__ = [

@@ -3,11 +3,12 @@
 (:func:`camfab.design.motion_report.analyse_motion`)."""
 from __future__ import annotations
 
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 from ...results import Finding
-from ..profile import CamGeometry
 from ..motion_report import analyse_motion
+from ..profile import CamGeometry
 from .common import ContactSample, Limits, RuleResult
 
 __all__ = ["continuity_rule"]

@@ -4,7 +4,7 @@ No findings: the numbers go into the report (``base_radius_mm``, ``max_radius_mm
 """
 from __future__ import annotations
 
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 

@@ -29,7 +29,7 @@ def pressure_angle_rule(contact: Contact, limits: Limits, sample: ContactSample)
     over = [sign for sign, worst in ((1.0, dmax), (-1.0, dmin)) if sign * worst - lim > _PA_TOL_RAD]
     found = sample.ranges(*[lambda s, sign=sign: sign * s.pressure_angle - lim for sign in over]) if over else []
     out = []
-    for sign, ranges in zip(over, found):
+    for sign, ranges in zip(over, found, strict=True):
         for lo, hi, xw, gw in ranges:
             val = sign * math.degrees(gw + lim)
             out.append(Finding(IssueCode.PRESSURE_ANGLE_EXCEEDED, Severity.ERROR, sample.user(lo), sample.user(hi),
