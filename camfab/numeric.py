@@ -264,11 +264,9 @@ class _Search(NamedTuple):
 def _candidates(grid: Grid, v: np.ndarray) -> np.ndarray:
     """Indices of the :data:`_KEEP` smallest local minima of v (NaN-free) within the intervals
     (stable by value; the first and last sample of an interval compare one-sidedly)."""
-    le_prev, le_next = np.empty(v.size, dtype=bool), np.empty(v.size, dtype=bool)
-    np.less_equal(v[1:], v[:-1], out=le_prev[1:]), np.less_equal(v[:-1], v[1:], out=le_next[:-1])
-    le_prev[grid.starts] = True  # the first sample of an interval (and of the grid)
-    le_next[grid.starts[1:] - 1] = True  # the last one
-    le_next[-1] = True
+    le_prev, le_next = np.r_[True, v[1:] <= v[:-1]], np.r_[v[:-1] <= v[1:], True]
+    le_prev[grid.starts] = True  # the first sample of an interval compares with its successor only
+    le_next[grid.starts[1:] - 1] = True  # the last one with its predecessor only
     loc = np.flatnonzero(le_prev & le_next)
     return loc[np.argsort(v[loc], kind="stable")][:_KEEP]
 
@@ -276,7 +274,8 @@ def _candidates(grid: Grid, v: np.ndarray) -> np.ndarray:
 def _prepare(searches: Sequence[_Search], dense: Sequence[np.ndarray | None], batch0: int = 0):
     """The candidates of every search (``dense[i]``: its row of f at its grid, None for an empty grid)
     and their refinement brackets, search i in batch ``batch0 + i``: ``(plans, minima tuples)``."""
-    plans, parts, off = [], [], 0
+    plans: list[tuple | None] = []
+    parts, off = [], 0
     for i, (s, y) in enumerate(zip(searches, dense, strict=True)):
         if not s.grid.x.size:
             plans.append(None)
@@ -369,8 +368,7 @@ def _refine_roots(f: Function, parts: list[tuple], mins: _Minima | None, found: 
     """Refine root problems (batch = function index), with ``mins`` in the same rounds; file every
     root under its function and its sample pair (as given) in ``found``."""
     roots = _Roots(parts) if any(p[0].size for p in parts) else None
-    if mins is not None or roots is not None:
-        _solve(f, mins, roots)
+    _solve(f, mins, roots)
     if roots is not None:
         for a, b, j, x in zip(roots.a0.tolist(), roots.b0.tolist(), roots.batch.tolist(), roots.best().tolist(),
                                strict=True):
@@ -411,7 +409,7 @@ def _sign_ranges(grid: Grid, xa: np.ndarray, pos: np.ndarray, st: np.ndarray, ro
     inn[st[1:] - 1] = False
     chg = np.flatnonzero((pos[:-1] != pos[1:]) & inn)
     cut = np.r_[np.searchsorted(chg, st), chg.size]
-    raw: list[list[float]] = []
+    raw: list[list] = []
     for m in np.flatnonzero(np.logical_or.reduceat(pos, st)):
         start = grid.lo[m] if pos[st[m]] else None
         for q in chg[cut[m]:cut[m + 1]]:
@@ -452,7 +450,8 @@ def _worst_values(f: Function, step: float, raw: list, rows: Sequence[int], edge
     """The merged ranges of every function with the exact largest value of each, all searched together
     (a wrapping range in its two pieces, sampled at the parent's spacing: one call of f for all)."""
     tol = 1e-9 * max(edges[-1] - edges[0], 1.0)
-    spans, searches = [], []
+    spans: list[list[tuple]] = []
+    searches: list[_Search] = []
     for r, row in zip(raw, rows, strict=True):
         spans.append([])
         for lo, hi, subs in _merged_ranges(r, edges, closed, tol):
@@ -466,10 +465,9 @@ def _worst_values(f: Function, step: float, raw: list, rows: Sequence[int], edge
     plans, parts = _prepare(searches, [V[s.row, cols[id(s.grid)]] if s.grid.x.size else None  # type: ignore
                                        for s in searches])
     mins = _Minima(parts) if parts else None
-    if mins is not None:
-        _solve(f, mins)
+    _solve(f, mins)
     found = _finish(searches, plans, mins)
-    return [[Range(float(lo), float(hi), *map(float, max(found[q:q + m], key=lambda t: t[1])))
+    return [[Range(float(lo), float(hi), *max(found[q:q + m], key=lambda t: t.value))
              for lo, hi, q, m in mine] for mine in spans]
 
 

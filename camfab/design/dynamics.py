@@ -42,6 +42,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -367,14 +368,15 @@ def analyse_dynamics(geometry: CamGeometry, loads: Loads, speed: float, *, prelo
     work *= 1.0 if c.closed else 1e-3
     cycle_s = (2 * math.pi / speed) if c.closed else c.period / speed
     at_b, bmax = found[("bearing_force", True)]
-    common = dict(form_closed=form_closed, contact_force=extreme("contact_force"), bearing_force=Maximum(
-        float(bmax), _user(c, at_b)), drive=drive, torque=c.closed, work_per_cycle_j=work, mean_power_w=work / cycle_s)
+    common: dict[str, Any] = dict(
+        form_closed=form_closed, contact_force=extreme("contact_force"), drive=drive, torque=c.closed,
+        bearing_force=Maximum(float(bmax), _user(c, at_b)), work_per_cycle_j=work, mean_power_w=work / cycle_s)
     findings = _self_locking(ranges[0], c)
     if form_closed:
         rev = _reversals(ranges[1], ranges[2], c)
         summary = DynamicsSummary(safety_force_n=None, second_contact_force=extreme("contact_force_2"),
-                                  load_reversals=tuple((f.from_deg, f.to_deg) for f in rev), **common)
-        return DynamicsReport(summary, tuple(findings + rev))
+                                  load_reversals=tuple((a, b) for a, b, _ in rev), **common)
+        return DynamicsReport(summary, tuple(findings + [f for _, _, f in rev]))
     fs = loads.safety_force_n
     (at_pre, pre), (at_jump, r_jump) = found[("preload", True)], found[("jump", False)]
     summary = DynamicsSummary(safety_force_n=fs, preload_needed=Preload(float(pre), preload_unit, _user(c, at_pre)),
@@ -394,23 +396,23 @@ def _self_locking(ranges, c) -> list[Finding]:
             for lo, hi, _, gw in ranges]
 
 
-def _reversals(first, second, c) -> list[Finding]:
+def _reversals(first, second, c) -> list[tuple[float, float, Finding]]:
     """LOAD_REVERSAL (info) between consecutive stretches where different followers carry the load
-    (``first``/``second``: the ranges where G > 0 / G < 0)."""
+    (``first``/``second``: the ranges where G > 0 / G < 0): ``(from, to, finding)`` in order."""
     unit = c.axis.x_unit
     runs = sorted([(lo, hi, 1) for lo, hi, _, _ in first] + [(lo, hi, 2) for lo, hi, _, _ in second])
-    out: list[Finding] = []
+    out: list[tuple[float, float, Finding]] = []
     if len({k for _, _, k in runs}) < 2:
         return out
     for (_, hi, k), (lo2, _, k2) in zip(runs, runs[1:] + runs[:1], strict=True):
         if k != k2:
             a, b = _user(c, hi), _user(c, lo2)
             where = f"at {a:.2f} {unit}" if abs(b - a) < 1e-9 else f"between {a:.2f} and {b:.2f} {unit}"
-            out.append(Finding(
+            out.append((a, b, Finding(
                 IssueCode.LOAD_REVERSAL, Severity.INFO, a, b, None, None,
                 f"the load passes from follower {k} to follower {k2} {where}: across a clearance the follower "
-                "knocks there — keep the clearance small (or preload the pair)"))
-    return sorted(out, key=lambda f: f.from_deg)
+                "knocks there — keep the clearance small (or preload the pair)")))
+    return sorted(out, key=lambda t: t[0])
 
 
 def _force_closed(jump, low, c, fs, speed, pre, r_jump, preload_unit) -> list[Finding]:

@@ -28,7 +28,7 @@ CUSP_TOL_MM = 1e-7
 DEFAULT_PRESSURE_LIMIT_DEG = {"translating": 30.0, "oscillating": 35.0}
 
 #: a quantity of a profile sample: (n,) values from a :class:`ProfileSample` of n parameters
-Quantity = Callable[[ProfileSample], np.ndarray]
+Quantity = Callable[[ProfileSample], np.ndarray | None]
 
 
 @dataclass(frozen=True)

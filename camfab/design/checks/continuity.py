@@ -4,11 +4,12 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, cast
 
 from ...results import Finding
 from ..motion_report import analyse_motion
 from ..profile import CamGeometry
+from ..program import MotionProgram
 from .common import ContactSample, Limits, RuleResult
 
 __all__ = ["continuity_rule"]
@@ -25,7 +26,8 @@ def continuity_rule(geometry: CamGeometry, limits: Limits, samples: Sequence[Con
         if any(c.motion is m for m in seen) or not hasattr(c.motion, "junctions"):
             continue
         seen.append(c.motion)
-        rep = analyse_motion(c.motion, speed=limits.speed, lift_unit="deg" if c.oscillating else "mm",
+        lift_unit = "deg" if c.oscillating else "mm"
+        rep = analyse_motion(cast(MotionProgram, c.motion), speed=limits.speed, lift_unit=lift_unit,
                              allow_acceleration_jump=limits.allow_acceleration_jump)
         fields.setdefault("motion", rep)
         findings += rep.findings

@@ -18,6 +18,7 @@ def face_rule(contact: Contact, limits: Limits, sample: ContactSample) -> RuleRe
     margin = limits.face_margin_mm
     (xa, pmin), (xb, pmax) = sample.extremes("face_position")
     a, b = sample.user(xa), sample.user(xb)
+    out: tuple[Finding, ...]
     if not contact.oscillating:  # either side of the stem
         left, right = max(-pmin, 0.0) + margin, max(pmax, 0.0) + margin
         out = (Finding(IssueCode.FACE_LENGTH, Severity.INFO, a, a, left, None,
