@@ -216,3 +216,30 @@ def test_two_profiles_are_both_checked():
     r = check(two)
     assert r.by_code("UNDERCUT") and all(f.message.startswith("profile 2") for f in r.by_code("UNDERCUT"))
     assert len(r.by_code("JERK_DISCONTINUITY")) == len(check(a).by_code("JERK_DISCONTINUITY"))
+
+
+def test_rules_run_in_registry_order_and_a_new_rule_is_one_entry(monkeypatch):
+    import camfab.design.checks as checks_mod
+    from camfab.design.checks import RULES, Rule, RuleResult, Scope
+    from camfab.results import Finding, Severity
+
+    assert [r.name for r in RULES] == ["continuity", "curvature", "pressure_angle", "face", "extent"]
+    seen = []
+
+    def lift_rule(contact, limits, sample):
+        """A contact rule: the dense sample is the one every rule reads; it may add report fields."""
+        (_, lo), (_, hi) = sample.extremes("pressure_angle")
+        seen.append(sample)
+        return RuleResult((Finding(IssueCode.PRESSURE_ANGLE_EXCEEDED, Severity.INFO, None, None, hi - lo, None,
+                                   "span of the pressure angle"),), {})
+
+    monkeypatch.setattr(checks_mod, "RULES", RULES + (Rule("span", Scope.CONTACT, lift_rule),))
+    a = CamGeometry(TranslatingRoller(35, 7), E9)
+    two = CamGeometry.from_contacts([a.profiles[0], CamGeometry(TranslatingRoller(30, 7), E9).profiles[0]],
+                                    a.mechanism, E9)
+    r = check(two)
+    span = [f for f in r.findings if f.severity == "info"]
+    assert [f.message for f in span] == [f"profile {k}: span of the pressure angle" for k in (1, 2)]
+    assert len(seen) == 2 and seen[0].dense is seen[0].dense  # one dense evaluation per contact, kept
+    # registered after the extent rule, the new rule runs last (profile by profile): its findings come last
+    assert r.findings[-1] is span[-1]
