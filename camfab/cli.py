@@ -8,6 +8,7 @@ heavy dependencies are imported inside the commands that need them.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 import sys
@@ -20,6 +21,7 @@ from . import __version__
 from .errors import CamfabError, GeometryError, MissingDependencyError, SpecError
 from .formats import load_design, resolve_design_path
 from .io import atomic_write
+from .results import FORCE_CODES, IssueCode, Severity, Verdict
 
 __all__ = ["main", "register", "COMMANDS"]
 
@@ -70,7 +72,7 @@ def cmd_motion(args: argparse.Namespace) -> int:
     report = analyse_motion(prog, name=spec.name, speed=spec.speed, lift_unit=spec.follower.lift_unit,
                             peaks_mode=args.peaks,
                             allow_acceleration_jump=spec.cam.kind in ("constant_width", "constant_diameter"))
-    report.findings.extend(knot_findings(spec))
+    report = dataclasses.replace(report, findings=report.findings + tuple(knot_findings(spec)))
     if args.csv:
         atomic_write(args.csv, motion_csv(prog, spec.speed, step))
     if args.json:
@@ -81,7 +83,7 @@ def cmd_motion(args: argparse.Namespace) -> int:
         print(format_motion(spec, prog, report))
         if args.csv:
             print(f"wrote {args.csv}")
-    return EXIT_CHECKS if report.verdict == "unacceptable" else EXIT_OK
+    return EXIT_CHECKS if report.verdict == Verdict.UNACCEPTABLE else EXIT_OK
 
 
 cmd_motion.add_arguments = _motion_args
@@ -134,12 +136,12 @@ def format_motion(spec, prog, report) -> str:
     for r in _segment_rows(prog):
         out.append(f"{r['index'] + 1:>3}  {r['title'][:33]:<34}{r['lift']:>+10.4f}{r['from']:>10.4f}"
                    f"{r['to']:>10.4f}{r['S_start']:>10.4f}{r['S_end']:>10.4f}")
-    out += ["", "Junctions: " + ", ".join(f"{j['at_deg']:g}{xu} {j['continuity']}" for j in report.junctions), ""]
+    out += ["", "Junctions: " + ", ".join(f"{j.at:g}{xu} {j.continuity}" for j in report.junctions), ""]
     units = {"S": lu, "V": f"{lu}/s", "A": f"{lu}/s²", "J": f"{lu}/s³"}
     out.append(f"Peaks ({report.peaks_mode}){'':14}{'max':>14}{'at':>10}{'min':>14}{'at':>10}")
     for q, p in report.peaks.items():
-        out.append(f"  {q} ({units[q]}){'':<{22 - len(units[q])}}{p['max']:>14.6g}{p['at_max_deg']:>10.4f}"
-                   f"{p['min']:>14.6g}{p['at_min_deg']:>10.4f}")
+        out.append(f"  {q} ({units[q]}){'':<{22 - len(units[q])}}{p.max:>14.6g}{p.at_max:>10.4f}"
+                   f"{p.min:>14.6g}{p.at_min:>10.4f}")
     out += ["", f"Verdict: {report.verdict}"]
     out += [f"  [{f.severity}] {f.code}: {f.message}" for f in report.findings]
     return "\n".join(out)
@@ -161,80 +163,82 @@ def cmd_check(args: argparse.Namespace) -> int:
         print(json.dumps(report.to_dict(), indent=2))
     else:
         print(format_check(spec, report))
-    return EXIT_CHECKS if report.verdict == "unacceptable" else EXIT_OK
+    return EXIT_CHECKS if report.verdict == Verdict.UNACCEPTABLE else EXIT_OK
 
 
 cmd_check.add_arguments = _check_args
 
-_VERDICT_TEXT = {"acceptable": "Cam OK (acceptable)",
-                 "not_for_high_speed": "Not suitable for high speeds",
-                 "unacceptable": "Cam KO (unacceptable)"}
+_VERDICT_TEXT = {Verdict.ACCEPTABLE: "Cam OK (acceptable)",
+                 Verdict.NOT_FOR_HIGH_SPEED: "Not suitable for high speeds",
+                 Verdict.UNACCEPTABLE: "Cam KO (unacceptable)"}
 
 
 def format_check(spec, report) -> str:
     """The CAM-DAS style conclusions table."""
-    d = report.to_dict()
     lu = spec.follower.lift_unit
-    codes = {f.code for f in report.findings}
+    codes = report.codes()
     cont = {"S": "Continuous",
-            "V": "Discontinuous" if "VELOCITY_DISCONTINUITY" in codes else "Continuous",
-            "A": "Discontinuous" if "ACCELERATION_DISCONTINUITY" in codes else "Continuous",
-            "J": "Discontinuous" if "JERK_DISCONTINUITY" in codes else "Continuous"}
+            "V": "Discontinuous" if IssueCode.VELOCITY_DISCONTINUITY in codes else "Continuous",
+            "A": "Discontinuous" if IssueCode.ACCELERATION_DISCONTINUITY in codes else "Continuous",
+            "J": "Discontinuous" if IssueCode.JERK_DISCONTINUITY in codes else "Continuous"}
     names = {"S": f"Displacement ({lu})", "V": f"Velocity ({lu}/s)", "A": f"Acceleration ({lu}/s²)",
              "J": f"Jerk ({lu}/s³)"}
-    rows = [(names[q], _num(p["max"]), _num(p["min"]), cont[q]) for q, p in d.get("peaks", {}).items()]
-    roc = d.get("radius_of_curvature_mm") or {}
-    if roc:
-        bad = codes & {"UNDERCUT", "CUSP"}
-        rows.append(("Convex radius of curvature (mm)", "--", _num(roc.get("min_convex")),
+    rows = [(names[q], _num(p.max), _num(p.min), cont[q])
+            for q, p in (report.motion.peaks.items() if report.motion is not None else ())]
+    roc = report.curvature
+    if roc is not None:
+        bad = codes & {IssueCode.UNDERCUT, IssueCode.CUSP}
+        rows.append(("Convex radius of curvature (mm)", "--", _num(roc.min_convex),
                      "undercut or cusp: see findings" if bad else "The profile is free of cusps and undercuts"))
-        if roc.get("min_concave") is not None:
-            rows.append(("Concave radius of curvature (mm)", "--", _num(roc.get("min_concave")),
+        if roc.min_concave is not None:
+            rows.append(("Concave radius of curvature (mm)", "--", _num(roc.min_concave),
                          "smallest concave radius (cutter must be smaller)"))
-    pa = d.get("pressure_angle_deg")
-    if pa:
-        ok = "PRESSURE_ANGLE_EXCEEDED" not in codes
-        rows.append(("Pressure angle (°)", _num(pa["max"]), _num(pa["min"]),
-                     "Acceptable" if ok else f"High pressure angle (> {pa.get('limit', 0):g}°)"))
-    face = d.get("face_length_mm")
-    if face:
-        rows.append(("Face length left / right (mm)", _num(face.get("left")), _num(face.get("right")),
+    pa = report.pressure_angle
+    if pa is not None:
+        ok = IssueCode.PRESSURE_ANGLE_EXCEEDED not in codes
+        rows.append(("Pressure angle (°)", _num(pa.max), _num(pa.min),
+                     "Acceptable" if ok else f"High pressure angle (> {pa.limit:g}°)"))
+    face = report.face_length
+    if face is not None:
+        rows.append(("Face length left / right (mm)", _num(face.left), _num(face.right),
                      "minimum face length on each side to keep contact"))
-    dyn = d.get("dynamics")
-    if dyn:
-        cf = dyn["contact_force_n"]
-        low = codes & {"FOLLOWER_JUMP", "CONTACT_FORCE_BELOW_SAFETY", "SELF_LOCKING"}
-        if dyn.get("form_closed"):
-            cf2 = dyn["second_contact_force_n"]
-            rev = len(dyn["load_reversals_deg"])
-            rows.append(("Contact force, follower 1 (N)", _num(cf["max"]), _num(cf["min"]), "form-closed: no jump"))
-            rows.append(("Contact force, follower 2 (N)", _num(cf2["max"]), _num(cf2["min"]),
-                         f"the load changes follower {rev} time{'s' if rev != 1 else ''} per turn"))
-        else:
-            rows.append(("Contact force (N)", _num(cf["max"]), _num(cf["min"]),
-                         "below the safety force or jumping: see findings" if low else
-                         f"never below the safety force ({dyn['safety_force_n']:g} N)"))
-        key, label = (("drive_torque_nm", "Drive torque (N·m)") if "drive_torque_nm" in dyn
-                      else ("drive_force_n", "Drive force (N)"))
-        rows.append((label, _num(dyn[key]["max"]), _num(dyn[key]["min"]),
-                     f"work per cycle {dyn['work_per_cycle_j']:.4g} J, mean power {dyn['mean_power_w']:.4g} W"))
-        rows.append(("Camshaft bearing force (N)", _num(dyn["bearing_force_n"]["max"]), "--", ""))
+    dyn = report.dynamics
+    if dyn is not None:
+        rows += _dynamics_rows(dyn, codes)
     width = max(len(r[0]) for r in rows) + 2
     out = [f"{spec.name}: {_VERDICT_TEXT[report.verdict]}", ""]
     out.append(f"{'Concept':<{width}}{'Maximum':>13}{'Minimum':>13}  Comments")
     out += [f"{a:<{width}}{b:>13}{c:>13}  {e}" for a, b, c, e in rows]
-    extra = [(k, d.get(k)) for k in ("base_radius_mm", "max_radius_mm", "area_mm2", "initial_arm_angle_deg")]
+    extra = [("base_radius_mm", report.base_radius_mm), ("max_radius_mm", report.max_radius_mm),
+             ("area_mm2", report.area_mm2), ("initial_arm_angle_deg", report.initial_arm_angle_deg)]
     out += [""] + [f"{k}: {v:.6g}" for k, v in extra if v is not None]
-    if dyn and not dyn.get("form_closed"):
-        pre, jump = dyn["preload_needed"], dyn["jump_speed"]
-        out.append(f"spring preload for the safety force: {pre['value']:.6g} {pre['unit']} (worst at "
-                   f"{pre['at_deg']:.2f})")
-        out.append("jump speed: " + ("none (the follower never leaves the cam)" if jump["value"] is None else
-                                     f"{jump['value']:.6g} {jump['unit']} (first at {jump['at_deg']:.2f})"))
+    if dyn is not None and not dyn.form_closed:
+        pre, jump = dyn.preload_needed, dyn.jump_speed
+        out.append(f"spring preload for the safety force: {pre.value:.6g} {pre.unit} (worst at {pre.at:.2f})")
+        out.append("jump speed: " + ("none (the follower never leaves the cam)" if jump.value is None else
+                                     f"{jump.value:.6g} {jump.unit} (first at {jump.at:.2f})"))
     if report.findings:
         out += ["", "Findings:"]
         out += [f"  [{f.severity}] {f.code}: {f.message}" for f in report.findings]
     return "\n".join(out)
+
+
+def _dynamics_rows(dyn, codes) -> list[tuple[str, str, str, str]]:
+    """The contact-force, drive and bearing rows of the conclusions table."""
+    cf, rows = dyn.contact_force, []
+    if dyn.form_closed:
+        cf2, rev = dyn.second_contact_force, len(dyn.load_reversals or ())
+        rows.append(("Contact force, follower 1 (N)", _num(cf.max), _num(cf.min), "form-closed: no jump"))
+        rows.append(("Contact force, follower 2 (N)", _num(cf2.max), _num(cf2.min),
+                     f"the load changes follower {rev} time{'s' if rev != 1 else ''} per turn"))
+    else:
+        rows.append(("Contact force (N)", _num(cf.max), _num(cf.min),
+                     "below the safety force or jumping: see findings" if codes & set(FORCE_CODES) else
+                     f"never below the safety force ({dyn.safety_force_n:g} N)"))
+    rows.append(("Drive torque (N·m)" if dyn.torque else "Drive force (N)", _num(dyn.drive.max), _num(dyn.drive.min),
+                 f"work per cycle {dyn.work_per_cycle_j:.4g} J, mean power {dyn.mean_power_w:.4g} W"))
+    rows.append(("Camshaft bearing force (N)", _num(dyn.bearing_force.max), "--", ""))
+    return rows
 
 
 def _num(v) -> str:
@@ -278,7 +282,7 @@ def cmd_export(args: argparse.Namespace) -> int:
     except ValueError as exc:
         raise UsageError(f"--tol {args.tol}: {exc}") from None
     report = check_design(spec)
-    if report.verdict == "unacceptable" and not args.force:
+    if report.verdict == Verdict.UNACCEPTABLE and not args.force:
         print(format_check(spec, report), file=sys.stderr)
         print(f"camfab export: {spec.name} is unacceptable: nothing written (use --force to export anyway)",
               file=sys.stderr)
@@ -359,7 +363,7 @@ def cmd_gcode(args: argparse.Namespace) -> int:
     job = _job(spec, args, tol)
     post = args.post or spec.outputs.gcode or "linuxcnc"
     report = check_design(spec)
-    if report.verdict == "unacceptable" and not args.force:
+    if report.verdict == Verdict.UNACCEPTABLE and not args.force:
         print(f"camfab gcode: {spec.name} is unacceptable ({_worst(report)}): nothing written "
               "(use --force to write anyway)", file=sys.stderr)
         return EXIT_CHECKS
@@ -387,7 +391,7 @@ cmd_gcode.add_arguments = _gcode_args
 
 
 def _worst(report) -> str:
-    errs = [f.code for f in report.findings if f.severity == "error"]
+    errs = [f.code for f in report.findings if f.severity == Severity.ERROR]
     return ", ".join(sorted(set(errs))) or report.verdict
 
 
@@ -443,15 +447,14 @@ def cmd_verify(args: argparse.Namespace) -> int:
     rep = verify(moves, exact_curve_distance=signed_distance(offset_curve(contact, tool / 2), tol=tol),
                  part_distance=signed_distance(profile_curve(contact), tol=tol), tool_radius=tool / 2, tol=tol,
                  safe_z=args.safe_z, top_z=0.0, comp_radius=args.comp_radius)
-    data = rep.to_dict()
     if args.json:
-        print(json.dumps(data, indent=2))
+        print(json.dumps(rep.to_dict(), indent=2))
     else:
-        dev = data.get("max_deviation_mm")
+        dev = rep.max_deviation_mm
         print(f"{args.program}: {'OK' if rep.ok else 'FAILED'}; max deviation "
               f"{'-' if dev is None else f'{dev:.3g}'} mm (tol {tol:g}); gouge: {'yes' if rep.gouge else 'no'}")
-        for pr in data.get("problems", []):
-            print(f"  [{pr.get('code')}] line {pr.get('line')}: {pr.get('message')}")
+        for pr in rep.problems:
+            print(f"  [{pr.code}] line {pr.line}: {pr.message}")
     return EXIT_OK if rep.ok else EXIT_CHECKS
 
 
@@ -499,7 +502,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(f"  {name:<36}" + ("" if dev is None else f" max deviation {dev:.3g} mm"))
     if res.withheld:
         print(f"  withheld (verdict unacceptable, use --force): {', '.join(res.withheld)}")
-    return EXIT_CHECKS if res.verdict == "unacceptable" else EXIT_OK
+    return EXIT_CHECKS if res.verdict == Verdict.UNACCEPTABLE else EXIT_OK
 
 
 cmd_run.add_arguments = _run_args

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Callable
 
 from .io import atomic_write
+from .results import Verdict
 
 __all__ = ["JobRequest", "RunResult", "request_from_outputs", "run_design", "SHOP_ARTIFACTS"]
 
@@ -105,7 +106,7 @@ def run_design(spec, outdir: str | Path, req: JobRequest, *,
     tool = spec.manufacturing.tool_diameter_mm
     report = timed("check", check_design, spec, tool_radius_mm=tool / 2 if tool else None)
     res.verdict = report.verdict
-    if report.verdict == "unacceptable" and not req.force:
+    if report.verdict == Verdict.UNACCEPTABLE and not req.force:
         res.withheld = [a for a in SHOP_ARTIFACTS if _wants(req, a)]
         req = replace(req, dxf=False, step=False, stl=False, gcode=None, drawing=False, lift_table=False)
     geom = timed("geometry", geometry_from_spec, spec)

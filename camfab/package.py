@@ -30,6 +30,7 @@ from .design.spec import DesignSpec
 from .formats import load_design
 from .io import atomic_write
 from .jobs import JobRequest
+from .results import Verdict
 
 __all__ = ["discover", "input_key", "package", "exit_status", "MANIFEST", "INDEX"]
 
@@ -117,7 +118,7 @@ def _build(args: tuple) -> dict:
         folder = Path(out) / _folder_name(spec.name)
         req = request_from_outputs(spec, **overrides)
         res = run_design(spec, folder, req)
-        entry.update(status="unacceptable" if res.verdict == "unacceptable" else "ok", verdict=res.verdict,
+        entry.update(status="unacceptable" if res.verdict == Verdict.UNACCEPTABLE else "ok", verdict=str(res.verdict),
                      tolerance_mm=res.tol, withheld=res.withheld, timings=res.timings,
                      folder=str(folder.relative_to(out)),
                      files=[_file_entry(p, Path(out), res.deviations.get(n)) for n, p in sorted(res.files.items())])

@@ -52,6 +52,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import ExportError
+from ..results import Severity, Verdict
 from .dxf import _ezdxf, write_deterministic
 from .plate import BulgeLoop, bore_loop, keyway_size
 
@@ -191,16 +192,16 @@ def title_fields(spec, report, layout: SheetLayout) -> dict[str, str]:
 
     return {"name": spec.name, "material": spec.manufacturing.material or "to be specified",
             "scale": layout.scale_label, "units": "mm", "tolerance": f"±{spec.manufacturing.tolerance_mm:g} mm",
-            "verdict": report.verdict, "date": "", "drawn_by": f"camfab {__version__}", "paper": layout.paper,
+            "verdict": report.verdict.value, "date": "", "drawn_by": f"camfab {__version__}", "paper": layout.paper,
             "sheet": "1 / 1", "checked": ""}
 
 
 def _verdict_note(report) -> str:
-    errors = [x for x in report.findings if x.severity == "error"]
-    verdict = f"Check verdict: {report.verdict}"
+    errors = [x for x in report.findings if x.severity == Severity.ERROR]
+    verdict = f"Check verdict: {report.verdict.value}"
     if errors:
         verdict += " — " + "; ".join(sorted({x.code for x in errors}))
-    elif report.verdict == "not_for_high_speed":
+    elif report.verdict == Verdict.NOT_FOR_HIGH_SPEED:
         verdict += " — jerk discontinuity, not for high speeds"
     return verdict
 

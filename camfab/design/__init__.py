@@ -6,7 +6,8 @@ reads designs into :class:`DesignSpec` values.
 from __future__ import annotations
 
 from .laws import LAWS, Law, get_law, law_names
-from .motion_report import Finding, MotionReport, analyse_motion
+from ..results import Finding, MotionReport
+from .motion_report import analyse_motion
 from .program import MotionProgram, Segment, SegmentInput, build_program
 from .spec import DesignSpec, design_from_dict
 

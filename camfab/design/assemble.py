@@ -9,9 +9,9 @@ import dataclasses
 import math
 
 from ..errors import SpecError
-from .checks import Report, check
-from .dynamics import ContactDynamics, DynamicsReport, Loads, PairDynamics, analyse_dynamics, pair_of
-from .motion_report import Finding
+from ..results import CheckReport, DynamicsReport, Finding
+from .checks import check
+from .dynamics import ContactDynamics, Loads, PairDynamics, analyse_dynamics, pair_of
 from .mechanisms import geometry_from_spec, mechanism_from_spec
 from .profile import CamGeometry
 from .spec import DesignSpec, DynamicsSpec
@@ -20,7 +20,7 @@ __all__ = ["mechanism_from_spec", "geometry_from_spec", "check_design", "knot_fi
            "dynamics_of", "dynamics_model", "is_form_closed"]
 
 
-def check_design(spec: DesignSpec, *, tool_radius_mm: float | None = None) -> Report:
+def check_design(spec: DesignSpec, *, tool_radius_mm: float | None = None) -> CheckReport:
     """Geometry + checks + verdict for a design (the ``camfab check`` report), knot-table
     consistency warnings included."""
     geom = geometry_from_spec(spec)
@@ -31,10 +31,10 @@ def check_design(spec: DesignSpec, *, tool_radius_mm: float | None = None) -> Re
     extra = knot_findings(spec)
     if spec.dynamics is not None:
         dyn = dynamics_of(spec, geom)
-        report = dataclasses.replace(report, summary={**report.summary, "dynamics": dyn.summary})
+        report = dataclasses.replace(report, dynamics=dyn.summary)
         extra = list(dyn.findings) + extra
     if extra:
-        report = dataclasses.replace(report, findings=tuple(report.findings) + tuple(extra))
+        report = dataclasses.replace(report, findings=report.findings + tuple(extra))
     return report
 
 
@@ -76,5 +76,4 @@ def knot_findings(spec: DesignSpec) -> list[Finding]:
     """KNOT_INCONSISTENT warnings of a knot-table design (none for segment programs)."""
     if spec.knot_table is None:
         return []
-    return [Finding(w.code, "warning", w.from_deg, w.to_deg, w.implied_peak, w.knot_max, w.message)
-            for w in spec.knot_table.warnings()]
+    return list(spec.knot_table.warnings())

@@ -52,7 +52,7 @@ from .kinds import CamKind, FollowerMotion, FollowerType
 from .mechanism import Mechanism, finite_fields, require_rotation
 from .profile import CamGeometry, Contact, MotionLike, ProfileSample
 from .rollers import OscillatingRoller, OscillatingRollerContact, TranslatingRoller, TranslatingRollerContact
-from .solvers import extremum
+from ..numeric import extremum
 
 __all__ = [
     "ConjugateTranslatingFlat", "ConjugateTranslatingRoller", "ConjugateOscillatingFlat", "ConjugateOscillatingRoller",

@@ -1,8 +1,7 @@
 """Follower dynamics: contact forces, jump, drive torque — spring-loaded and form-closed followers.
 
-Kinetostatics at constant cam speed (``spec/valve-case-and-textbook.md`` §3.9 items 5–6): the
-motion is imposed, so every force follows from S, S′, S″ and the exact geometry; nothing is
-integrated in time and the follower is rigid.
+Kinetostatics at constant cam speed: the motion is imposed, so every force follows from S, S′, S″
+and the exact geometry; nothing is integrated in time and the follower is rigid.
 
 Model (one generalised coordinate q of the follower: its travel in m, or its arm angle in rad)
 -----------------------------------------------------------------------------------------------
@@ -41,19 +40,29 @@ angle; D does not depend on the speed).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from .. import numeric
+from ..results import (
+    DynamicsReport,
+    DynamicsSummary,
+    Extreme,
+    Finding,
+    IssueCode,
+    JumpSpeed,
+    Maximum,
+    Preload,
+    Severity,
+)
 from ..units import DEG, RPM
-from .motion_report import Finding
-from .checks import _positive_ranges_steps
+from .conjugate import DesmodromicGeometry
 from .profile import CamGeometry, Contact
-from .solvers import _extremum_steps, _gather, _mapped, _run, integrate
 
-__all__ = ["Loads", "DynamicsSample", "DynamicsReport", "ContactDynamics", "PairDynamics", "pair_of",
-           "analyse_dynamics"]
+__all__ = ["Loads", "DynamicsSample", "ContactDynamics", "PairDynamics", "pair_of", "analyse_dynamics"]
 
 
 @dataclass(frozen=True)
@@ -120,12 +129,11 @@ class ContactDynamics:
         if not speed > 0:
             raise ValueError("speed must be > 0")
         self.contact, self.loads, self.speed = contact, loads, float(speed)
-        self.xi0 = getattr(contact, "xi0", None)
-        self.oscillating = self.xi0 is not None
-        self.pivot = np.array([contact.m, 0.0]) if self.oscillating else None
+        self.oscillating = contact.oscillating
+        self.pivot = np.array([contact.m, 0.0]) if self.oscillating else None  # type: ignore[attr-defined]
         #: q per unit of S: m per mm, or rad per degree
         self.q_per_s = DEG if self.oscillating else 1e-3
-        self.sliding = contact.kind == "flat" or contact.roller_radius == 0.0
+        self.sliding = contact.sliding
 
     # ---- kinematics -------------------------------------------------------------------
     def _kinematics(self, x):
@@ -135,7 +143,7 @@ class ContactDynamics:
         x = np.atleast_1d(np.asarray(x, dtype=float))
         S = np.asarray(c.motion.evaluate(x, (0, 1, 2)), dtype=float)
         s = c.evaluate_fixed(x, S)
-        where = s.pitch if (c.kind == "roller" and not self.sliding) else s.point  # point of force, mm
+        where = s.point if self.sliding else s.pitch  # point of force (a rolling roller's centre), mm
         if self.oscillating:  # ξ grows clockwise: d r/dξ = −J·(r − pivot)
             rel = (where - self.pivot) * 1e-3
             w = np.stack([rel[:, 1], -rel[:, 0]], axis=1)
@@ -272,16 +280,59 @@ def pair_of(geometry: CamGeometry, loads: Loads, speed: float) -> PairDynamics:
     return PairDynamics(first, ContactDynamics(profs[0], loads, speed), math.pi)
 
 
-@dataclass(frozen=True)
-class DynamicsReport:
-    """Summary and findings of :func:`analyse_dynamics` (user units: N, N·m, J, W, rpm, degrees)."""
-
-    summary: dict[str, Any]
-    findings: tuple[Finding, ...]
+def _user(c: Contact, x: float) -> float:
+    """A parameter in user units: degrees of cam angle, or mm of travel."""
+    return math.degrees(x) if c.axis.rotating else x
 
 
-def _x_user(c: Contact, x: float) -> float:
-    return math.degrees(x) if c.closed else x
+#: the rows of the force table searched by :func:`analyse_dynamics`: spring-loaded (False) or
+#: form-closed (True) followers
+_ROWS = {False: ("contact_force", "bearing_force", "drive", "lever", "preload", "jump"),
+         True: ("contact_force", "bearing_force", "drive", "lever", "contact_force_2", "required")}
+#: the exact extrema wanted: (row, maximise)
+_EXTREMA = {False: (("contact_force", False), ("contact_force", True), ("drive", False), ("drive", True),
+                    ("bearing_force", True), ("preload", True), ("jump", False)),
+            True: (("contact_force", False), ("contact_force", True), ("drive", False), ("drive", True),
+                   ("bearing_force", True), ("contact_force_2", False), ("contact_force_2", True))}
+
+
+def _range_rows(form_closed: bool, fs: float) -> list[tuple[str, float, float]]:
+    """The functions ``sign·row + offset`` whose positive ranges are findings: self-locking (−D > 0);
+    form-closed: where each follower carries the load (±G > 0); spring-loaded: jump (−N > 0) and,
+    with a safety force, F_s − N > 0."""
+    out = [("lever", -1.0, 0.0)]
+    if form_closed:
+        return out + [("required", 1.0, 0.0), ("required", -1.0, 0.0)]
+    return out + [("contact_force", -1.0, 0.0)] + ([("contact_force", -1.0, fs)] if fs > 0 else [])
+
+
+def _force_table(dyn: ContactDynamics | PairDynamics, form_closed: bool) -> Callable[[np.ndarray], np.ndarray]:
+    """x (n,) → the (6, n) table of :data:`_ROWS` (``+ 0.0``: a −0 force reads as 0)."""
+    def table(x: np.ndarray) -> np.ndarray:
+        sm = dyn.evaluate(x)
+        more = ((sm.contact_force_2, sm.required) if form_closed else
+                (dyn.needed_preload(sm), dyn.jump_speed(sm)))  # type: ignore[union-attr]
+        return np.stack([sm.contact_force, sm.bearing_force, sm.drive, sm.lever, *more]) + 0.0
+    return table
+
+
+def _searches(dyn: ContactDynamics | PairDynamics, form_closed: bool, fs: float, edges: np.ndarray,
+              closed: bool) -> tuple[dict, list[list[numeric.Range]]]:
+    """The exact extrema (by (row, maximise): (at, value)) and the positive ranges of
+    :func:`_range_rows`, all searched together: one evaluation of the forces per round."""
+    names = _ROWS[form_closed]
+    table = _force_table(dyn, form_closed)
+    picks = [(names.index(n), sign, off) for n, sign, off in _range_rows(form_closed, fs)]
+
+    def rows(x: np.ndarray) -> np.ndarray:  # the table, then the functions whose ranges are wanted
+        T = table(x)
+        return np.concatenate([T, [sign * T[j] + off for j, sign, off in picks]])
+
+    spec = _EXTREMA[form_closed]
+    with np.errstate(invalid="ignore"):  # the per-angle jump speed is +inf where N never drops
+        found, ranges = numeric.search(rows, edges, extrema=[(names.index(n), mx) for n, mx in spec],
+                                       ranges=range(len(names), len(names) + len(picks)), closed=closed)
+    return dict(zip(spec, found, strict=True)), ranges
 
 
 def analyse_dynamics(geometry: CamGeometry, loads: Loads, speed: float, *, preload_unit: str = "N",
@@ -295,8 +346,6 @@ def analyse_dynamics(geometry: CamGeometry, loads: Loads, speed: float, *, prelo
     root refinement.  ``speed`` is ω (rad/s), or mm/s for a translating cam.
     """
     if form_closed is None:
-        from .conjugate import DesmodromicGeometry
-
         form_closed = isinstance(geometry, DesmodromicGeometry)
     if not form_closed and len(geometry.profiles) != 1:
         raise ValueError("a force-closed cam has one follower")
@@ -304,125 +353,92 @@ def analyse_dynamics(geometry: CamGeometry, loads: Loads, speed: float, *, prelo
     dyn = pair_of(geometry, loads, speed) if form_closed else ContactDynamics(c, loads, speed)
     edges = np.unique(np.concatenate([c.breakpoints, np.mod(c.breakpoints - math.pi, 2 * math.pi)])) \
         if form_closed and len(geometry.profiles) == 1 else geometry.breakpoints
-    closed, fs = c.closed, loads.safety_force_n
-    # every search runs in lockstep: one evaluation of the forces per round, its columns
-    cols = ("contact_force", "bearing_force", "drive", "lever",
-            *(("contact_force_2", "required") if form_closed else ("preload", "jump")))
+    found, ranges = _searches(dyn, form_closed, loads.safety_force_n, edges, c.closed)
 
-    def table(x):
-        sm = dyn.evaluate(x)
-        more = ((sm.contact_force_2, sm.required) if form_closed else
-                (dyn.needed_preload(sm), dyn.jump_speed(sm)))
-        return np.stack([sm.contact_force, sm.bearing_force, sm.drive, sm.lever, *more], axis=1)
+    def extreme(name: str) -> Extreme:
+        (at_lo, lo), (at_hi, hi) = found[(name, False)], found[(name, True)]
+        return Extreme(float(lo), _user(c, at_lo), float(hi), _user(c, at_hi))
 
-    def col(name, sign=1.0, offset=0.0):
-        j = cols.index(name)
-        return lambda v: sign * v[:, j] + offset
-
-    extrema = [("contact_force", False), ("contact_force", True), ("drive", False), ("drive", True),
-               ("bearing_force", True)]
-    extrema += ([("contact_force_2", False), ("contact_force_2", True)] if form_closed else
-                [("preload", True), ("jump", False)])
-    ranges = [("lever", -1.0, 0.0)]  # self-locking: D < 0
-    ranges += ([("required", 1.0, 0.0), ("required", -1.0, 0.0)] if form_closed else
-               [("contact_force", -1.0, 0.0)] + ([("contact_force", -1.0, fs)] if fs > 0 else []))
-    jobs = [_mapped(_extremum_steps(edges, maximize=mx), col(name)) for name, mx in extrema]
-    jobs += [_mapped(_positive_ranges_steps(edges, closed=closed), col(*r)) for r in ranges]
-    with np.errstate(invalid="ignore"):  # the per-angle jump speed is +inf where N never drops
-        found = _run(table, _gather(jobs))
-    ext = {(name, mx): (float(v), _x_user(c, at)) for (name, mx), (at, v) in zip(extrema, found)}
-    got = found[len(extrema):]
-
-    def minmax(name):
-        (lo, at_lo), (hi, at_hi) = ext[(name, False)], ext[(name, True)]
-        return {"min": lo, "max": hi, "at_min_deg": at_lo, "at_max_deg": at_hi}
-
-    drive = minmax("drive")
+    drive = extreme("drive")
     # the work may cancel to 0 (no damping, no friction): an absolute target of 1e-12 of the
     # largest |drive| over the cycle
     span = float(edges[-1] - edges[0])
-    work = integrate(lambda x: dyn.evaluate(x).drive, edges,
-                     atol=1e-12 * max(abs(drive["min"]), abs(drive["max"])) * span)
-    work *= 1.0 if closed else 1e-3
-    cycle_s = (2 * math.pi / speed) if closed else c.period / speed
-    bmax, at_b = ext[("bearing_force", True)]
-    summary: dict[str, Any] = {
-        "form_closed": form_closed,
-        "contact_force_n": minmax("contact_force"),
-        "safety_force_n": None if form_closed else fs,
-        "bearing_force_n": {"max": bmax, "at_max_deg": at_b},
-        ("drive_torque_nm" if closed else "drive_force_n"): drive,
-        "work_per_cycle_j": work,
-        "mean_power_w": work / cycle_s,
-    }
-    findings = _self_locking(got[0], c)
+    work = numeric.integrate(lambda x: dyn.evaluate(x).drive, edges,
+                             atol=1e-12 * max(abs(drive.min), abs(drive.max)) * span)
+    work *= 1.0 if c.closed else 1e-3
+    cycle_s = (2 * math.pi / speed) if c.closed else c.period / speed
+    at_b, bmax = found[("bearing_force", True)]
+    common: dict[str, Any] = dict(
+        form_closed=form_closed, contact_force=extreme("contact_force"), drive=drive, torque=c.closed,
+        bearing_force=Maximum(float(bmax), _user(c, at_b)), work_per_cycle_j=work, mean_power_w=work / cycle_s)
+    findings = _self_locking(ranges[0], c)
     if form_closed:
-        summary["second_contact_force_n"] = minmax("contact_force_2")
-        summary["preload_needed"] = summary["jump_speed"] = None
-        rev = _reversals(got[1], got[2], c)
-        summary["load_reversals_deg"] = [[f.from_deg, f.to_deg] for f in rev]
-        findings += rev
-    else:
-        pre, at_pre = ext[("preload", True)]
-        r_jump, at_jump = ext[("jump", False)]
-        summary["preload_needed"] = {"value": pre, "unit": preload_unit, "at_deg": at_pre}
-        summary["jump_speed"] = _speed_user(r_jump, closed, at_jump)
-        findings += _force_closed(got[1], got[2] if fs > 0 else [], c, fs, speed, pre, r_jump, preload_unit)
+        rev = _reversals(ranges[1], ranges[2], c)
+        summary = DynamicsSummary(safety_force_n=None, second_contact_force=extreme("contact_force_2"),
+                                  load_reversals=tuple((a, b) for a, b, _ in rev), **common)
+        return DynamicsReport(summary, tuple(findings + [f for _, _, f in rev]))
+    fs = loads.safety_force_n
+    (at_pre, pre), (at_jump, r_jump) = found[("preload", True)], found[("jump", False)]
+    summary = DynamicsSummary(safety_force_n=fs, preload_needed=Preload(float(pre), preload_unit, _user(c, at_pre)),
+                              jump_speed=_speed_user(float(r_jump), c.closed, _user(c, at_jump)), **common)
+    findings += _force_closed(ranges[1], ranges[2] if fs > 0 else [], c, fs, speed, float(pre), float(r_jump),
+                              preload_unit)
     return DynamicsReport(summary, tuple(findings))
 
 
 def _self_locking(ranges, c) -> list[Finding]:
     """SELF_LOCKING from the ranges where −D > 0."""
-    unit = "deg" if c.closed else "mm"
-    return [Finding("SELF_LOCKING", "error", _x_user(c, lo), _x_user(c, hi), float(-gw), 0.0,
-                    f"friction wedges the follower from {_x_user(c, lo):.2f} to {_x_user(c, hi):.2f} {unit}: no "
+    unit = c.axis.x_unit
+    return [Finding(IssueCode.SELF_LOCKING, Severity.ERROR, _user(c, lo), _user(c, hi), float(-gw), 0.0,
+                    f"friction wedges the follower from {_user(c, lo):.2f} to {_user(c, hi):.2f} {unit}: no "
                     "contact force can move it (μ too high for the pressure angle there); lower the friction "
                     "coefficient or the pressure angle (larger base radius)")
             for lo, hi, _, gw in ranges]
 
 
-def _reversals(first, second, c) -> list[Finding]:
+def _reversals(first, second, c) -> list[tuple[float, float, Finding]]:
     """LOAD_REVERSAL (info) between consecutive stretches where different followers carry the load
-    (``first``/``second``: the ranges where G > 0 / G < 0)."""
-    unit = "deg" if c.closed else "mm"
+    (``first``/``second``: the ranges where G > 0 / G < 0): ``(from, to, finding)`` in order."""
+    unit = c.axis.x_unit
     runs = sorted([(lo, hi, 1) for lo, hi, _, _ in first] + [(lo, hi, 2) for lo, hi, _, _ in second])
-    out = []
+    out: list[tuple[float, float, Finding]] = []
     if len({k for _, _, k in runs}) < 2:
         return out
-    for (lo, hi, k), (lo2, _, k2) in zip(runs, runs[1:] + runs[:1]):
+    for (_, hi, k), (lo2, _, k2) in zip(runs, runs[1:] + runs[:1], strict=True):
         if k != k2:
-            a, b = _x_user(c, hi), _x_user(c, lo2)
+            a, b = _user(c, hi), _user(c, lo2)
             where = f"at {a:.2f} {unit}" if abs(b - a) < 1e-9 else f"between {a:.2f} and {b:.2f} {unit}"
-            out.append(Finding(
-                "LOAD_REVERSAL", "info", a, b, None, None,
+            out.append((a, b, Finding(
+                IssueCode.LOAD_REVERSAL, Severity.INFO, a, b, None, None,
                 f"the load passes from follower {k} to follower {k2} {where}: across a clearance the follower "
-                "knocks there — keep the clearance small (or preload the pair)"))
-    return sorted(out, key=lambda f: f.from_deg)
+                "knocks there — keep the clearance small (or preload the pair)")))
+    return sorted(out, key=lambda t: t[0])
 
 
 def _force_closed(jump, low, c, fs, speed, pre, r_jump, preload_unit) -> list[Finding]:
     """FOLLOWER_JUMP and CONTACT_FORCE_BELOW_SAFETY from the ranges where −N > 0 and F_s − N > 0."""
-    closed, unit = c.closed, ("deg" if c.closed else "mm")
+    closed, unit = c.closed, c.axis.x_unit
     speed_txt = _speed_text(speed, closed)
     fix = (f"raise the spring preload to at least {pre:.6g} {preload_unit}" if math.isfinite(pre) else
            "stiffen the spring")
     if math.isfinite(r_jump) and r_jump > 0:
         fix += f", or run slower than {_speed_text(r_jump, closed)}"
-    out = [Finding("FOLLOWER_JUMP", "error", _x_user(c, lo), _x_user(c, hi), float(-gw), 0.0,
-                   f"the follower leaves the cam from {_x_user(c, lo):.2f} to {_x_user(c, hi):.2f} {unit} at "
+    out = [Finding(IssueCode.FOLLOWER_JUMP, Severity.ERROR, _user(c, lo), _user(c, hi), float(-gw), 0.0,
+                   f"the follower leaves the cam from {_user(c, lo):.2f} to {_user(c, hi):.2f} {unit} at "
                    f"{speed_txt}: the contact force falls to {-gw:.6g} N (the spring cannot hold it); {fix}")
            for lo, hi, _, gw in jump]
-    out += [Finding("CONTACT_FORCE_BELOW_SAFETY", "error", _x_user(c, lo), _x_user(c, hi), float(fs - gw), fs,
-                    f"the contact force is below the safety force {fs:g} N from {_x_user(c, lo):.2f} to "
-                    f"{_x_user(c, hi):.2f} {unit} (down to {fs - gw:.6g} N at {_x_user(c, xw):.2f} {unit}); {fix}")
+    out += [Finding(IssueCode.CONTACT_FORCE_BELOW_SAFETY, Severity.ERROR, _user(c, lo), _user(c, hi), float(fs - gw),
+                    fs, f"the contact force is below the safety force {fs:g} N from {_user(c, lo):.2f} to "
+                    f"{_user(c, hi):.2f} {unit} (down to {fs - gw:.6g} N at {_user(c, xw):.2f} {unit}); {fix}")
             for lo, hi, xw, gw in low]
     return out
 
 
-def _speed_user(r: float, closed: bool, at: float) -> dict[str, Any]:
+def _speed_user(r: float, closed: bool, at: float) -> JumpSpeed:
+    unit = "rpm" if closed else "mm/s"
     if not math.isfinite(r):
-        return {"value": None, "unit": "rpm" if closed else "mm/s", "at_deg": None}
-    return {"value": float(r / RPM if closed else r), "unit": "rpm" if closed else "mm/s", "at_deg": at}
+        return JumpSpeed(None, unit, None)
+    return JumpSpeed(float(r / RPM if closed else r), unit, at)
 
 
 def _speed_text(r: float, closed: bool) -> str:

@@ -67,13 +67,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..errors import Problem, SpecError
+from ..results import Finding, IssueCode, Severity
 from ..tolerances import ANGLE_SUM_TOL_DEG
 from ..units import DEG, rpm_to_rad_s
 from .program import MotionProgram, Segment, hermite_coefficients
@@ -81,7 +82,6 @@ from .program import MotionProgram, Segment, hermite_coefficients
 __all__ = [
     "UNITS",
     "KnotTable",
-    "KnotWarning",
     "KnotFile",
     "TABLE_KEYS",
     "build_knot_table",
@@ -136,47 +136,6 @@ class KnotFile:
 
     def __str__(self) -> str:
         return self.name
-
-
-@dataclass(frozen=True, slots=True)
-class KnotWarning:
-    """One inconsistent knot segment (a warning, not an error).
-
-    Attributes
-    ----------
-    segment : int
-        Segment index (segment ``i`` runs from row ``i`` to row ``i + 1``, the
-        closing segment back to row 0).
-    from_deg, to_deg : float
-        Angle range of the segment in degrees.
-    quantity : str
-        ``"A"`` (second derivative) or ``"J"`` (third).
-    implied_peak : float
-        Peak magnitude inside the segment, in the table's unit ``unit``.
-    knot_max : float
-        Largest magnitude given at the segment's two knots, same unit.
-    ratio : float
-        ``implied_peak / knot_max``.
-    unit : str
-        Unit of ``implied_peak`` and ``knot_max`` (the table's ``a`` or ``j`` unit).
-    message : str
-        The finding in words.
-    """
-
-    segment: int
-    from_deg: float
-    to_deg: float
-    quantity: str
-    implied_peak: float
-    knot_max: float
-    ratio: float
-    unit: str
-    message: str
-    code: str = "KNOT_INCONSISTENT"
-
-    def as_dict(self) -> dict[str, Any]:
-        """Plain dict (JSON-ready), with ``severity = "warning"``."""
-        return {**asdict(self), "severity": "warning"}
 
 
 @dataclass(frozen=True, eq=False)
@@ -290,7 +249,7 @@ class KnotTable:
                     "give s, v, a at full precision and mutually consistent, or add a knot"))
         return problems
 
-    def warnings(self, ratio: float = WARN_RATIO) -> list[KnotWarning]:
+    def warnings(self, ratio: float = WARN_RATIO) -> list[Finding]:
         """Segments whose implied peak ``|S″|`` (``|S‴|``) is far above the knots'.
 
         Parameters
@@ -301,8 +260,10 @@ class KnotTable:
 
         Returns
         -------
-        list of KnotWarning
-            In segment order (for degree 7, ``A`` before ``J`` per segment).
+        list of Finding
+            ``KNOT_INCONSISTENT`` warnings in segment order (for degree 7, the acceleration before
+            the jerk per segment): ``from_deg``/``to_deg`` the segment, ``value`` the implied peak
+            and ``limit`` the largest knot magnitude, both in the table's ``a`` (``j``) unit.
         """
         segs = self.segments()
         _, vals = self.cycle_knots()
@@ -316,10 +277,10 @@ class KnotTable:
                 lo, hi, _, _ = _extremes(seg, nu)
                 peak = max(abs(lo), abs(hi))
                 if ref > floor and peak > ratio * ref:
-                    out.append(self._warning(i, seg, nu, peak, ref))
-        return sorted(out, key=lambda w: (w.segment, w.quantity))
+                    out.append((i, nu, self._warning(i, seg, nu, peak, ref)))
+        return [w for _, _, w in sorted(out, key=lambda t: (t[0], t[1]))]
 
-    def _warning(self, i: int, seg: Segment, nu: int, peak: float, ref: float) -> KnotWarning:
+    def _warning(self, i: int, seg: Segment, nu: int, peak: float, ref: float) -> Finding:
         key = "a" if nu == 2 else "j"
         unit = self.units[key]
         f = _factor(unit, nu + 1, self._omega())
@@ -328,7 +289,7 @@ class KnotTable:
         msg = (f"segment {i} ({lo:.6g}°–{hi:.6g}°): the {name} implied between the knots reaches "
                f"{peak / f:.6g} {unit}, {peak / ref:.3g}× the largest knot value ({ref / f:.6g} {unit}); "
                "the knot values are mutually inconsistent (rounded s?) — give them at full precision")
-        return KnotWarning(i, lo, hi, "A" if nu == 2 else "J", peak / f, ref / f, peak / ref, unit, msg)
+        return Finding(IssueCode.KNOT_INCONSISTENT, Severity.WARNING, lo, hi, peak / f, ref / f, msg)
 
     def _omega(self) -> float:
         return rpm_to_rad_s(self.speed_rpm) if self.speed_rpm else float("nan")

@@ -61,7 +61,7 @@ import numpy as np
 
 from ..errors import SpecError
 from .kinds import Axis, ContactKind
-from .solvers import extremum, integrate
+from ..numeric import extrema, extremum, integrate
 
 __all__ = [
     "MotionLike",
@@ -386,9 +386,8 @@ class CamGeometry:
         if profile not in memo:
             c = self.profiles[profile]
             edges = c.breakpoints
-            lo = extremum(lambda x: c.radius(x)[0], edges)
-            hi = extremum(lambda x: c.radius(x)[0], edges, maximize=True)
-            memo[profile] = Extremes(lo[1], lo[0], hi[1], hi[0])
+            lo, hi = extrema(lambda x: c.radius(x)[0], edges, (False, True), rows=(0, 0))
+            memo[profile] = Extremes(lo.value, lo.at, hi.value, hi.at)
         return memo[profile]
 
     @property

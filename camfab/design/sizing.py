@@ -9,23 +9,26 @@ below), or the geometric lower bound when the constraint never binds.
   roller (numerical).
 * :func:`min_base_radius_no_undercut` — rollers: min convex ρ_p = R_r.
 * :func:`min_base_radius_no_cusp` — flat faces: translating
-  ``R_b,min = −min(S + S″)`` (spec §5, Ejemplo3PT), oscillating numerical.
+  ``R_b,min = −min(S + S″)`` (ρ = R_b + S + S″ must stay ≥ 0), oscillating numerical.
 * :func:`optimal_offset` — the offset of a translating roller that minimises
-  the peak |pressure angle| (bounded Brent).
+  the peak |pressure angle|.
+
+The searches are :mod:`camfab.numeric`'s: bracketing root refinement for the radius at which a
+constraint becomes active, the global extremum search for the best offset.
 """
 from __future__ import annotations
 
 import dataclasses
 import math
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar
 
 from ..errors import SpecError
+from ..numeric import extremum, root
 from .checks import DEFAULT_PRESSURE_LIMIT_DEG
-from .mechanisms import (Mechanism, OscillatingFlat, OscillatingRoller, TranslatingFlat, TranslatingRoller)
-from .profile import CamGeometry, MotionLike, extremum
+from .mechanisms import Mechanism, OscillatingFlat, OscillatingRoller, TranslatingFlat, TranslatingRoller
+from .profile import CamGeometry, MotionLike
 
 __all__ = [
     "peak_pressure_angle_deg",
@@ -58,11 +61,16 @@ def _measure(mech: Mechanism, program: MotionLike, rb: float, fn: Callable) -> f
     return fn(g.profiles[0])
 
 
+def _each(f: Callable[[float], float]) -> Callable[[np.ndarray], np.ndarray]:
+    """A scalar function applied to every element of an array."""
+    return lambda xs: np.array([f(float(x)) for x in np.ravel(xs)])
+
+
 def _smallest(f: Callable[[float], float], lo: float, hi: float, n: int = 40) -> float:
     """Smallest r in [lo, hi] with f(r) <= 0 (the first feasible point from below).
 
-    Scans n points, then refines the infeasible→feasible step by Brent's method
-    (or bisection when the lower end cannot be built).
+    Scans n points, then refines the infeasible→feasible step to its root (f = +inf where the
+    geometry cannot be built counts as infeasible, so the step may cross a validity boundary).
     """
     rs = np.geomspace(lo, hi, n) if lo > 0 else np.linspace(lo, hi, n)
     vals = np.array([f(r) for r in rs])
@@ -72,18 +80,7 @@ def _smallest(f: Callable[[float], float], lo: float, hi: float, n: int = 40) ->
     i = int(good[0])
     if i == 0:
         return float(lo)
-    a, b, fa = rs[i - 1], rs[i], vals[i - 1]
-    if math.isfinite(fa):
-        return float(brentq(f, a, b, xtol=1e-13 * b, rtol=1e-15))
-    for _ in range(200):  # bisection across a geometric-validity boundary
-        m = 0.5 * (a + b)
-        if f(m) > 0:
-            a = m
-        else:
-            b = m
-        if b - a < 1e-13 * b:
-            break
-    return float(b)
+    return root(_each(f), float(rs[i - 1]), float(rs[i]), fa=vals[i - 1], fb=vals[i])
 
 
 def _upper(mech: Mechanism, program: MotionLike, f: Callable[[float], float], start: float) -> float:
@@ -171,7 +168,7 @@ def min_base_radius_no_cusp(mechanism: Mechanism, program: MotionLike) -> float:
     """Smallest R_b (mm) of a flat-face follower at which the profile's radius of
     curvature reaches 0 (a cusp); above it the profile is free of cusps.
 
-    Translating face: ``R_b,min = −min(S + S″)`` exactly (spec §5).
+    Translating face: ``R_b,min = −min(S + S″)`` exactly (its radius of curvature is R_b + S + S″).
     """
     if isinstance(mechanism, TranslatingFlat):
         g = lambda x: np.sum(program.evaluate(x, (0, 2)), axis=0)  # noqa: E731
@@ -187,8 +184,8 @@ def min_base_radius_no_cusp(mechanism: Mechanism, program: MotionLike) -> float:
 def optimal_offset(mechanism: TranslatingRoller, program: MotionLike) -> float:
     """Offset e (mm) that minimises the peak |pressure angle| of a translating roller.
 
-    Searched over |e| < 0.99·R_p by bounded Brent; the base and roller radii of
-    ``mechanism`` are kept.
+    Searched over |e| < 0.99·R_p (a coarse scan, then the best local minima refined to 1e-9 of
+    their bracket); the base and roller radii of ``mechanism`` are kept.
     """
     if not isinstance(mechanism, TranslatingRoller):
         raise TypeError("optimal_offset applies to translating roller followers")
@@ -197,5 +194,5 @@ def optimal_offset(mechanism: TranslatingRoller, program: MotionLike) -> float:
     def peak(e):
         return peak_pressure_angle_deg(dataclasses.replace(mechanism, offset_mm=e), program)
 
-    r = minimize_scalar(peak, bounds=(-0.99 * rp, 0.99 * rp), method="bounded", options={"xatol": 1e-7 * rp})
-    return float(r.x)
+    span = 0.99 * rp
+    return extremum(_each(peak), [-span, span], step=span / 4).at

@@ -15,11 +15,11 @@ from camfab.gcode.post import POSTS, dumps, get_post, write_gcode
 from camfab.gcode.toolpath import (Arc, Comment, Coolant, CutterComp, Feed, Job, Program, Rapid, Segment,
                                    Spindle, ToolChange, as_contour, contour_toolpath, offset_contour,
                                    orient_contour)
-from camfab.gcode.verify import VerifyProblem, VerifyReport, verify
+from camfab.gcode.verify import VerifyReport, verify
 
 __all__ = [
     "Arc", "Backplot", "Comment", "ContourDistance", "Coolant", "CutterComp", "Feed", "GcodeError", "Job",
-    "Move", "POSTS", "Program", "Rapid", "Samples", "Segment", "Spindle", "ToolChange", "VerifyProblem",
+    "Move", "POSTS", "Program", "Rapid", "Samples", "Segment", "Spindle", "ToolChange",
     "VerifyReport", "arc_sweep", "as_contour", "backplot", "contour_toolpath", "dumps", "get_post",
     "lift_angles", "lift_table_csv", "offset_contour", "orient_contour", "parse", "sample", "simulate_compensation", "verify",
     "write_gcode", "write_lift_table",

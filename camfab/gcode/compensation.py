@@ -30,36 +30,27 @@ point, so what is cut is the same:
   Switching G41 <-> G42 without G40 between is reported (``COMP_SIDE_CHANGE``) and treated as an exit
   plus a new entry.
 
-Everything stays in mm and the XY plane (G17); Z of each move is interpolated along it.  The offsets and
-tangents of all moves are computed at once with numpy; the corner joins, which depend on each other (a
-trimmed move), run in one pass over the moves.
+Everything stays in mm and the XY plane (G17); Z of each move is interpolated along it.  Offsets and tangents
+of all moves are computed at once; the corner joins, which depend on each other, run in one pass.
 """
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
-from typing import Sequence
 
 import numpy as np
 
 from camfab.gcode.geom import TWO_PI, arc_sweep
 from camfab.gcode.parse import Move
+from camfab.results import Finding, IssueCode
 
-__all__ = ["CompProblem", "CompensatedPath", "simulate_compensation", "move_lengths"]
+__all__ = ["CompensatedPath", "simulate_compensation", "move_lengths"]
 
 #: offset moves whose ends are closer than this (mm) join without a corner move
 JOIN_EPS_MM = 1e-9
 #: relative slack on the parameter range of a move when trimming at a concave corner
 _T_EPS = 1e-9
-
-
-@dataclass(frozen=True)
-class CompProblem:
-    """A compensation finding: ``code``, a sentence, the program line (1-based) when known."""
-
-    code: str
-    message: str
-    line: int | None = None
 
 
 @dataclass(frozen=True)
@@ -92,7 +83,8 @@ class CompensatedPath:
         Index into ``runs`` of the compensated stretch each output move belongs to (its exit included),
         ``-1`` outside.
     runs : tuple of CompRun
-    problems : tuple of CompProblem
+    problems : tuple of Finding
+        The compensation findings (``COMP_*``), each with its program line.
     radius : float
         The compensation radius used, mm.
     corners : dict
@@ -125,10 +117,9 @@ def move_lengths(moves: Sequence[Move]) -> np.ndarray:
     return out
 
 
+
 # --------------------------------------------------------------------------------------------------
 # pieces: one offset move whose ends can still be trimmed
-
-
 def _rot(v):
     return np.array([-v[1], v[0]])
 
@@ -146,13 +137,10 @@ class _Piece:
 
     def __init__(self, src, kind, *, a=None, b=None, c=None, a0=0.0, sw=0.0, r0=0.0, r1=0.0, z0=math.nan,
                  z1=math.nan, tan_in=None, tan_out=None, p_start=None, p_end=None, exact=True):
-        self.src = src
-        self.kind = kind
-        self.arc = c is not None
+        self.src, self.kind, self.arc = src, kind, c is not None
         self.a, self.b, self.c = a, b, c
         self.a0, self.sw, self.r0, self.r1 = a0, sw, r0, r1
-        self.z0, self.z1 = z0, z1
-        self.t0, self.t1 = 0.0, 1.0
+        self.z0, self.z1, self.t0, self.t1 = z0, z1, 0.0, 1.0
         self.tan_in, self.tan_out = tan_in, tan_out
         self.p_start, self.p_end = p_start, p_end
         self.exact = exact  # ends at distance r from the programmed end points (corners can be rolled)
@@ -202,8 +190,7 @@ class _Piece:
 
 
 def _line_piece(src, kind, a, b, z0, z1, p_start=None, p_end=None, exact=True):
-    a = np.asarray(a, float)
-    b = np.asarray(b, float)
+    a, b = np.asarray(a, float), np.asarray(b, float)
     d = b - a
     L = float(np.hypot(*d))
     t = d / L if L > 0 else np.array([1.0, 0.0])
@@ -211,10 +198,9 @@ def _line_piece(src, kind, a, b, z0, z1, p_start=None, p_end=None, exact=True):
                   exact=exact)
 
 
+
 # --------------------------------------------------------------------------------------------------
 # intersections of pieces (as infinite lines / full circles)
-
-
 def _ll(a1, d1, a2, d2):
     den = _cross(d1, d2)
     scale = float(np.hypot(*d1) * np.hypot(*d2))
@@ -282,36 +268,33 @@ def _intersect(p: _Piece, q: _Piece, corner: np.ndarray):
     return None if best is None else best[1:]
 
 
+
 # --------------------------------------------------------------------------------------------------
 # the simulation
-
-
 def _has_xy(m: Move) -> bool:
-    if m.kind == "arc":
-        return True
+    """An arc, or a move to a known X/Y from an unknown one or from farther than :data:`JOIN_EPS_MM`."""
     s, e = m.start, m.end
-    if not (math.isfinite(e[0]) and math.isfinite(e[1])):
-        return False
-    if not (math.isfinite(s[0]) and math.isfinite(s[1])):
-        return True
-    return math.hypot(e[0] - s[0], e[1] - s[1]) > JOIN_EPS_MM
+    if m.kind == "arc" or not (math.isfinite(e[0]) and math.isfinite(e[1])):
+        return m.kind == "arc"
+    known = math.isfinite(s[0]) and math.isfinite(s[1])
+    return not known or math.hypot(e[0] - s[0], e[1] - s[1]) > JOIN_EPS_MM
 
 
 class _Sim:
     def __init__(self, moves, r, swap, join_tol):
-        self.m = moves
-        self.r = float(r)
-        self.swap = swap
-        self.join_tol = join_tol
+        self.m, self.r, self.swap, self.join_tol = moves, float(r), swap, join_tol
         self.out: list[Move] = []
         self.src: list[int] = []
         self.kind: list[str] = []
         self.run: list[int] = []
         self.runs: list[CompRun] = []
-        self.problems: list[CompProblem] = []
+        self.problems: list[Finding] = []
         self.corners = {"rolling": 0, "trimmed": 0, "failed": 0}
         self.tool = None  # tool XY when it differs from the programmed position (after compensation)
         self.last_run = -1
+
+    def report(self, code: IssueCode, message: str, line: int | None) -> None:
+        self.problems.append(Finding.at_line(code, message, line))
 
     def emit(self, mv: Move, src: int, kind: str, run: int) -> None:
         self.out.append(mv)
@@ -348,16 +331,14 @@ class _Sim:
         if m.comp != "G40":
             return  # a side change: reported as COMP_SIDE_CHANGE
         if m.kind == "arc":
-            self.problems.append(CompProblem(
-                "COMP_EXIT", "the exit move after G40 is an arc: compensation must be turned off during a "
-                f"straight move (G0/G1) at least the tool diameter ({2 * self.r:.4f} mm) long", m.line))
+            self.report(IssueCode.COMP_EXIT, "the exit move after G40 is an arc: compensation must be turned off "
+                        f"during a straight move (G0/G1) at least the tool diameter ({2 * self.r:.4f} mm) long", m.line)
             return
         L = math.hypot(m.end[0] - m.start[0], m.end[1] - m.start[1])
-        if L < 2 * self.r - self.join_tol:
-            self.problems.append(CompProblem(
-                "COMP_EXIT", f"the exit move after G40 is {L:.4f} mm long, shorter than the tool diameter "
-                f"{2 * self.r:.4f} mm: the controller cannot ramp the compensation off (LinuxCNC refuses it)",
-                m.line))
+        if 2 * self.r - self.join_tol > L:
+            self.report(IssueCode.COMP_EXIT, f"the exit move after G40 is {L:.4f} mm long, shorter than the tool "
+                        f"diameter {2 * self.r:.4f} mm: the controller cannot ramp the compensation off (LinuxCNC "
+                        "refuses it)", m.line)
 
     # -- one compensated stretch -------------------------------------------------------------------
     def stretch(self, lo: int, hi: int) -> None:
@@ -374,15 +355,11 @@ class _Sim:
             for k in range(lo, hi):
                 self.plain(k, run)
             return
-        # position of the tool before the entry
         e = self.m[xy[0]]
-        if self.tool is not None:
-            cur = np.array(self.tool, float)
-        else:
-            cur = np.array(e.start[:2], float)
+        cur = np.array(self.tool if self.tool is not None else e.start[:2], float)  # the tool before the entry
         if not np.all(np.isfinite(cur)):
-            self.problems.append(CompProblem("COMP_ENTRY", f"{side} is turned on before the X/Y position is "
-                                             "known: the compensation cannot be simulated", e.line))
+            self.report(IssueCode.COMP_ENTRY, f"{side} is turned on before the X/Y position is known: the "
+                        "compensation cannot be simulated", e.line)
             for k in range(lo, hi):
                 self.plain(k, run)
             return
@@ -392,9 +369,9 @@ class _Sim:
         pieces = [self._entry(xy[0], cur, sgn, side)] + self._offsets(xy[1:], sgn, side)
         # Z-only moves between two XY moves go with the junction after the first of them (an arc that
         # cannot be offset - a None piece - hands its own over to the piece before it)
-        zs = [list(range(a + 1, b)) for a, b in zip(xy[:-1], xy[1:])] + [[]]
+        zs = [list(range(a + 1, b)) for a, b in zip(xy[:-1], xy[1:], strict=True)] + [[]]
         pending, pz = pieces[0], list(zs[0])
-        for q, qz in zip(pieces[1:], zs[1:]):
+        for q, qz in zip(pieces[1:], zs[1:], strict=True):
             if q is None:
                 pz += qz
                 continue
@@ -415,9 +392,8 @@ class _Sim:
         P = np.array(m.end[:2], float)
         z0, z1 = m.start[2], m.end[2]
         if m.kind == "arc":
-            self.problems.append(CompProblem(
-                "COMP_ENTRY", f"the {side} entry move is an arc: compensation must be turned on during a "
-                "straight move (G0/G1) longer than the tool radius", m.line))
+            self.report(IssueCode.COMP_ENTRY, f"the {side} entry move is an arc: compensation must be turned on "
+                        "during a straight move (G0/G1) longer than the tool radius", m.line)
             cx, cy = m.center
             rs = math.hypot(cur[0] - cx, cur[1] - cy)
             a0 = math.atan2(cur[1] - cy, cur[0] - cx)
@@ -431,10 +407,9 @@ class _Sim:
             return pc
         d = float(np.hypot(*(P - cur)))
         if d <= r * (1 + 1e-9):
-            self.problems.append(CompProblem(
-                "COMP_ENTRY", f"the {side} entry move is {d:.4f} mm long, not longer than the tool radius "
-                f"{r:.4f} mm: the controller cannot ramp the compensation on (LinuxCNC stops with 'length "
-                "of cutter compensation entry move is not greater than the tool radius')", m.line))
+            self.report(IssueCode.COMP_ENTRY, f"the {side} entry move is {d:.4f} mm long, not longer than the tool "
+                        f"radius {r:.4f} mm: the controller cannot ramp the compensation on (LinuxCNC stops with "
+                        "'length of cutter compensation entry move is not greater than the tool radius')", m.line)
             if d <= JOIN_EPS_MM:
                 return _line_piece(k, "entry", cur, cur, z0, z1, p_end=P, exact=False)
             u = (P - cur) / d
@@ -490,11 +465,10 @@ class _Sim:
                 out.append(pc)
                 continue
             if min(RS2[j], RE2[j]) <= 0.0:
-                self.problems.append(CompProblem(
-                    "COMP_ARC_RADIUS", f"arc radius smaller than tool radius under {side}: the "
-                    f"{'G3' if ccw[j] else 'G2'} arc of radius {RS[j]:.4f} mm about X{C[j, 0]:.4f} "
-                    f"Y{C[j, 1]:.4f} has the tool ({r:.4f} mm) on its centre's side; the largest tool that "
-                    f"fits has diameter {2 * min(RS[j], RE[j]):.4f} mm", m.line))
+                self.report(IssueCode.COMP_ARC_RADIUS, f"arc radius smaller than tool radius under {side}: the "
+                            f"{'G3' if ccw[j] else 'G2'} arc of radius {RS[j]:.4f} mm about X{C[j, 0]:.4f} "
+                            f"Y{C[j, 1]:.4f} has the tool ({r:.4f} mm) on its centre's side; the largest tool "
+                            f"that fits has diameter {2 * min(RS[j], RE[j]):.4f} mm", m.line)
                 out.append(None)
                 continue
             out.append(_Piece(k, "offset", c=C[j], a0=float(A0[j]), sw=float(SW[j]), r0=float(RS2[j]),
@@ -533,11 +507,11 @@ class _Sim:
                         if gap > self.join_tol:
                             self.corners["failed"] += 1
                             mp, mq = self.m[p.src], self.m[q.src]
-                            self.problems.append(CompProblem(
-                                "COMP_CORNER", f"concave corner at X{corner[0]:.4f} Y{corner[1]:.4f} (lines "
-                                f"{mp.line} and {mq.line}) is too tight for the tool radius {r:.4f} mm under "
-                                f"{mq.comp}: the offset moves do not meet (a notch or a move shorter than the "
-                                "tool needs); the tool would cut into the part", mq.line))
+                            self.report(IssueCode.COMP_CORNER, f"concave corner at X{corner[0]:.4f} "
+                                        f"Y{corner[1]:.4f} (lines {mp.line} and {mq.line}) is too tight for the tool "
+                                        f"radius {r:.4f} mm under {mq.comp}: the offset moves do not meet (a notch or "
+                                        "a move shorter than the tool needs); the tool would cut into the part",
+                                        mq.line)
         self.emit(p.to_move(self.m[p.src]), p.src, p.kind, run)
         E = p.point(p.t1)
         z = p.z(p.t1)
@@ -611,9 +585,8 @@ def simulate_compensation(moves: Sequence[Move], radius: float, *, swap_side: bo
         while j < n and moves[j].comp == m.comp:
             j += 1
         if prev_side != "G40":
-            sim.problems.append(CompProblem(
-                "COMP_SIDE_CHANGE", f"{m.comp} while {prev_side} is active: cancel compensation with G40 "
-                "(and an exit move) before changing sides", m.line))
+            sim.report(IssueCode.COMP_SIDE_CHANGE, f"{m.comp} while {prev_side} is active: cancel compensation "
+                       "with G40 (and an exit move) before changing sides", m.line)
         if radius == 0:
             for k in range(i, j):
                 sim.plain(k)

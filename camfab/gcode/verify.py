@@ -36,30 +36,18 @@ the line of the programmed move they lead into.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Callable, Sequence
 
 import numpy as np
 
 from camfab.gcode.compensation import CompensatedPath, simulate_compensation
 from camfab.gcode.parse import Backplot, sample
+from camfab.results import Finding, IssueCode, Severity
 
-__all__ = ["VerifyProblem", "VerifyReport", "verify"]
+__all__ = ["VerifyReport", "verify"]
 
 _EPS_Z = 1e-6
-
-
-@dataclass(frozen=True)
-class VerifyProblem:
-    """One finding: a code, a sentence, and the program line (1-based) when known."""
-
-    code: str
-    message: str
-    line: int | None = None
-
-    def to_dict(self) -> dict:
-        """JSON-ready mapping."""
-        return {"code": self.code, "message": self.message, "line": self.line}
 
 
 @dataclass(frozen=True)
@@ -74,7 +62,8 @@ class VerifyReport:
     gouge : bool
     gouge_at : dict or None
         Worst gouge: ``x``, ``y``, ``z``, ``line``, ``penetration_mm`` (how far the tool enters the part).
-    problems : tuple of VerifyProblem
+    problems : tuple of Finding
+        Each with its code, sentence and program line (1-based) when known.
     tolerance_mm : float
     coverage_gap_mm : float or None
     finish_moves : int
@@ -96,7 +85,7 @@ class VerifyReport:
         """True when there are no problems."""
         return not self.problems
 
-    def codes(self) -> set[str]:
+    def codes(self) -> set[IssueCode]:
         """The set of problem codes."""
         return {p.code for p in self.problems}
 
@@ -107,7 +96,7 @@ class VerifyReport:
             "max_deviation_mm": self.max_deviation_mm,
             "gouge": self.gouge,
             "gouge_at": self.gouge_at,
-            "problems": [p.to_dict() for p in self.problems],
+            "problems": [{"code": p.code.value, "message": p.message, "line": p.line} for p in self.problems],
             "ok": self.ok,
             "tolerance_mm": self.tolerance_mm,
             "coverage_gap_mm": self.coverage_gap_mm,
@@ -159,11 +148,11 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
     -------
     VerifyReport
     """
-    problems: list[VerifyProblem] = []
+    problems: list[Finding] = []
     notes: list[str] = []
     if isinstance(moves, Backplot):
         for w in moves.warnings:
-            problems.append(VerifyProblem("PARSE_WARNING", w))
+            problems.append(Finding.at_line(IssueCode.PARSE_WARNING, w, severity=Severity.WARNING))
         moves = moves.moves
     moves = list(moves)
     if step is None:
@@ -172,26 +161,26 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
 
     cutting = [i for i, m in enumerate(moves) if m.is_cutting]
     if not cutting:
-        problems.append(VerifyProblem("NO_CUTTING_MOVES", "the program has no cutting moves"))
+        problems.append(Finding.at_line(IssueCode.NO_CUTTING_MOVES, "the program has no cutting moves"))
 
     # -- feed and spindle --------------------------------------------------------------------------
     if cutting:
         m0 = moves[cutting[0]]
         if m0.feed is None or m0.feed <= 0:
-            problems.append(VerifyProblem("FEED_MISSING", "the first cutting move runs without a feed "
+            problems.append(Finding.at_line(IssueCode.FEED_MISSING, "the first cutting move runs without a feed "
                                           "(no F word before it, or F0)", m0.line))
     for i in cutting:
         m = moves[i]
         if not m.spindle_on and min(m.start[2], m.end[2]) < top_z - _EPS_Z:
-            problems.append(VerifyProblem("SPINDLE_OFF", "cutting below the stock top with the spindle off",
+            problems.append(Finding.at_line(IssueCode.SPINDLE_OFF, "cutting below the stock top with the spindle off",
                                           m.line))
             break
 
     # -- arcs ----------------------------------------------------------------------------------------
     for m in moves:
         if m.kind == "arc" and abs(m.radius_start - m.radius_end) > tol:
-            problems.append(VerifyProblem(
-                "ARC_RADIUS_MISMATCH", f"arc start and end radii differ by "
+            problems.append(Finding.at_line(
+                IssueCode.ARC_RADIUS_MISMATCH, f"arc start and end radii differ by "
                 f"{abs(m.radius_start - m.radius_end):.4f} mm (> tol {tol} mm)", m.line))
 
     # -- cutter compensation: simulate it, then check the tool-centre path ------------------------------
@@ -201,7 +190,7 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
     join_tol = max(0.1 * tol, 1e-6)
     if any(m.comp != "G40" for m in moves):
         comp_path = simulate_compensation(moves, r_comp, join_tol=join_tol)
-        problems.extend(VerifyProblem(p.code, p.message, p.line) for p in comp_path.problems)
+        problems.extend(comp_path.problems)
         c = comp_path.corners
         notes.append(f"cutter compensation simulated with radius {r_comp:g} mm over {len(comp_path.runs)} "
                      f"G41/G42 stretch(es): {c['rolling']} rolling corner arc(s), {c['trimmed']} trimmed "
@@ -226,8 +215,8 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
                 gouge_at = {"x": _r(p[w, 0]), "y": _r(p[w, 1]), "z": _r(p[w, 2]),
                             "line": moves[int(ii[w])].line, "penetration_mm": _r(pen[w])}
                 lines = sorted({moves[int(i)].line for i in ii[bad]})
-                problems.append(VerifyProblem(
-                    "GOUGE", f"the tool enters the finished profile by up to {pen[w]:.4f} mm "
+                problems.append(Finding.at_line(
+                    IssueCode.GOUGE, f"the tool enters the finished profile by up to {pen[w]:.4f} mm "
                     f"(> tol {tol} mm) at X{p[w, 0]:.4f} Y{p[w, 1]:.4f} Z{p[w, 2]:.4f}; "
                     f"lines {_line_list(lines)}", moves[int(ii[w])].line))
                 if comp_path is not None:
@@ -263,17 +252,17 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
         w = int(np.argmax(dev))
         max_dev = _r(dev[w])
         if dev[w] > tol:
-            problems.append(VerifyProblem(
-                "DEVIATION", f"the finishing pass deviates {dev[w]:.4f} mm from the exact curve "
+            problems.append(Finding.at_line(
+                IssueCode.DEVIATION, f"the finishing pass deviates {dev[w]:.4f} mm from the exact curve "
                 f"(> tol {tol} mm) at X{pts[w, 0]:.4f} Y{pts[w, 1]:.4f}", moves[int(idx[w])].line))
         if curve_points is not None:
             gap = _r(_coverage_gap(np.asarray(curve_points, float).reshape(-1, 2), pts[:, :2], idx, step))
             if gap > tol:
-                problems.append(VerifyProblem(
-                    "COVERAGE", f"part of the exact curve is {gap:.4f} mm from the finishing pass "
+                problems.append(Finding.at_line(
+                    IssueCode.COVERAGE, f"part of the exact curve is {gap:.4f} mm from the finishing pass "
                     f"(> tol {tol} mm): the program does not cut the whole contour"))
     elif cutting:
-        problems.append(VerifyProblem("NO_FINISH_PASS", "no horizontal cutting moves at final depth"))
+        problems.append(Finding.at_line(IssueCode.NO_FINISH_PASS, "no horizontal cutting moves at final depth"))
 
     # -- rapids --------------------------------------------------------------------------------------
     rapids = [i for i, m in enumerate(moves) if m.kind == "rapid"]
@@ -289,13 +278,13 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
         if xy_travel:
             zs = [v for v in (s[2], e[2])]
             if any(math.isnan(v) for v in zs):
-                problems.append(VerifyProblem("RAPID_BELOW_SAFE", "horizontal rapid before the height is "
+                problems.append(Finding.at_line(IssueCode.RAPID_BELOW_SAFE, "horizontal rapid before the height is "
                                               "known (retract Z first)", m.line))
             elif min(zs) < safe_z - tol:
-                problems.append(VerifyProblem("RAPID_BELOW_SAFE", f"horizontal rapid at Z{min(zs):.4f}, "
+                problems.append(Finding.at_line(IssueCode.RAPID_BELOW_SAFE, f"horizontal rapid at Z{min(zs):.4f}, "
                                               f"below the safe height Z{safe_z:.4f}", m.line))
         if math.isfinite(e[2]) and e[2] < top_z - _EPS_Z and (not math.isfinite(s[2]) or e[2] < s[2] - _EPS_Z):
-            problems.append(VerifyProblem("RAPID_INTO_STOCK", f"rapid descends to Z{e[2]:.4f}, below the "
+            problems.append(Finding.at_line(IssueCode.RAPID_INTO_STOCK, f"rapid descends to Z{e[2]:.4f}, below the "
                                           f"stock top Z{top_z:.4f}", m.line))
     if rapids:
         smp = sample([moves[i] for i in rapids], step)
@@ -305,7 +294,7 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
             d = np.asarray(part_distance(pts[below, :2]), dtype=float)
             hit = d < r_tool - tol
             for i in sorted(set(idx[below][hit].tolist())):
-                problems.append(VerifyProblem("RAPID_THROUGH_PART", "rapid below the stock top runs the "
+                problems.append(Finding.at_line(IssueCode.RAPID_THROUGH_PART, "rapid below the stock top runs the "
                                               "tool through the part", moves[i].line))
 
     problems.sort(key=lambda p: (p.line if p.line is not None else -1, p.code))
@@ -315,7 +304,7 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
 
 
 def _wrong_side(comp_path: CompensatedPath, programmed, worst: dict, part_distance, r_tool: float,
-                r_comp: float, tol: float, top_z: float, step: float, join_tol: float) -> list[VerifyProblem]:
+                r_comp: float, tol: float, top_z: float, step: float, join_tol: float) -> list[Finding]:
     """``COMP_WRONG_SIDE`` for each gouging G41/G42 stretch that would not gouge on the other side."""
     swapped = simulate_compensation(programmed, r_comp, swap_side=True, join_tol=join_tol)
     out = []
@@ -332,8 +321,8 @@ def _wrong_side(comp_path: CompensatedPath, programmed, worst: dict, part_distan
         if float(pen.max()) > tol:
             continue
         other = "G42" if info.side == "G41" else "G41"
-        out.append(VerifyProblem(
-            "COMP_WRONG_SIDE", f"{info.side} (lines {info.first_line}-{info.last_line}) compensates to the "
+        out.append(Finding.at_line(
+            IssueCode.COMP_WRONG_SIDE, f"{info.side} (lines {info.first_line}-{info.last_line}) compensates to the "
             f"wrong side of the contour: the tool cuts up to {pen_now:.4f} mm into the part; with {other} "
             "it would not gouge", info.entry_line if info.entry_line is not None else info.first_line))
     return out

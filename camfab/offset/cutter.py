@@ -88,8 +88,7 @@ def concave_limit(contact) -> tuple[float, list[tuple[float, float]]]:
     ``ranges`` lists ``(from, to)`` of the concave stretches in degrees (mm for
     a translating cam).
     """
-    from ..design.checks import positive_ranges
-    from ..design.profile import extremum
+    from ..numeric import extremum, positive_ranges
 
     edges = contact.breakpoints
     x, kmin = extremum(lambda t: contact.evaluate(t).curvature, edges)
@@ -100,7 +99,7 @@ def concave_limit(contact) -> tuple[float, list[tuple[float, float]]]:
 
 
 def _refuse_if_too_big(contact, tool_radius: float, label: str) -> None:
-    from ..design.checks import positive_ranges
+    from ..numeric import positive_ranges
 
     fits, _ = concave_limit(contact)
     if tool_radius < fits:

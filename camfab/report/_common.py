@@ -11,18 +11,18 @@ from typing import Any
 
 import numpy as np
 
+from ..results import CURVATURE_CODES, JUMP_CODES, IssueCode, Severity, Verdict
+
 __all__ = ["Axis", "axis_of", "sample_grid", "finding_spans", "fmt", "fmt_at", "range_text",
            "conclusions_rows", "VERDICT_TEXT", "VERDICT_CLASS", "mechanism_text", "key_values",
            "CURVATURE_CODES"]
 
 #: verdict → headline (same words as ``camfab check``)
-VERDICT_TEXT = {"acceptable": "Cam OK (acceptable)",
-                "not_for_high_speed": "Not suitable for high speeds",
-                "unacceptable": "Cam KO (unacceptable)"}
+VERDICT_TEXT = {Verdict.ACCEPTABLE: "Cam OK (acceptable)",
+                Verdict.NOT_FOR_HIGH_SPEED: "Not suitable for high speeds",
+                Verdict.UNACCEPTABLE: "Cam KO (unacceptable)"}
 #: verdict → CSS class / colour family
-VERDICT_CLASS = {"acceptable": "ok", "not_for_high_speed": "warn", "unacceptable": "bad"}
-#: finding codes shaded on the radius-of-curvature plot
-CURVATURE_CODES = ("UNDERCUT", "CUSP", "CONCAVE_RADIUS_BELOW_ROLLER")
+VERDICT_CLASS = {Verdict.ACCEPTABLE: "ok", Verdict.NOT_FOR_HIGH_SPEED: "warn", Verdict.UNACCEPTABLE: "bad"}
 
 
 @dataclass(frozen=True)
@@ -153,70 +153,67 @@ def conclusions_rows(spec, report) -> list[dict[str, Any]]:
     Each row has ``concept``, ``max`` and ``min`` cells (``text``, ``value`` – the exact
     report number –, ``at``, ``at_value``), ``comment`` and ``status`` ("ok", "warn", "bad").
     """
-    d = report.to_dict()
     lu = spec.follower.lift_unit
     xu = "°" if report.x_unit == "deg" else "mm"
     codes = report.codes()
-    jumps = {"V": "VELOCITY_DISCONTINUITY", "A": "ACCELERATION_DISCONTINUITY", "J": "JERK_DISCONTINUITY"}
     names = {"S": f"Displacement ({lu})", "V": f"Velocity ({lu}/s)", "A": f"Acceleration ({lu}/s²)",
              "J": f"Jerk ({lu}/s³)"}
     rows = []
-    for q, p in (d.get("peaks") or {}).items():
-        jump = q in jumps and jumps[q] in codes
-        sev = {f.severity for f in report.findings if q in jumps and f.code == jumps[q]}
-        rows.append({"concept": names[q], "max": _cell(p["max"], p["at_max_deg"], xu),
-                     "min": _cell(p["min"], p["at_min_deg"], xu),
+    for q, p in report.motion.peaks.items() if report.motion is not None else ():
+        jump = q in JUMP_CODES and JUMP_CODES[q] in codes
+        sev = {f.severity for f in report.findings if q in JUMP_CODES and f.code == JUMP_CODES[q]}
+        rows.append({"concept": names[q], "max": _cell(p.max, p.at_max, xu), "min": _cell(p.min, p.at_min, xu),
                      "comment": "Discontinuous" if jump else "Continuous",
-                     "status": ("bad" if "error" in sev else "warn") if jump else "ok"})
-    roc = d.get("radius_of_curvature_mm") or {}
-    if roc:
-        bad = codes & {"UNDERCUT", "CUSP"}
+                     "status": ("bad" if Severity.ERROR in sev else "warn") if jump else "ok"})
+    roc = report.curvature
+    if roc is not None:
+        bad = codes & {IssueCode.UNDERCUT, IssueCode.CUSP}
         rows.append({"concept": "Convex radius of curvature (mm)", "max": _cell(None),
-                     "min": _cell(roc.get("min_convex"), roc.get("at_deg"), xu),
+                     "min": _cell(roc.min_convex, roc.at_min_convex, xu),
                      "comment": "Undercut or cusp: see the findings" if bad
                      else "The profile is free of cusps and undercuts", "status": "bad" if bad else "ok"})
-        if roc.get("min_concave") is not None:
-            tight = "CONCAVE_RADIUS_BELOW_ROLLER" in codes
+        if roc.min_concave is not None:
+            tight = IssueCode.CONCAVE_RADIUS_BELOW_ROLLER in codes
             rows.append({"concept": "Concave radius of curvature (mm)", "max": _cell(None),
-                         "min": _cell(roc["min_concave"], roc.get("at_min_concave_deg"), xu),
+                         "min": _cell(roc.min_concave, roc.at_min_concave, xu),
                          "comment": "Tighter than the cutter: see the findings" if tight
                          else "Smallest concave radius (the cutter must be smaller)",
                          "status": "warn" if tight else "ok"})
-    pa = d.get("pressure_angle_deg")
-    if pa:
-        ok = "PRESSURE_ANGLE_EXCEEDED" not in codes
-        rows.append({"concept": "Pressure angle (°)", "max": _cell(pa["max"], pa["at_max_deg"], xu),
-                     "min": _cell(pa["min"], pa["at_min_deg"], xu),
-                     "comment": (f"Acceptable (limit ±{pa.get('limit', 0):g}°)" if ok
-                                 else f"High pressure angle (> {pa.get('limit', 0):g}°)"),
+    pa = report.pressure_angle
+    if pa is not None:
+        ok = IssueCode.PRESSURE_ANGLE_EXCEEDED not in codes
+        rows.append({"concept": "Pressure angle (°)", "max": _cell(pa.max, pa.at_max, xu),
+                     "min": _cell(pa.min, pa.at_min, xu),
+                     "comment": (f"Acceptable (limit ±{pa.limit:g}°)" if ok
+                                 else f"High pressure angle (> {pa.limit:g}°)"),
                      "status": "ok" if ok else "bad"})
-    face = d.get("face_length_mm")
-    if face:
-        if face.get("left") is not None:
-            rows.append({"concept": "Face length left / right (mm)", "max": _cell(face["left"]),
-                         "min": _cell(face["right"]),
+    face = report.face_length
+    if face is not None:
+        if face.left is not None:
+            rows.append({"concept": "Face length left / right (mm)", "max": _cell(face.left),
+                         "min": _cell(face.right),
                          "comment": "Minimum face length on each side of the stem to keep contact",
                          "status": "ok"})
         else:
-            rows.append({"concept": "Contact along the face (mm)", "max": _cell(face["max"]),
-                         "min": _cell(face["min"]), "comment": "Distance of the contact from the face vertex",
+            rows.append({"concept": "Contact along the face (mm)", "max": _cell(face.max),
+                         "min": _cell(face.min), "comment": "Distance of the contact from the face vertex",
                          "status": "ok"})
     return rows
 
 
 def key_values(report) -> list[tuple[str, str, float | None]]:
     """Dimensions of the cam: ``[(label, text, exact value), ...]`` (rows that do not apply are left out)."""
-    d = report.to_dict()
     out = []
-    rb, rmax = d.get("base_radius_mm"), d.get("max_radius_mm")
+    rb, rmax = report.base_radius_mm, report.max_radius_mm
     if rb is not None:
         out.append(("Minimum radius Rmin (mm)", fmt(rb, 3), rb))
         out.append(("DMIN = 2·Rmin (mm)", fmt(2 * rb, 3), 2 * rb))
     if rmax is not None:
         out.append(("Maximum radius Rmax (mm)", fmt(rmax, 3), rmax))
         out.append(("DMAX = 2·Rmax (mm)", fmt(2 * rmax, 3), 2 * rmax))
-    if d.get("area_mm2") is not None:
-        out.append(("Profile area (mm²)", fmt(d["area_mm2"], 2), d["area_mm2"]))
-    if d.get("initial_arm_angle_deg") is not None:
-        out.append(("Initial arm angle ξ₀ (°)", fmt(d["initial_arm_angle_deg"], 3), d["initial_arm_angle_deg"]))
+    if report.area_mm2 is not None:
+        out.append(("Profile area (mm²)", fmt(report.area_mm2, 2), report.area_mm2))
+    if report.initial_arm_angle_deg is not None:
+        arm = report.initial_arm_angle_deg
+        out.append(("Initial arm angle ξ₀ (°)", fmt(arm, 3), arm))
     return out

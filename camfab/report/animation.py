@@ -78,7 +78,7 @@ def animation_data(spec, geometry, report, *, frames: int = 360, outline_points:
     if spec.cam.kind in ("constant_width", "constant_diameter") and len(geometry.profiles) == 1:
         pairs.append((0, math.pi))
     if closed:
-        rmax = report.to_dict().get("max_radius_mm") or float(np.max(np.hypot(*geometry.evaluate(x).point.T)))
+        rmax = report.max_radius_mm or float(np.max(np.hypot(*geometry.evaluate(x).point.T)))
     else:  # a translating cam: its height sets the scale
         rmax = float(np.max(geometry.evaluate(x).point[:, 1])) + geometry.profiles[0].roller_radius
     stem = 0.9 * rmax
@@ -117,7 +117,7 @@ def animation_data(spec, geometry, report, *, frames: int = 360, outline_points:
     c0 = geometry.profiles[0]
     if getattr(c0, "xi0", None) is not None:
         pivot = [float(c0.m), 0.0]
-    pa_lim = (report.to_dict().get("pressure_angle_deg") or {}).get("limit")
+    pa_lim = report.pressure_angle.limit if report.pressure_angle is not None else None
     return {
         "name": spec.name, "closed": closed, "sense": int(sense), "unit": axis.unit,
         "period": axis.user_period, "lift_unit": f0.lift_unit,

@@ -12,6 +12,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from ..results import Severity
 from ._common import VERDICT_CLASS, VERDICT_TEXT, axis_of, fmt, mechanism_text, sample_grid
 from .plots import SVAJ_UNITS, _off_view, new_figure, plot_style
 
@@ -77,7 +78,7 @@ def compare_svaj_figure(items, labels: Sequence[str] | None = None):
 def compare_curvature_figure(items, labels: Sequence[str] | None = None):
     """Radius of curvature of every design's profile(s), overlaid (view clipped at ±3·Rmax)."""
     labels = list(labels or design_labels(items))
-    rmax = max((r.to_dict().get("max_radius_mm") or 50.0) for _, _, r in items)
+    rmax = max((r.max_radius_mm or 50.0) for _, _, r in items)
     lim = 3.0 * rmax
     with plot_style():
         fig = new_figure(9.0, 4.4)
@@ -115,7 +116,7 @@ def compare_pressure_angle_figure(items, labels: Sequence[str] | None = None):
                     continue
                 ax.plot(x * axis.scale, np.degrees(pa), color=f"C{i}", ls="-" if k == 0 else "--",
                         label=labels[i] + (f" cam {k + 1}" if len(geom.profiles) > 1 else ""))
-            lim = (rep.to_dict().get("pressure_angle_deg") or {}).get("limit")
+            lim = rep.pressure_angle.limit if rep.pressure_angle is not None else None
             if lim is not None:
                 for sgn in (1, -1):
                     ax.axhline(sgn * lim, color=f"C{i}", lw=0.9, ls=(0, (5, 3)),
@@ -139,67 +140,72 @@ def _t(text: str, cls: str = "") -> dict[str, Any]:
     return {"text": text, "value": None, "cls": cls}
 
 
-def _spring_loaded(d: dict, key: str, sub: str):
-    """``d["dynamics"][key][sub]`` of a spring-loaded follower (None without dynamics, or form-closed)."""
-    dyn = d.get("dynamics")
-    return None if not dyn or dyn["form_closed"] else (dyn.get(key) or {}).get(sub)
+def _min_contact_force(rep):
+    """The smallest contact force of a spring-loaded follower (None without dynamics, or form-closed)."""
+    dyn = rep.dynamics
+    return None if dyn is None or dyn.form_closed else dyn.contact_force.min
 
 
-def _max_contact_force(d: dict):
-    dyn = d.get("dynamics")
-    if not dyn:
+def _max_contact_force(rep):
+    dyn = rep.dynamics
+    if dyn is None:
         return None
-    return max(dyn[k]["max"] for k in ("contact_force_n", "second_contact_force_n") if dyn.get(k))
+    return max(e.max for e in (dyn.contact_force, dyn.second_contact_force) if e is not None)
 
 
-def _peak_torque(d: dict):
-    t = (d.get("dynamics") or {}).get("drive_torque_nm")
-    return None if not t else max(abs(t["max"]), abs(t["min"]))
+def _peak_torque(rep):
+    dyn = rep.dynamics
+    return None if dyn is None or not dyn.torque else max(abs(dyn.drive.max), abs(dyn.drive.min))
 
 
-def _jump_cell(d: dict) -> dict[str, Any]:
-    dyn = d.get("dynamics")
-    if not dyn or dyn["form_closed"]:
+def _jump_cell(rep) -> dict[str, Any]:
+    dyn = rep.dynamics
+    if dyn is None or dyn.form_closed:
         return _c(None)
-    v = dyn["jump_speed"]["value"]
+    v = dyn.jump_speed.value
     return _t("never") if v is None else _c(v, digits=1)
+
+
+def _part(obj, attr: str):
+    """``obj.attr``, or None when the summary ``obj`` is None."""
+    return None if obj is None else getattr(obj, attr)
 
 
 def comparison_rows(items) -> list[dict[str, Any]]:
     """The side-by-side table: ``[{"label": str, "cells": [{"text", "value", "cls"}, ...]}, ...]``,
     one cell per design (``value`` is the exact report number, or None)."""
-    ds = [(spec, rep, rep.to_dict()) for spec, _, rep in items]
+    ds = [(spec, rep) for spec, _, rep in items]
     rows: list[dict[str, Any]] = []
 
     def add(label, fn):
-        rows.append({"label": label, "cells": [fn(spec, rep, d) for spec, rep, d in ds]})
+        rows.append({"label": label, "cells": [fn(spec, rep) for spec, rep in ds]})
 
-    add("Mechanism", lambda s, r, d: _t(mechanism_text(s)))
-    add("Verdict", lambda s, r, d: _t(VERDICT_TEXT[r.verdict], "verdict-cell " + VERDICT_CLASS[r.verdict]))
-    add("Errors / warnings", lambda s, r, d: _t(f"{sum(f.severity == 'error' for f in r.findings)} / "
-                                               f"{sum(f.severity == 'warning' for f in r.findings)}"))
-    add("Speed", lambda s, r, d: _t(f"{s.speed:.4g} mm/s" if s.is_translating_cam else
-                                    f"{s.speed * 30 / math.pi:.4g} rpm"))
-    add("Base radius Rb (mm)", lambda s, r, d: _c(s.follower.base_radius_mm))
-    add("Roller radius (mm)", lambda s, r, d: _c(s.follower.roller_radius_mm if s.follower.type == "roller" else None))
-    add("DMIN (mm)", lambda s, r, d: _c(None if d.get("base_radius_mm") is None else 2 * d["base_radius_mm"]))
-    add("DMAX (mm)", lambda s, r, d: _c(None if d.get("max_radius_mm") is None else 2 * d["max_radius_mm"]))
-    add("Profile area (mm²)", lambda s, r, d: _c(d.get("area_mm2")))
+    add("Mechanism", lambda s, r: _t(mechanism_text(s)))
+    add("Verdict", lambda s, r: _t(VERDICT_TEXT[r.verdict], "verdict-cell " + VERDICT_CLASS[r.verdict]))
+    add("Errors / warnings", lambda s, r: _t(f"{sum(f.severity == Severity.ERROR for f in r.findings)} / "
+                                            f"{sum(f.severity == Severity.WARNING for f in r.findings)}"))
+    add("Speed", lambda s, r: _t(f"{s.speed:.4g} mm/s" if s.is_translating_cam else
+                                 f"{s.speed * 30 / math.pi:.4g} rpm"))
+    add("Base radius Rb (mm)", lambda s, r: _c(s.follower.base_radius_mm))
+    add("Roller radius (mm)", lambda s, r: _c(s.follower.roller_radius_mm if s.follower.type == "roller" else None))
+    add("DMIN (mm)", lambda s, r: _c(None if r.base_radius_mm is None else 2 * r.base_radius_mm))
+    add("DMAX (mm)", lambda s, r: _c(None if r.max_radius_mm is None else 2 * r.max_radius_mm))
+    add("Profile area (mm²)", lambda s, r: _c(r.area_mm2))
     for q, unit in (("S", "{u}"), ("V", "{u}/s"), ("A", "{u}/s²"), ("J", "{u}/s³")):
         for key in ("max", "min"):
-            add(f"{q} {key}", lambda s, r, d, q=q, key=key, unit=unit:
-                _c(((d.get("peaks") or {}).get(q) or {}).get(key), unit.format(u=s.follower.lift_unit)))
-    add("Min convex ρ (mm)", lambda s, r, d: _c((d.get("radius_of_curvature_mm") or {}).get("min_convex")))
-    add("Min concave ρ (mm)", lambda s, r, d: _c((d.get("radius_of_curvature_mm") or {}).get("min_concave")))
+            add(f"{q} {key}", lambda s, r, q=q, key=key, unit=unit:
+                _c(_part(_part(_part(r.motion, "peaks"), q), key), unit.format(u=s.follower.lift_unit)))
+    add("Min convex ρ (mm)", lambda s, r: _c(_part(r.curvature, "min_convex")))
+    add("Min concave ρ (mm)", lambda s, r: _c(_part(r.curvature, "min_concave")))
     for key in ("max", "min"):
-        add(f"Pressure angle {key} (°)", lambda s, r, d, key=key: _c((d.get("pressure_angle_deg") or {}).get(key)))
-    add("Pressure-angle limit (°)", lambda s, r, d: _c((d.get("pressure_angle_deg") or {}).get("limit"), digits=1))
-    add("Face length left (mm)", lambda s, r, d: _c((d.get("face_length_mm") or {}).get("left")))
-    add("Face length right (mm)", lambda s, r, d: _c((d.get("face_length_mm") or {}).get("right")))
-    add("Min contact force (N)", lambda s, r, d: _c(_spring_loaded(d, "contact_force_n", "min")))
-    add("Max contact force (N)", lambda s, r, d: _c(_max_contact_force(d)))
-    add("Peak drive torque (N·m)", lambda s, r, d: _c(_peak_torque(d)))
-    add("Jump speed (rpm)", lambda s, r, d: _jump_cell(d))
+        add(f"Pressure angle {key} (°)", lambda s, r, key=key: _c(_part(r.pressure_angle, key)))
+    add("Pressure-angle limit (°)", lambda s, r: _c(_part(r.pressure_angle, "limit"), digits=1))
+    add("Face length left (mm)", lambda s, r: _c(_part(r.face_length, "left")))
+    add("Face length right (mm)", lambda s, r: _c(_part(r.face_length, "right")))
+    add("Min contact force (N)", lambda s, r: _c(_min_contact_force(r)))
+    add("Max contact force (N)", lambda s, r: _c(_max_contact_force(r)))
+    add("Peak drive torque (N·m)", lambda s, r: _c(_peak_torque(r)))
+    add("Jump speed (rpm)", lambda s, r: _jump_cell(r))
     return [r for r in rows if any(c["text"] != "--" for c in r["cells"])]
 
 

@@ -21,6 +21,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from ..results import DynamicsSummary, IssueCode, Severity
 from ._common import (VERDICT_CLASS, VERDICT_TEXT, _cell, axis_of, conclusions_rows, fmt, fmt_at, key_values,
                       mechanism_text, range_text)
 
@@ -48,10 +49,10 @@ PLOT_TEXT = {
                  "cam) that keeps the speed constant."),
 }
 #: finding codes of the follower dynamics (the contact-force row of the dynamics table)
-_DYNAMICS_CODES = (("SELF_LOCKING", "Friction wedges the follower: see the findings"),
-                   ("FOLLOWER_JUMP", "The follower leaves the cam (N < 0): see the findings"),
-                   ("CONTACT_FORCE_BELOW_SAFETY", "Below the safety force {fs:g} N: see the findings"))
-_SEVERITY_ORDER = {"error": 0, "warning": 1, "info": 2}
+_DYNAMICS_CODES = ((IssueCode.SELF_LOCKING, "Friction wedges the follower: see the findings"),
+                   (IssueCode.FOLLOWER_JUMP, "The follower leaves the cam (N < 0): see the findings"),
+                   (IssueCode.CONTACT_FORCE_BELOW_SAFETY, "Below the safety force {fs:g} N: see the findings"))
+_SEVERITY_ORDER = {Severity.ERROR: 0, Severity.WARNING: 1, Severity.INFO: 2}
 
 
 def _read_asset(name: str) -> str:
@@ -108,34 +109,34 @@ def plot_files(figures: Mapping[str, Any], *, standalone: bool = False) -> tuple
 
 def _highlights(spec, report) -> list[str]:
     """The worst values in words (for the verdict box)."""
-    d = report.to_dict()
     xu = "°" if report.x_unit == "deg" else " mm"
     out = []
     lu = spec.follower.lift_unit
     units = {"V": f"{lu}/s", "A": f"{lu}/s²", "J": f"{lu}/s³"}
-    for q, word in (("V", "velocity"), ("A", "acceleration"), ("J", "jerk")):
-        p = (d.get("peaks") or {}).get(q)
-        if p:
-            big, at = (p["max"], p["at_max_deg"]) if abs(p["max"]) >= abs(p["min"]) else (p["min"], p["at_min_deg"])
+    if report.motion is not None:
+        for q, word, p in (("V", "velocity", report.motion.peaks.V), ("A", "acceleration", report.motion.peaks.A),
+                           ("J", "jerk", report.motion.peaks.J)):
+            big, at = (p.max, p.at_max) if abs(p.max) >= abs(p.min) else (p.min, p.at_min)
             out.append(f"Largest {word} {fmt(big)} {units[q]} at {at:.1f}{xu}")
-    pa = d.get("pressure_angle_deg")
-    if pa:
-        big, at = (pa["max"], pa["at_max_deg"]) if abs(pa["max"]) >= abs(pa["min"]) else (pa["min"], pa["at_min_deg"])
-        out.append(f"Largest pressure angle {fmt(big)}° at {at:.1f}{xu} (limit ±{pa['limit']:g}°)")
-    roc = d.get("radius_of_curvature_mm") or {}
-    if roc.get("min_convex") is not None:
-        out.append(f"Smallest convex radius of curvature {fmt(roc['min_convex'])} mm at {roc['at_deg']:.1f}{xu}")
-    face = d.get("face_length_mm")
-    if face and face.get("left") is not None:
-        out.append(f"Face length needed {fmt(face['left'])} mm left and {fmt(face['right'])} mm right of the stem")
-    cf = (d.get("dynamics") or {}).get("contact_force_n")
-    if cf and d["dynamics"].get("form_closed"):
-        n = len(d["dynamics"]["load_reversals_deg"])
+    pa = report.pressure_angle
+    if pa is not None:
+        big, at = (pa.max, pa.at_max) if abs(pa.max) >= abs(pa.min) else (pa.min, pa.at_min)
+        out.append(f"Largest pressure angle {fmt(big)}° at {at:.1f}{xu} (limit ±{pa.limit:g}°)")
+    roc = report.curvature
+    if roc is not None and roc.min_convex is not None:
+        out.append(f"Smallest convex radius of curvature {fmt(roc.min_convex)} mm at {roc.at_min_convex:.1f}{xu}")
+    face = report.face_length
+    if face is not None and face.left is not None:
+        out.append(f"Face length needed {fmt(face.left)} mm left and {fmt(face.right)} mm right of the stem")
+    dyn = report.dynamics
+    if dyn is not None and dyn.form_closed:
+        n = len(dyn.load_reversals or ())
         out.append(f"Form-closed follower: the load passes between the followers {n} time{'s' if n != 1 else ''} "
                    "per cycle")
-    elif cf:
-        out.append(f"Smallest contact force {fmt(cf['min'])} N at {fmt_at(cf['at_min_deg'], xu.strip())} "
-                   f"(safety force {d['dynamics']['safety_force_n']:g} N)")
+    elif dyn is not None:
+        cf = dyn.contact_force
+        out.append(f"Smallest contact force {fmt(cf.min)} N at {fmt_at(cf.at_min, xu.strip())} "
+                   f"(safety force {dyn.safety_force_n:g} N)")
     return out
 
 
@@ -147,73 +148,71 @@ def dynamics_rows(spec, report) -> list[dict[str, Any]]:
     """The follower-dynamics table (rows as :func:`~camfab.report._common.conclusions_rows`: ``concept``,
     ``max`` and ``min`` cells, ``comment``, ``status``); single values sit in the ``max`` cell.
     Empty without a ``dynamics`` summary."""
-    dyn = report.summary.get("dynamics")
-    if not dyn:
+    dyn = report.dynamics
+    if dyn is None:
         return []
     xu = "°" if report.x_unit == "deg" else "mm"
-    if dyn.get("form_closed"):
+    if dyn.form_closed:
         return _pair_rows(dyn, report, xu)
-    fs, codes, none = dyn["safety_force_n"], report.codes(), _cell(None)
-    cf = dyn["contact_force_n"]
+    fs, codes, none = dyn.safety_force_n, report.codes(), _cell(None)
+    cf = dyn.contact_force
     bad = next((text.format(fs=fs) for code, text in _DYNAMICS_CODES if code in codes), None)
     ok_text = f"Never below the safety force {fs:g} N" if fs > 0 else "The follower stays on the cam"
-    rows = [_row("Contact force (N)", _cell(cf["max"], cf["at_max_deg"], xu), _cell(cf["min"], cf["at_min_deg"], xu),
+    rows = [_row("Contact force (N)", _cell(cf.max, cf.at_max, xu), _cell(cf.min, cf.at_min, xu),
                  bad or ok_text, "bad" if bad else "ok"),
             _row("Safety force (N)", _cell(fs), none, "Smallest acceptable contact force (design input)")]
     return rows + _drive_rows(dyn, report, xu) + _limit_rows(spec, dyn, xu)
 
 
-def _pair_rows(dyn: dict[str, Any], report, xu: str) -> list[dict[str, Any]]:
+def _pair_rows(dyn: DynamicsSummary, report, xu: str) -> list[dict[str, Any]]:
     """The dynamics table of a form-closed follower: both contact forces and the load reversals."""
     none, rows = _cell(None), []
-    for k, key in ((1, "contact_force_n"), (2, "second_contact_force_n")):
-        cf = dyn[key]
-        rows.append(_row(f"Contact force, follower {k} (N)", _cell(cf["max"], cf["at_max_deg"], xu),
-                         _cell(cf["min"], cf["at_min_deg"], xu),
+    for k, cf in ((1, dyn.contact_force), (2, dyn.second_contact_force)):
+        rows.append(_row(f"Contact force, follower {k} (N)", _cell(cf.max, cf.at_max, xu),
+                         _cell(cf.min, cf.at_min, xu),
                          "Form closure: the follower cannot leave the cam" if k == 1 else
                          "Pushes where follower 1 cannot (the load has changed sides)"))
-    rev = dyn["load_reversals_deg"]
+    rev = dyn.load_reversals or ()
     where = ", ".join(f"{a:.1f}{xu}" for a, _ in rev) or "never"
     rows.append(_row("Load reversals", {**none, "text": str(len(rev))}, none,
                      f"The load passes to the other follower at {where}: across a clearance the follower knocks"))
     return rows + _drive_rows(dyn, report, xu)
 
 
-def _drive_rows(dyn: dict[str, Any], report, xu: str) -> list[dict[str, Any]]:
+def _drive_rows(dyn: DynamicsSummary, report, xu: str) -> list[dict[str, Any]]:
     """Bearing force, drive torque (force), work per cycle and mean power rows."""
     none, rows = _cell(None), []
-    b = dyn["bearing_force_n"]
-    rows.append(_row("Bearing force (N)", _cell(b["max"], b["at_max_deg"], xu), none,
+    b = dyn.bearing_force
+    rows.append(_row("Bearing force (N)", _cell(b.max, b.at_max, xu), none,
                      "Largest load on the camshaft bearings" if report.x_unit == "deg"
                      else "Largest load on the plate's guides"))
-    torque = "drive_torque_nm" in dyn
-    t = dyn["drive_torque_nm" if torque else "drive_force_n"]
-    rows.append(_row("Drive torque (N·m)" if torque else "Drive force (N)", _cell(t["max"], t["at_max_deg"], xu),
-                     _cell(t["min"], t["at_min_deg"], xu),
+    torque, t = dyn.torque, dyn.drive
+    rows.append(_row("Drive torque (N·m)" if torque else "Drive force (N)", _cell(t.max, t.at_max, xu),
+                     _cell(t.min, t.at_min, xu),
                      f"{'Torque' if torque else 'Force'} that keeps the speed constant (negative: the follower "
                      "drives the cam)"))
-    rows.append(_row("Work per cycle (J)", _cell(dyn["work_per_cycle_j"]), none,
+    rows.append(_row("Work per cycle (J)", _cell(dyn.work_per_cycle_j), none,
                      "Energy lost to damping and friction in one cycle"))
-    rows.append(_row("Mean power (W)", _cell(dyn["mean_power_w"]), none, "Mean drive power at the design speed"))
+    rows.append(_row("Mean power (W)", _cell(dyn.mean_power_w), none, "Mean drive power at the design speed"))
     return rows
 
 
-def _limit_rows(spec, dyn: dict[str, Any], xu: str) -> list[dict[str, Any]]:
+def _limit_rows(spec, dyn: DynamicsSummary, xu: str) -> list[dict[str, Any]]:
     """The preload-needed and jump-speed rows of :func:`dynamics_rows` (bad when the design misses them)."""
-    fs, none, rows = dyn["safety_force_n"], _cell(None), []
-    pre, have = dyn["preload_needed"], spec.dynamics.spring_preload if spec.dynamics is not None else None
-    short = have is not None and not have >= pre["value"] - 1e-9 * max(1.0, abs(pre["value"]))
-    rows.append(_row(f"Preload needed ({pre['unit']})", _cell(pre["value"], pre["at_deg"], xu), none,
+    fs, none, rows = dyn.safety_force_n, _cell(None), []
+    pre, have = dyn.preload_needed, spec.dynamics.spring_preload if spec.dynamics is not None else None
+    short = have is not None and not have >= pre.value - 1e-9 * max(1.0, abs(pre.value))
+    rows.append(_row(f"Preload needed ({pre.unit})", _cell(pre.value, pre.at, xu), none,
                      f"Spring preload that keeps the contact force ≥ {fs:g} N"
-                     + (f" (the design has {have:g} {pre['unit']})" if have is not None else ""),
+                     + (f" (the design has {have:g} {pre.unit})" if have is not None else ""),
                      "bad" if short else "ok"))
-    js = dyn["jump_speed"]
+    js = dyn.jump_speed
     design = spec.speed * 30 / math.pi if xu == "°" else spec.speed
-    cell = _cell(js["value"], js["at_deg"], xu) if js["value"] is not None else {**none, "text": "never"}
-    slow = js["value"] is not None and js["value"] <= design
-    rows.append(_row(f"Jump speed ({js['unit']})", cell, none,
+    cell = _cell(js.value, js.at, xu) if js.value is not None else {**none, "text": "never"}
+    slow = js.value is not None and js.value <= design
+    rows.append(_row(f"Jump speed ({js.unit})", cell, none,
                      f"Speed at which the contact force first falls to {fs:g} N (design: {design:.6g} "
-                     f"{js['unit']})", "bad" if slow else "ok"))
+                     f"{js.unit})", "bad" if slow else "ok"))
     return rows
 
 

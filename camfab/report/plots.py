@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from ..results import Extreme, IssueCode
 from ._common import CURVATURE_CODES, Axis, axis_of, finding_spans, fmt, fmt_at, sample_grid
 
 __all__ = ["svaj_figure", "profile_figure", "curvature_figure", "pressure_angle_figure", "face_position_figure",
@@ -33,9 +34,9 @@ _SVAJ = (("S", "#1f77b4"), ("V", "#2ca02c"), ("A", "#ff7f0e"), ("J", "#d62728"))
 SVAJ_UNITS = {"S": "{u}", "V": "{u}/s", "A": "{u}/s²", "J": "{u}/s³"}
 _BAD = "#d62728"
 #: finding codes shaded on the dynamics figure: (codes, colour, label)
-_DYNAMICS_SHADES = ((("FOLLOWER_JUMP",), _BAD, "follower jumps (N < 0)"),
-                    (("CONTACT_FORCE_BELOW_SAFETY",), "#ff7f0e", "below the safety force"),
-                    (("SELF_LOCKING",), "#9467bd", "self-locking (friction wedges the follower)"))
+_DYNAMICS_SHADES = (((IssueCode.FOLLOWER_JUMP,), _BAD, "follower jumps (N < 0)"),
+                    ((IssueCode.CONTACT_FORCE_BELOW_SAFETY,), "#ff7f0e", "below the safety force"),
+                    ((IssueCode.SELF_LOCKING,), "#9467bd", "self-locking (friction wedges the follower)"))
 _N = 1441
 _RC = {"font.size": 9, "axes.titlesize": 10, "axes.labelsize": 9, "legend.fontsize": 8, "axes.grid": True,
        "grid.alpha": 0.35, "grid.linewidth": 0.6, "svg.hashsalt": "camfab", "svg.fonttype": "path",
@@ -195,7 +196,6 @@ def profile_figure(spec, geometry, report):
         Equal-aspect view: follower side (+Y) at cam angle 0, contact points labelled every 90°
         and an arrow showing the rotation sense.
     """
-    d = report.to_dict()
     rr = spec.follower.roller_radius_mm or 0.0
     multi = len(geometry.profiles) > 1
     with plot_style():
@@ -218,16 +218,17 @@ def profile_figure(spec, geometry, report):
                 _circle(ax, rb, color="0.35", lw=0.9, ls=(0, (4, 3)), label=f"base circle Rb = {rb:g} mm")
                 if rr > 0 and spec.cam.kind not in ("constant_width",):
                     _circle(ax, rb + rr, color="0.35", lw=0.8, ls="-.", label=f"prime circle Rp = {rb + rr:g} mm")
-            if d.get("base_radius_mm") is not None:
-                _circle(ax, d["base_radius_mm"], color=_BAD, lw=0.8, label=f"DMIN = {fmt(2 * d['base_radius_mm'])} mm")
-            if d.get("max_radius_mm") is not None:
-                _circle(ax, d["max_radius_mm"], color=_BAD, lw=0.8, ls=(0, (1, 1.5)),
-                        label=f"DMAX = {fmt(2 * d['max_radius_mm'])} mm")
+            if report.base_radius_mm is not None:
+                _circle(ax, report.base_radius_mm, color=_BAD, lw=0.8,
+                        label=f"DMIN = {fmt(2 * report.base_radius_mm)} mm")
+            if report.max_radius_mm is not None:
+                _circle(ax, report.max_radius_mm, color=_BAD, lw=0.8, ls=(0, (1, 1.5)),
+                        label=f"DMAX = {fmt(2 * report.max_radius_mm)} mm")
             if spec.manufacturing.bore_mm:
                 _circle(ax, spec.manufacturing.bore_mm / 2, color="0.1", lw=0.8,
                         label=f"bore Ø{spec.manufacturing.bore_mm:g} mm")
             ax.plot([0], [0], "k+", ms=12, mew=1.2, label="cam centre")
-            _rotation_arrow(ax, d.get("max_radius_mm") or 1.0, geometry.profiles[0].sense)
+            _rotation_arrow(ax, report.max_radius_mm or 1.0, geometry.profiles[0].sense)
             ax.set_title(f"{spec.name}: cam profile (cam frame, follower at +Y at 0°)")
         else:
             ax.axhline(spec.follower.base_height_mm or 0.0, color="0.35", lw=0.9, ls="--", label="cam base line")
@@ -284,9 +285,8 @@ def curvature_figure(spec, geometry, report, *, n: int = _N):
     matplotlib.figure.Figure
     """
     axis = axis_of(spec.program())
-    d = report.to_dict()
-    roc = d.get("radius_of_curvature_mm") or {}
-    rmax = d.get("max_radius_mm") or 50.0
+    roc = report.curvature
+    rmax = report.max_radius_mm or 50.0
     lim = 3.0 * rmax
     multi = len(geometry.profiles) > 1
     with plot_style():
@@ -309,9 +309,9 @@ def curvature_figure(spec, geometry, report, *, n: int = _N):
         if tool and lo < 0:
             ax.axhline(-tool / 2, color="#9467bd", lw=0.9, ls="--", label=f"−cutter radius ({tool / 2:g} mm)")
         shade(ax, finding_spans(report.findings, CURVATURE_CODES, axis), label="undercut / cusp / too tight")
-        if roc.get("min_convex") is not None and roc.get("at_deg") is not None:
-            ax.plot([roc["at_deg"]], [roc["min_convex"]], "v", color=_BAD, ms=6,
-                    label=f"min convex ρ = {fmt(roc['min_convex'])} mm at {roc['at_deg']:.1f}{axis.unit}")
+        if roc is not None and roc.min_convex is not None and roc.at_min_convex is not None:
+            ax.plot([roc.at_min_convex], [roc.min_convex], "v", color=_BAD, ms=6,
+                    label=f"min convex ρ = {fmt(roc.min_convex)} mm at {roc.at_min_convex:.1f}{axis.unit}")
         boundaries(ax, spec.program(), axis)
         ax.set_ylim(max(lo, -lim) - 0.08 * lim, min(hi, lim) + 0.08 * lim)
         x_axis(ax, axis)
@@ -337,8 +337,8 @@ def pressure_angle_figure(spec, geometry, report, *, n: int = _N):
     matplotlib.figure.Figure
     """
     axis = axis_of(spec.program())
-    pa = report.to_dict().get("pressure_angle_deg") or {}
-    lim = pa.get("limit")
+    pa = report.pressure_angle
+    lim = pa.limit if pa is not None else None
     multi = len(geometry.profiles) > 1
     with plot_style():
         fig = new_figure(9.0, 4.2)
@@ -354,12 +354,12 @@ def pressure_angle_figure(spec, geometry, report, *, n: int = _N):
         if lim is not None:
             for sgn in (1, -1):
                 ax.axhline(sgn * lim, color=_BAD, lw=1.0, ls="--", label=f"limit ±{lim:g}°" if sgn > 0 else None)
-        shade(ax, finding_spans(report.findings, ("PRESSURE_ANGLE_EXCEEDED",), axis), label="limit exceeded",
+        shade(ax, finding_spans(report.findings, (IssueCode.PRESSURE_ANGLE_EXCEEDED,), axis), label="limit exceeded",
               alpha=0.12)
-        if pa:
-            for key, at, va in (("max", "at_max_deg", "bottom"), ("min", "at_min_deg", "top")):
-                ax.plot([pa[at]], [pa[key]], "o", color="0.1", ms=3.5)
-                ax.annotate(f"{pa[key]:.2f}° at {pa[at]:.1f}{axis.unit}", (pa[at], pa[key]),
+        if pa is not None:
+            for v, at, va in ((pa.max, pa.at_max, "bottom"), (pa.min, pa.at_min, "top")):
+                ax.plot([at], [v], "o", color="0.1", ms=3.5)
+                ax.annotate(f"{v:.2f}° at {at:.1f}{axis.unit}", (at, v),
                             xytext=(5, 4 if va == "bottom" else -4), textcoords="offset points", fontsize=7, va=va)
         ax.axhline(0.0, color="0.2", lw=0.6)
         boundaries(ax, spec.program(), axis)
@@ -379,7 +379,7 @@ def face_position_figure(spec, geometry, report, *, n: int = _N):
     matplotlib.figure.Figure
     """
     axis = axis_of(spec.program())
-    face = report.to_dict().get("face_length_mm") or {}
+    face = report.face_length
     multi = len(geometry.profiles) > 1
     with plot_style():
         fig = new_figure(9.0, 4.0)
@@ -389,12 +389,12 @@ def face_position_figure(spec, geometry, report, *, n: int = _N):
                 continue
             ax.plot(x * axis.scale, s.face_position, color=f"C{k}",
                     label=f"cam {k + 1} contact" if multi else "contact position")
-        if face.get("left") is not None:
-            lo, hi = -face["left"], face["right"]
+        if face is not None and face.left is not None:
+            lo, hi = -face.left, face.right
             ax.axhline(0.0, color="0.2", lw=0.8, label="stem axis")
-            what = f"face needed: {fmt(face['left'])} mm left, {fmt(face['right'])} mm right"
-        elif face:
-            lo, hi = min(face["min"], 0.0), face["max"] + spec.face_margin_mm
+            what = f"face needed: {fmt(face.left)} mm left, {fmt(face.right)} mm right"
+        elif face is not None:
+            lo, hi = min(face.min, 0.0), face.max + spec.face_margin_mm
             ax.axhline(0.0, color="0.2", lw=0.8, label="face vertex")
             what = f"face needed from the vertex: {fmt(hi)} mm"
         else:
@@ -424,13 +424,14 @@ def _finite_view(v: np.ndarray, clip: bool) -> tuple[np.ndarray, float]:
     return out, lim
 
 
-def _mark_extremes(ax, ext: dict | None, unit: str, xu: str, colour: str, lim: float = math.inf) -> None:
-    """Dots and labels at the exact min/max of a ``{min, max, at_min_deg, at_max_deg}`` summary
-    (those beyond ±``lim``, off the view, are left out)."""
-    if not ext:
+def _mark_extremes(ax, ext: Extreme | None, unit: str, xu: str, colour: str, lim: float = math.inf, *,
+                   max_only: bool = False) -> None:
+    """Dots and labels at the exact maximum (and minimum, unless ``max_only``) of ``ext`` (those
+    beyond ±``lim``, off the view, are left out)."""
+    if ext is None:
         return
-    for key, at, va in (("max", "at_max_deg", "bottom"), ("min", "at_min_deg", "top")):
-        v, x = ext.get(key), ext.get(at)
+    marks = [(ext.max, ext.at_max, "bottom")] + ([] if max_only else [(ext.min, ext.at_min, "top")])
+    for v, x, va in marks:
         if v is None or x is None or not abs(v) <= lim:
             continue
         ax.plot([x], [v], "o", color=colour, ms=3.5)
@@ -438,16 +439,12 @@ def _mark_extremes(ax, ext: dict | None, unit: str, xu: str, colour: str, lim: f
                     textcoords="offset points", fontsize=7, va=va, color=colour)
 
 
-def _max_only(ext: dict | None) -> dict | None:
-    return None if not ext else {"max": ext["max"], "at_max_deg": ext["at_max_deg"]}
-
-
 def dynamics_figure(spec, geometry, report, *, n: int = _N):
     """Contact force and drive torque (drive force of a translating cam) against the cam angle.
 
     Top panel: the contact force N with the zero line and the safety force, the ranges of the
     ``FOLLOWER_JUMP``, ``CONTACT_FORCE_BELOW_SAFETY`` and ``SELF_LOCKING`` findings shaded and the
-    exact extremes of ``report.summary["dynamics"]`` marked.  Bottom panel: the drive torque (N·m),
+    exact extremes of ``report.dynamics`` marked.  Bottom panel: the drive torque (N·m),
     or the drive force (N) along the travel of a translating cam.
 
     Parameters
@@ -472,11 +469,10 @@ def dynamics_figure(spec, geometry, report, *, n: int = _N):
     x = sample_grid(c.period, c.breakpoints, n)
     sm = dynamics_model(spec, geometry).evaluate(x)
     pair = sm.contact_force_2 is not None
-    dyn = report.summary.get("dynamics") or {}
-    locking = bool(report.by_code("SELF_LOCKING"))
+    dyn = report.dynamics
+    locking = bool(report.by_code(IssueCode.SELF_LOCKING))
     xu, fs = axis.unit, spec.dynamics.safety_force_n
-    drive_key, drive_label = (("drive_torque_nm", "drive torque T (N·m)") if geometry.closed
-                              else ("drive_force_n", "drive force (N)"))
+    drive_label = "drive torque T (N·m)" if geometry.closed else "drive force (N)"
     with plot_style():
         fig = new_figure(9.0, 6.4)
         ax, ax2 = fig.subplots(2, 1, sharex=True, height_ratios=(3, 2))
@@ -484,22 +480,21 @@ def dynamics_figure(spec, geometry, report, *, n: int = _N):
         ax.plot(x * axis.scale, force, color="C0", label="follower 1" if pair else "contact force N")
         if pair:
             ax.plot(x * axis.scale, sm.contact_force_2, color="C1", label="follower 2")
-            _mark_extremes(ax, _max_only(dyn.get("second_contact_force_n")), "N", xu, "0.1", lim)
+            _mark_extremes(ax, dyn.second_contact_force if dyn else None, "N", xu, "0.1", lim, max_only=True)
         ax.axhline(0.0, color="0.1", lw=0.9, label="N = 0" if pair else "N = 0 (jump limit)")
         if fs:
             ax.axhline(fs, color=_BAD, lw=1.0, ls="--", label=f"safety force {fs:g} N")
         for codes, colour, label in _DYNAMICS_SHADES:
             shade(ax, finding_spans(report.findings, codes, axis), color=colour, label=label)
         # a form-closed pair's minima are the 0 N of the unloaded follower: only the maxima are marked
-        _mark_extremes(ax, _max_only(dyn.get("contact_force_n")) if pair else dyn.get("contact_force_n"), "N", xu,
-                       "0.1", lim)
+        _mark_extremes(ax, dyn.contact_force if dyn else None, "N", xu, "0.1", lim, max_only=pair)
         ax.set_ylabel("contact force N (N)")
         ax.set_title("Contact force", loc="left", fontsize=9)
         ax.margins(y=0.15)
         drive, lim = _finite_view(sm.drive, locking)
         ax2.plot(x * axis.scale, drive, color="C2", label=drive_label)
         ax2.axhline(0.0, color="0.2", lw=0.6)
-        _mark_extremes(ax2, dyn.get(drive_key), "N·m" if geometry.closed else "N", xu, "0.1", lim)
+        _mark_extremes(ax2, dyn.drive if dyn else None, "N·m" if geometry.closed else "N", xu, "0.1", lim)
         ax2.set_ylabel(drive_label)
         ax2.set_title("Drive torque" if geometry.closed else "Drive force", loc="left", fontsize=9)
         ax2.margins(y=0.15)

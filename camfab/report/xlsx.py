@@ -74,6 +74,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import Problem, SpecError
+from ..results import JUMP_CODES, IssueCode, Severity, Verdict
 
 __all__ = ["CAMDAS_COLUMNS", "FIXED_DATE", "LiftTable", "camdas_workbook", "camdas_columns", "conclusions",
            "dynamics_columns", "dynamics_summary_rows", "fixed_zip", "geometry_rows", "lift_table", "sample_params",
@@ -88,9 +89,9 @@ CAMDAS_COLUMNS = {"A": "angle", "B": "S", "C": "V", "D": "A", "E": "J", "F": "ra
                   "O": "pitch r", "P": "pitch polar angle", "R": "pitch x", "S": "pitch y"}
 FIRST_DATA_ROW = 10
 _VERDICT_TEXT = {
-    "acceptable": "Acceptable cam",
-    "not_for_high_speed": "Jerk (or allowed acceleration) discontinuity. Cam not suitable for high speeds",
-    "unacceptable": "Unacceptable cam",
+    Verdict.ACCEPTABLE: "Acceptable cam",
+    Verdict.NOT_FOR_HIGH_SPEED: "Jerk (or allowed acceleration) discontinuity. Cam not suitable for high speeds",
+    Verdict.UNACCEPTABLE: "Unacceptable cam",
 }
 
 
@@ -98,8 +99,8 @@ def verdict_sentence(report) -> str:
     """The A3 conclusion: a CAM-DAS-style sentence followed by the verdict code in brackets."""
     v = report.verdict
     text = _VERDICT_TEXT[v]
-    if v == "unacceptable":
-        why = sorted({f.code.lower().replace("_", " ") for f in report.findings if f.severity == "error"})
+    if v == Verdict.UNACCEPTABLE:
+        why = sorted({f.code.lower().replace("_", " ") for f in report.findings if f.severity == Severity.ERROR})
         text += ": " + ", ".join(why)
     return f"{text} [{v}]"
 
@@ -258,31 +259,29 @@ def dynamics_columns(spec, geometry, *, step_deg: float = 1.0) -> tuple[list[str
 def dynamics_summary_rows(report) -> list[tuple[str, Any, str, float | None]]:
     """The dynamics summary of ``report`` as ``(label, value, unit, at)`` rows ([] without dynamics).
     ``at`` is the cam angle in degrees (travel in mm); a jump speed that is never reached is "never"."""
-    d = report.summary.get("dynamics")
-    if not d:
+    d = report.dynamics
+    if d is None:
         return []
-    cf, b = d["contact_force_n"], d["bearing_force_n"]
-    torque = "drive_torque_nm" in d
-    t, tu = (d["drive_torque_nm"], "N·m") if torque else (d["drive_force_n"], "N")
-    word = "drive torque" if torque else "drive force"
-    common = [("Maximum bearing force", b["max"], "N", b["at_max_deg"]),
-              (f"Minimum {word}", t["min"], tu, t["at_min_deg"]), (f"Maximum {word}", t["max"], tu, t["at_max_deg"]),
-              ("Work per cycle", d["work_per_cycle_j"], "J", None), ("Mean power", d["mean_power_w"], "W", None)]
-    if d.get("form_closed"):
-        cf2 = d["second_contact_force_n"]
-        return [("Maximum contact force, follower 1", cf["max"], "N", cf["at_max_deg"]),
-                ("Maximum contact force, follower 2", cf2["max"], "N", cf2["at_max_deg"]), *common,
+    cf, b, t, torque = d.contact_force, d.bearing_force, d.drive, d.torque
+    tu, word = ("N·m", "drive torque") if torque else ("N", "drive force")
+    common = [("Maximum bearing force", b.max, "N", b.at_max),
+              (f"Minimum {word}", t.min, tu, t.at_min), (f"Maximum {word}", t.max, tu, t.at_max),
+              ("Work per cycle", d.work_per_cycle_j, "J", None), ("Mean power", d.mean_power_w, "W", None)]
+    if d.form_closed:
+        cf2 = d.second_contact_force
+        return [("Maximum contact force, follower 1", cf.max, "N", cf.at_max),
+                ("Maximum contact force, follower 2", cf2.max, "N", cf2.at_max), *common,
                 *[("Load passes to the other follower", lo, "deg" if torque else "mm", None)
-                  for lo, _ in d["load_reversals_deg"]]]
-    pre, js = d["preload_needed"], d["jump_speed"]
-    return [("Minimum contact force", cf["min"], "N", cf["at_min_deg"]),
-            ("Maximum contact force", cf["max"], "N", cf["at_max_deg"]),
-            ("Safety force", d["safety_force_n"], "N", None),
-            ("Maximum bearing force", b["max"], "N", b["at_max_deg"]),
-            (f"Minimum {word}", t["min"], tu, t["at_min_deg"]), (f"Maximum {word}", t["max"], tu, t["at_max_deg"]),
-            ("Work per cycle", d["work_per_cycle_j"], "J", None), ("Mean power", d["mean_power_w"], "W", None),
-            ("Preload needed", pre["value"], pre["unit"], pre["at_deg"]),
-            ("Jump speed", js["value"] if js["value"] is not None else "never", js["unit"], js["at_deg"])]
+                  for lo, _ in d.load_reversals or ()]]
+    pre, js = d.preload_needed, d.jump_speed
+    return [("Minimum contact force", cf.min, "N", cf.at_min),
+            ("Maximum contact force", cf.max, "N", cf.at_max),
+            ("Safety force", d.safety_force_n, "N", None),
+            ("Maximum bearing force", b.max, "N", b.at_max),
+            (f"Minimum {word}", t.min, tu, t.at_min), (f"Maximum {word}", t.max, tu, t.at_max),
+            ("Work per cycle", d.work_per_cycle_j, "J", None), ("Mean power", d.mean_power_w, "W", None),
+            ("Preload needed", pre.value, pre.unit, pre.at),
+            ("Jump speed", js.value if js.value is not None else "never", js.unit, js.at)]
 
 
 # ---------------------------------------------------------------------------
@@ -439,33 +438,32 @@ def conclusions(spec, report) -> list[tuple[str, Any, Any, str]]:
     """The CAM-DAS "Conclusiones" rows: (concept, maximum, minimum, comments)."""
     u = _unit(spec)
     rows: list[tuple[str, Any, Any, str]] = []
-    peaks = report.motion.peaks if report.motion is not None else {}
-    names = (("S", "Displacement", u, None), ("V", "Velocity", f"{u}/s", "VELOCITY_DISCONTINUITY"),
-             ("A", "Acceleration", f"{u}/s2", "ACCELERATION_DISCONTINUITY"),
-             ("J", "Jerk", f"{u}/s3", "JERK_DISCONTINUITY"))
-    for key, word, unit, code in names:
-        p = peaks.get(key, {})
-        rows.append((f"{word} ({unit})", p.get("max"), p.get("min"),
-                     "Continuous" if code is None else _continuity(report, code)))
-    s = report.summary
-    roc = s.get("radius_of_curvature_mm") or {}
-    bad = [f for f in report.findings if f.code in ("UNDERCUT", "CUSP")]
-    rows.append(("Radius of curvature (mm)" if roc.get("max") is not None else "Convex radius of curvature (mm)",
-                 roc.get("max"), roc.get("min_convex"),
+    peaks = dict(report.motion.peaks.items()) if report.motion is not None else {}
+    names = (("S", "Displacement", u), ("V", "Velocity", f"{u}/s"), ("A", "Acceleration", f"{u}/s2"),
+             ("J", "Jerk", f"{u}/s3"))
+    for key, word, unit in names:
+        p = peaks.get(key)
+        rows.append((f"{word} ({unit})", p.max if p else None, p.min if p else None,
+                     _continuity(report, JUMP_CODES[key]) if key in JUMP_CODES else "Continuous"))
+    roc = report.curvature
+    big, convex = (roc.max, roc.min_convex) if roc is not None else (None, None)
+    bad = [f for f in report.findings if f.code in (IssueCode.UNDERCUT, IssueCode.CUSP)]
+    rows.append(("Radius of curvature (mm)" if big is not None else "Convex radius of curvature (mm)",
+                 big, convex,
                  "; ".join(f.message for f in bad) if bad else "The profile is free of cusps and undercuts"))
-    pa = s.get("pressure_angle_deg")
-    if pa:
-        over = report.by_code("PRESSURE_ANGLE_EXCEEDED")
-        rows.append(("Pressure angle (deg)", pa.get("max"), pa.get("min"),
-                     f"Pressure angle > {pa.get('limit'):g} deg, high pressure angle" if over else "Acceptable"))
-    fl = s.get("face_length_mm")
-    if fl:
+    pa = report.pressure_angle
+    if pa is not None:
+        over = report.by_code(IssueCode.PRESSURE_ANGLE_EXCEEDED)
+        rows.append(("Pressure angle (deg)", pa.max, pa.min,
+                     f"Pressure angle > {pa.limit:g} deg, high pressure angle" if over else "Acceptable"))
+    fl = report.face_length
+    if fl is not None:
         note = "The maximum is the minimum face length needed to keep contact"
-        if fl.get("left") is not None:
-            rows.append(("Left contact distance (mm)", fl.get("left"), 0.0, note))
-            rows.append(("Right contact distance (mm)", fl.get("right"), 0.0, note))
+        if fl.left is not None:
+            rows.append(("Left contact distance (mm)", fl.left, 0.0, note))
+            rows.append(("Right contact distance (mm)", fl.right, 0.0, note))
         else:
-            rows.append(("Contact distance along the face (mm)", fl.get("max"), fl.get("min"), note))
+            rows.append(("Contact distance along the face (mm)", fl.max, fl.min, note))
     return rows
 
 
@@ -485,13 +483,13 @@ def _checks_sheet(ws, spec, report) -> None:
             ws.cell(row, col, v)
     row += 2
     ws.cell(row, 1, "Summary").font = bold
-    s = report.summary
-    for label, key, unit in (("Base radius (min distance)", "base_radius_mm", "mm"),
-                             ("Max radius (DMAX)", "max_radius_mm", "mm"), ("Profile area", "area_mm2", "mm2"),
-                             ("Initial arm angle", "initial_arm_angle_deg", "deg")):
-        if s.get(key) is not None:
+    for label, value, unit in (("Base radius (min distance)", report.base_radius_mm, "mm"),
+                               ("Max radius (DMAX)", report.max_radius_mm, "mm"), ("Profile area", report.area_mm2,
+                                                                                     "mm2"),
+                               ("Initial arm angle", report.initial_arm_angle_deg, "deg")):
+        if value is not None:
             row += 1
-            ws.cell(row, 1, label), ws.cell(row, 2, _fmt(s[key])), ws.cell(row, 3, unit)
+            ws.cell(row, 1, label), ws.cell(row, 2, _fmt(value)), ws.cell(row, 3, unit)
     dyn = dynamics_summary_rows(report)
     if dyn:
         row += 2

@@ -7,11 +7,13 @@ import math
 import numpy as np
 import pytest
 
-from camfab.design.checks import CUSP_TOL_MM, Code, check
+from camfab.design.checks import CUSP_TOL_MM, check
 from camfab.design.mechanisms import (OscillatingFlat, OscillatingRoller, TranslatingCamRoller, TranslatingFlat,
                                       TranslatingRoller)
-from camfab.design.profile import CamGeometry, extremum
+from camfab.design.profile import CamGeometry
 from camfab.design.program import MotionProgram
+from camfab.numeric import extremum
+from camfab.results import IssueCode
 
 from ..conftest import EJEMPLO9RT, EJEMPLO11RO
 
@@ -32,19 +34,19 @@ def test_ejemplo9rt_is_sound():
     r = check(g, name="Ejemplo9RT")
     assert r.verdict == "not_for_high_speed"  # jerk jumps (modified sine, cycloidal, 3-4-5 next to dwells)
     assert r.codes() == {"JERK_DISCONTINUITY"}
-    pa = r.summary["pressure_angle_deg"]
+    pa = r.pressure_angle
     x, d = _dense(g, "pressure_angle")
-    assert pa["max"] == pytest.approx(np.degrees(d.max()), abs=1e-6) and 20 < pa["max"] < 30
-    assert pa["min"] == pytest.approx(np.degrees(d.min()), abs=1e-6) and -30 < pa["min"] < -25
-    assert 180 < pa["at_max_deg"] < 230 and 270 < pa["at_min_deg"] < 320  # the 3-4-5 rise, the 4-5-6-7 return
-    roc = r.summary["radius_of_curvature_mm"]
+    assert pa.max == pytest.approx(np.degrees(d.max()), abs=1e-6) and 20 < pa.max < 30
+    assert pa.min == pytest.approx(np.degrees(d.min()), abs=1e-6) and -30 < pa.min < -25
+    assert 180 < pa.at_max < 230 and 270 < pa.at_min < 320  # the 3-4-5 rise, the 4-5-6-7 return
+    roc = r.curvature
     _, kp = _dense(g, "curvature_pitch")
-    assert roc["pitch_min_convex"] == pytest.approx(1 / kp.max(), rel=1e-6) and roc["pitch_min_convex"] > 7
-    assert roc["min_convex"] == pytest.approx(roc["pitch_min_convex"] - 7)
-    assert roc["min_concave"] == pytest.approx(-1 / kp.min() + 7, rel=1e-6)
-    assert r.summary["base_radius_mm"] == pytest.approx(35.0, abs=1e-9)
-    assert r.summary["max_radius_mm"] == pytest.approx(45.0, abs=1e-9)
-    assert r.summary["face_length_mm"] is None and r.summary["initial_arm_angle_deg"] is None
+    assert roc.pitch_min_convex == pytest.approx(1 / kp.max(), rel=1e-6) and roc.pitch_min_convex > 7
+    assert roc.min_convex == pytest.approx(roc.pitch_min_convex - 7)
+    assert roc.min_concave == pytest.approx(-1 / kp.min() + 7, rel=1e-6)
+    assert r.base_radius_mm == pytest.approx(35.0, abs=1e-9)
+    assert r.max_radius_mm == pytest.approx(45.0, abs=1e-9)
+    assert r.face_length is None and r.initial_arm_angle_deg is None
     d = json.loads(json.dumps(r.to_dict()))
     for key in ("name", "verdict", "peaks", "junctions", "pressure_angle_deg", "radius_of_curvature_mm",
                 "face_length_mm", "base_radius_mm", "max_radius_mm", "area_mm2", "findings"):
@@ -58,7 +60,7 @@ def test_undercut_roller_range_is_exact():
     g = CamGeometry(TranslatingRoller(8, rr), E9)
     r = check(g)
     assert r.verdict == "unacceptable"
-    under = r.by_code(Code.UNDERCUT)
+    under = r.by_code(IssueCode.UNDERCUT)
     assert under and all(f.severity == "error" and f.limit == rr and 0 < f.value < rr for f in under)
     for f in under:
         rho = g.evaluate(np.radians([f.from_deg, f.to_deg])).rho_pitch
@@ -67,7 +69,7 @@ def test_undercut_roller_range_is_exact():
         assert np.all((g.evaluate(mid).rho_pitch < rr) & (g.evaluate(mid).rho_pitch > 0))
         assert "undercut" in f.message and "smaller than the roller" in f.message
     worst = min(f.value for f in under)
-    assert worst == pytest.approx(r.summary["radius_of_curvature_mm"]["pitch_min_convex"], rel=1e-9)
+    assert worst == pytest.approx(r.curvature.pitch_min_convex, rel=1e-9)
 
 
 def test_undercut_and_cusp_flat_face():
@@ -99,17 +101,17 @@ def test_cusp_roller():
 def test_concave_radius_below_tool():
     g = CamGeometry(TranslatingRoller(35, 7), E9)
     r0 = check(g)
-    fits = r0.summary["radius_of_curvature_mm"]["min_concave"]
+    fits = r0.curvature.min_concave
     assert "CONCAVE_RADIUS_BELOW_ROLLER" not in r0.codes()  # a roller always fits its own envelope (D10)
     r = check(g, tool_radius_mm=fits + 5.0)
-    found = r.by_code(Code.CONCAVE_RADIUS_BELOW_ROLLER)
+    found = r.by_code(IssueCode.CONCAVE_RADIUS_BELOW_ROLLER)
     assert found and all(f.severity == "warning" for f in found)
     assert r.verdict == r0.verdict  # a manufacturing warning does not change the CAM-DAS verdict
     assert f"{fits:.6g}" in found[0].message and found[0].limit == fits + 5.0
     for f in found:
         rho = g.evaluate(np.radians([f.from_deg, f.to_deg])).rho
         np.testing.assert_allclose(rho, -(fits + 5.0), rtol=1e-8)
-    assert not check(g, tool_radius_mm=fits - 0.01).by_code(Code.CONCAVE_RADIUS_BELOW_ROLLER)
+    assert not check(g, tool_radius_mm=fits - 0.01).by_code(IssueCode.CONCAVE_RADIUS_BELOW_ROLLER)
 
 
 def test_pressure_angle_exceeded():
@@ -131,8 +133,8 @@ def test_pressure_angle_exceeded():
     assert small.by_code("PRESSURE_ANGLE_EXCEEDED")[0].limit == 30.0
     # oscillating default 35°
     osc = CamGeometry(OscillatingRoller(40, 10, 100, 90), E11)
-    peak = max(abs(v) for v in (check(osc, pressure_angle_limit_deg=89).summary["pressure_angle_deg"][k]
-                                for k in ("max", "min")))
+    pa = check(osc, pressure_angle_limit_deg=89).pressure_angle
+    peak = max(abs(pa.max), abs(pa.min))
     assert 35 < peak < 50
     assert check(osc).by_code("PRESSURE_ANGLE_EXCEEDED")[0].limit in (35.0, -35.0)
     assert not check(osc, pressure_angle_limit_deg=peak + 0.1).by_code("PRESSURE_ANGLE_EXCEEDED")
@@ -143,27 +145,27 @@ def test_face_length_translating():
     s1 = E9.evaluate(x, (1,))[0]
     for rot, left, right in (("cw", s1.max(), -s1.min()), ("ccw", -s1.min(), s1.max())):
         r = check(CamGeometry(TranslatingFlat(100, 0.0, rot), E9), face_margin_mm=1.0)
-        fl = r.summary["face_length_mm"]
-        assert fl["left"] == pytest.approx(left + 1.0, rel=1e-7) and fl["right"] == pytest.approx(right + 1.0, rel=1e-7)
-        info = r.by_code(Code.FACE_LENGTH)
+        fl = r.face_length
+        assert fl.left == pytest.approx(left + 1.0, rel=1e-7) and fl.right == pytest.approx(right + 1.0, rel=1e-7)
+        info = r.by_code(IssueCode.FACE_LENGTH)
         assert len(info) == 2 and all(f.severity == "info" for f in info)
-        assert r.summary["pressure_angle_deg"] is None and r.verdict == "not_for_high_speed"
+        assert r.pressure_angle is None and r.verdict == "not_for_high_speed"
     # a stem offset to the right moves the contact to the left of the stem
-    fl = check(CamGeometry(TranslatingFlat(100, 4.0), E9)).summary["face_length_mm"]
-    assert fl["left"] == pytest.approx(s1.max() + 4.0, rel=1e-7)
-    assert fl["right"] == pytest.approx(-s1.min() - 4.0, rel=1e-7)
+    fl = check(CamGeometry(TranslatingFlat(100, 4.0), E9)).face_length
+    assert fl.left == pytest.approx(s1.max() + 4.0, rel=1e-7)
+    assert fl.right == pytest.approx(-s1.min() - 4.0, rel=1e-7)
 
 
 def test_face_length_oscillating():
     g = CamGeometry(OscillatingFlat(40, 100, 5), E2)
     r = check(g)
     x, pos = _dense(g, "face_position")
-    fl = r.summary["face_length_mm"]
-    assert fl["max"] == pytest.approx(pos.max(), rel=1e-8) and fl["min"] == pytest.approx(pos.min(), rel=1e-8)
-    assert fl["left"] is None and fl["right"] is None
+    fl = r.face_length
+    assert fl.max == pytest.approx(pos.max(), rel=1e-8) and fl.min == pytest.approx(pos.min(), rel=1e-8)
+    assert fl.left is None and fl.right is None
     (f,) = r.by_code("FACE_LENGTH")
     assert f.value == pytest.approx(pos.max(), rel=1e-8) and "vertex" in f.message
-    assert r.summary["initial_arm_angle_deg"] == pytest.approx(math.degrees(math.asin(35 / 100)))
+    assert r.initial_arm_angle_deg == pytest.approx(math.degrees(math.asin(35 / 100)))
     assert r.verdict == "acceptable"
 
 
@@ -186,7 +188,7 @@ def test_motion_discontinuities_and_verdicts():
     r = check(CamGeometry(TranslatingRoller(35, 7), E9), speed=2.0)
     jerk = r.by_code("JERK_DISCONTINUITY")
     assert jerk and jerk[0].severity == "warning" and r.verdict == "not_for_high_speed"
-    assert r.motion.peaks["V"]["max"] == pytest.approx(2 * 21.4859, rel=1e-4)
+    assert r.motion.peaks.V.max == pytest.approx(2 * 21.4859, rel=1e-4)
     smooth = MotionProgram.from_segments([("poly4567", 10, 120), ("dwell", 0, 120), ("poly4567", -10, 120)])
     assert check(CamGeometry(TranslatingRoller(35, 7), smooth)).verdict == "acceptable"
 
@@ -198,11 +200,11 @@ def test_translating_cam():
     r = check(g)
     x = np.linspace(0, prog.period, 100001)
     s1 = prog.evaluate(x, (1,))[0]
-    pa = r.summary["pressure_angle_deg"]
-    assert pa["max"] == pytest.approx(math.degrees(math.atan(s1.max())), abs=1e-6)
-    assert pa["at_max_deg"] == pytest.approx(20.0, abs=1e-5)  # mm of travel: middle of the cycloidal rise
-    assert r.summary["base_radius_mm"] is None and r.summary["max_radius_mm"] is None
-    assert r.x_unit == "mm" and r.summary["area_mm2"] > 150 * 10
+    pa = r.pressure_angle
+    assert pa.max == pytest.approx(math.degrees(math.atan(s1.max())), abs=1e-6)
+    assert pa.at_max == pytest.approx(20.0, abs=1e-5)  # mm of travel: middle of the cycloidal rise
+    assert r.base_radius_mm is None and r.max_radius_mm is None
+    assert r.x_unit == "mm" and r.area_mm2 > 150 * 10
     assert "PRESSURE_ANGLE_EXCEEDED" in r.codes()  # 12 mm over 40 mm of cycloidal: 31°
     assert r.by_code("PRESSURE_ANGLE_EXCEEDED")[0].limit == 30.0
 
@@ -214,3 +216,30 @@ def test_two_profiles_are_both_checked():
     r = check(two)
     assert r.by_code("UNDERCUT") and all(f.message.startswith("profile 2") for f in r.by_code("UNDERCUT"))
     assert len(r.by_code("JERK_DISCONTINUITY")) == len(check(a).by_code("JERK_DISCONTINUITY"))
+
+
+def test_rules_run_in_registry_order_and_a_new_rule_is_one_entry(monkeypatch):
+    import camfab.design.checks as checks_mod
+    from camfab.design.checks import RULES, Rule, RuleResult, Scope
+    from camfab.results import Finding, Severity
+
+    assert [r.name for r in RULES] == ["continuity", "curvature", "pressure_angle", "face", "extent"]
+    seen = []
+
+    def lift_rule(contact, limits, sample):
+        """A contact rule: the dense sample is the one every rule reads; it may add report fields."""
+        (_, lo), (_, hi) = sample.extremes("pressure_angle")
+        seen.append(sample)
+        return RuleResult((Finding(IssueCode.PRESSURE_ANGLE_EXCEEDED, Severity.INFO, None, None, hi - lo, None,
+                                   "span of the pressure angle"),), {})
+
+    monkeypatch.setattr(checks_mod, "RULES", RULES + (Rule("span", Scope.CONTACT, lift_rule),))
+    a = CamGeometry(TranslatingRoller(35, 7), E9)
+    two = CamGeometry.from_contacts([a.profiles[0], CamGeometry(TranslatingRoller(30, 7), E9).profiles[0]],
+                                    a.mechanism, E9)
+    r = check(two)
+    span = [f for f in r.findings if f.severity == "info"]
+    assert [f.message for f in span] == [f"profile {k}: span of the pressure angle" for k in (1, 2)]
+    assert len(seen) == 2 and seen[0].dense is seen[0].dense  # one dense evaluation per contact, kept
+    # registered after the extent rule, the new rule runs last (profile by profile): its findings come last
+    assert r.findings[-1] is span[-1]

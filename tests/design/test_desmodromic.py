@@ -12,7 +12,7 @@ import pytest
 from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 
-from camfab.design.checks import Code, check
+from camfab.design.checks import check
 from camfab.design.conjugate import (ComplementMotion, ConjugateOscillatingFlat, ConjugateOscillatingRoller,
                                      ConjugateTranslatingFlat, ConjugateTranslatingRoller, follower_limits, lift_of,
                                      minimum_follower_distance)
@@ -21,6 +21,7 @@ from camfab.design.symmetric import ConstantDiameterCam, ConstantWidthCam
 from camfab.design.profile import CamGeometry
 from camfab.design.program import MotionProgram
 from camfab.errors import SpecError
+from camfab.results import IssueCode
 
 from ..conftest import EJEMPLO9RT
 
@@ -118,14 +119,14 @@ def test_constant_diameter_roller_centre_distance(rot):
 def test_constant_width_check_accepts_acceleration_jump():
     g = ConstantWidthCam(40, 100).geometry()
     r = check(g, allow_acceleration_jump=True)
-    acc = r.by_code(Code.ACCELERATION_DISCONTINUITY)
+    acc = r.by_code(IssueCode.ACCELERATION_DISCONTINUITY)
     assert len(acc) == 4 and all(f.severity == "warning" for f in acc)
     assert not [f for f in r.findings if f.severity == "error"] and r.verdict == "not_for_high_speed"
     strict = check(g)
-    assert all(f.severity == "error" for f in strict.by_code(Code.ACCELERATION_DISCONTINUITY))
+    assert all(f.severity == "error" for f in strict.by_code(IssueCode.ACCELERATION_DISCONTINUITY))
     assert strict.verdict == "unacceptable"
     rd = check(ConstantDiameterCam(40, 10, 100).geometry(), allow_acceleration_jump=True)
-    assert rd.verdict == "not_for_high_speed" and rd.summary["pressure_angle_deg"]["max"] < 30
+    assert rd.verdict == "not_for_high_speed" and rd.pressure_angle.max < 30
 
 
 # ---------------------------------------------------------------------------
@@ -310,7 +311,7 @@ def test_ejemplo8da():
     assert minimum_follower_distance(mech, DA8) == pytest.approx(145.0, abs=1e-9)  # R_b2 → 0 binds
     r = check(g)
     assert not [f for f in r.findings if f.severity == "error"]
-    assert len(r.by_code(Code.FACE_LENGTH)) == 4  # both faces, both sides
+    assert len(r.by_code(IssueCode.FACE_LENGTH)) == 4  # both faces, both sides
 
 
 def test_ejemplo7crt_distance_380():

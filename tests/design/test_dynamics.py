@@ -13,11 +13,12 @@ from camfab.design.assemble import check_design, dynamics_of, loads_from_spec
 from camfab.design.dynamics import ContactDynamics, Loads, analyse_dynamics
 from camfab.design.mechanisms import OscillatingFlat, OscillatingRoller, TranslatingCamRoller, TranslatingFlat, \
     TranslatingRoller
-from camfab.design.profile import CamGeometry, integrate
+from camfab.design.profile import CamGeometry
 from camfab.design.program import MotionProgram
 from camfab.design.spec import design_from_dict
 from camfab.errors import SpecError
 from camfab.formats import load_design
+from camfab.numeric import integrate
 from camfab.units import RPM
 
 from ..conftest import EXAMPLES
@@ -47,13 +48,13 @@ def test_translating_flat_shm_closed_form():
     np.testing.assert_allclose(s.bearing_force, np.abs(N), rtol=1e-14)
     rep = analyse_dynamics(g, L, W)
     # at this speed the bottom (S = 0, S″ = +10) is the weakest point, the top the strongest
-    cf = rep.summary["contact_force_n"]
-    assert cf["min"] == pytest.approx(50 + 0.005 * W * W, rel=1e-12) and cf["at_min_deg"] == pytest.approx(0, abs=1e-6)
-    assert cf["max"] == pytest.approx(150 - 0.005 * W * W, rel=1e-12) and cf["at_max_deg"] == pytest.approx(180, abs=1e-6)
+    cf = rep.summary.contact_force
+    assert cf.min == pytest.approx(50 + 0.005 * W * W, rel=1e-12) and cf.at_min == pytest.approx(0, abs=1e-6)
+    assert cf.max == pytest.approx(150 - 0.005 * W * W, rel=1e-12) and cf.at_max == pytest.approx(180, abs=1e-6)
     # jump: 150 − 0.005·ω² = 0 at the top
-    assert rep.summary["jump_speed"]["value"] == pytest.approx(math.sqrt(150 / 0.005) / RPM, rel=1e-10)
-    assert rep.summary["jump_speed"]["unit"] == "rpm"
-    assert abs(rep.summary["work_per_cycle_j"]) < 1e-12
+    assert rep.summary.jump_speed.value == pytest.approx(math.sqrt(150 / 0.005) / RPM, rel=1e-10)
+    assert rep.summary.jump_speed.unit == "rpm"
+    assert abs(rep.summary.work_per_cycle_j) < 1e-12
     assert rep.findings == ()
 
 
@@ -190,13 +191,13 @@ def test_needed_preload_and_jump_speed_sit_exactly_at_the_safety_force(mech, pro
     g = CamGeometry(mech, prog)
     speed = 900 * RPM
     rep = analyse_dynamics(g, L, speed)
-    pre = rep.summary["preload_needed"]["value"]
+    pre = rep.summary.preload_needed.value
     at_limit = analyse_dynamics(g, Loads(**{**L.__dict__, "preload": pre}), speed)
-    assert at_limit.summary["contact_force_n"]["min"] == pytest.approx(L.safety_force_n, rel=1e-9)
-    jump = rep.summary["jump_speed"]["value"] * RPM
+    assert at_limit.summary.contact_force.min == pytest.approx(L.safety_force_n, rel=1e-9)
+    jump = rep.summary.jump_speed.value * RPM
     for f, ok in ((1 - 1e-6, True), (1 + 1e-6, False)):
         r = analyse_dynamics(g, L, jump * f)
-        assert (r.summary["contact_force_n"]["min"] >= L.safety_force_n * (1 - 1e-9)) is ok
+        assert (r.summary.contact_force.min >= L.safety_force_n * (1 - 1e-9)) is ok
         assert bool(r.findings) is not ok
 
 
@@ -278,7 +279,7 @@ def test_check_report_carries_dynamics_and_its_verdict():
     assert weak.verdict == "unacceptable" and "FOLLOWER_JUMP" in weak.codes()
     none = check_design(design_from_dict(BASE))
     assert none.to_dict()["dynamics"] is None
-    assert dynamics_of(_design({"mass_kg": 0.2, "spring_preload_n": 200})).summary["safety_force_n"] == 0.0
+    assert dynamics_of(_design({"mass_kg": 0.2, "spring_preload_n": 200})).summary.safety_force_n == 0.0
 
 
 @pytest.mark.parametrize("name", ["valve_exhaust_ej1", "press_feed_oscillating"])
@@ -337,7 +338,7 @@ def test_form_closed_power_balance_and_load_sharing(mech, prog, L):
     scale = np.abs(G * qd).max() + 1e-12
     np.testing.assert_allclose(s.power, G * qd + loss, rtol=0, atol=1e-10 * scale)
     rep = analyse_dynamics(g, L, W)
-    assert rep.summary["form_closed"] and rep.summary["jump_speed"] is None
+    assert rep.summary.form_closed and rep.summary.jump_speed is None
     assert not [f for f in rep.findings if f.severity == "error"]
 
 
@@ -349,12 +350,12 @@ def test_constant_width_shm_loads_and_reversals():
     rep = analyse_dynamics(g, Loads(0.4), W)
     h = 20.0  # width − 2·Rb
     peak = 0.4 * (h / 2) * (math.pi / (120 * math.pi / 180)) ** 2 * 1e-3 * W * W  # m·(h/2)(π/β)²·ω²
-    assert rep.summary["contact_force_n"]["max"] == pytest.approx(peak, rel=1e-10)
-    assert rep.summary["second_contact_force_n"]["max"] == pytest.approx(peak, rel=1e-10)
+    assert rep.summary.contact_force.max == pytest.approx(peak, rel=1e-10)
+    assert rep.summary.second_contact_force.max == pytest.approx(peak, rel=1e-10)
     rev = [f for f in rep.findings if f.code == "LOAD_REVERSAL"]
     assert [(round(f.from_deg, 9), round(f.to_deg, 9)) for f in rev] == [(60.0, 60.0), (240.0, 240.0)]
     assert all(f.severity == "info" for f in rev)
-    assert abs(rep.summary["work_per_cycle_j"]) < 1e-12
+    assert abs(rep.summary.work_per_cycle_j) < 1e-12
 
 
 def test_form_closed_design_file():
@@ -382,10 +383,9 @@ def test_summary_extremes_are_exact_against_dense_sampling(cam):
     assume(np.all(s.lever > 1e-6) and np.all(np.isfinite(s.contact_force)))
     rep = analyse_dynamics(g, L, speed).summary
     to_x = (lambda v: math.radians(v)) if c.closed else (lambda v: v)
-    for key, arr in (("contact_force_n", s.contact_force), ("drive_torque_nm" if c.closed else "drive_force_n", s.drive)):
-        e = rep[key]
+    for key, arr in (("contact_force", s.contact_force), ("drive", s.drive)):
+        e = getattr(rep, key)
         tol = 1e-9 * (1 + np.abs(arr).max())
-        assert e["min"] <= arr.min() + tol and e["max"] >= arr.max() - tol
-        got = getattr(d.evaluate(np.array([to_x(e["at_min_deg"]), to_x(e["at_max_deg"])])),
-                      "contact_force" if key == "contact_force_n" else "drive")
-        np.testing.assert_allclose(got, [e["min"], e["max"]], rtol=1e-9, atol=tol)
+        assert e.min <= arr.min() + tol and e.max >= arr.max() - tol
+        got = getattr(d.evaluate(np.array([to_x(e.at_min), to_x(e.at_max)])), key)
+        np.testing.assert_allclose(got, [e.min, e.max], rtol=1e-9, atol=tol)

@@ -3,8 +3,9 @@
 ``MotionProgram.evaluate`` evaluates few samples law by law (or all common laws with one
 formula) and many samples segment by segment; every path must give, value for value, what
 ``Segment.values`` gives (the operation-for-operation definition).  ``check`` runs its
-extremum and range searches merged into shared solvers; each must give exactly what the
-standalone searches (``extremum``, ``positive_ranges``) give.
+extremum and range searches on one shared dense sample per contact, several searches refined
+together; each must give exactly what the standalone searches (``extremum``, ``positive_ranges``)
+give.
 """
 from __future__ import annotations
 
@@ -14,11 +15,12 @@ import numpy as np
 import pytest
 
 import camfab.design.program as program_mod
-from camfab.design.checks import check, positive_ranges
+from camfab.design.checks import check
 from camfab.design.laws import law_names
 from camfab.design.mechanisms import OscillatingRoller, TranslatingFlat, TranslatingRoller
-from camfab.design.profile import CamGeometry, extremum
+from camfab.design.profile import CamGeometry
 from camfab.design.program import MotionProgram
+from camfab.numeric import extremum, positive_ranges
 
 PI = math.pi
 
@@ -87,18 +89,17 @@ def geometry(request):
 
 
 def test_merged_searches_equal_the_standalone_ones(geometry):
-    """check()'s batched searches give exactly the standalone results."""
+    """check()'s shared-sample searches give exactly the standalone results."""
     c = geometry.profiles[0]
     ev = c.evaluate_fixed  # check() reads frame-independent values from the unrotated sample
     rep = check(geometry, pressure_angle_limit_deg=10.0, tool_radius_mm=30.0)
     edges = c.breakpoints
-    s = rep.summary
     if c.kind == "roller":
         xa, pmax = extremum(lambda x: ev(x).pressure_angle, edges, maximize=True)
         xb, pmin = extremum(lambda x: ev(x).pressure_angle, edges)
-        assert s["pressure_angle_deg"]["max"] == math.degrees(pmax)
-        assert s["pressure_angle_deg"]["min"] == math.degrees(pmin)
-        assert s["pressure_angle_deg"]["at_max_deg"] == math.degrees(xa)
+        assert rep.pressure_angle.max == math.degrees(pmax)
+        assert rep.pressure_angle.min == math.degrees(pmin)
+        assert rep.pressure_angle.at_max == math.degrees(xa)
         lim = math.radians(10.0)
         ranges = positive_ranges(lambda x: ev(x).pressure_angle - lim, edges, closed=c.closed)
         found = [f for f in rep.findings if f.code == "PRESSURE_ANGLE_EXCEEDED" and f.limit > 0]
@@ -107,10 +108,10 @@ def test_merged_searches_equal_the_standalone_ones(geometry):
         assert [f.value for f in found] == [math.degrees(gw + lim) for _, _, _, gw in ranges]
     else:
         xa, rmin = extremum(lambda x: ev(x).rho, edges)
-        assert s["radius_of_curvature_mm"]["min_convex"] == rmin
-        assert s["radius_of_curvature_mm"]["at_deg"] == math.degrees(xa)
+        assert rep.curvature.min_convex == rmin
+        assert rep.curvature.at_min_convex == math.degrees(xa)
         ranges = positive_ranges(lambda x: -ev(x).rho, edges, closed=c.closed)
         found = [f for f in rep.findings if f.code == "UNDERCUT"]
         assert [(f.from_deg, f.to_deg, f.value) for f in found] == [
             (math.degrees(lo), math.degrees(hi), -gw) for lo, hi, _, gw in ranges]
-    assert s["base_radius_mm"] == extremum(lambda x: np.hypot(*ev(x).point.T), edges)[1]
+    assert rep.base_radius_mm == extremum(lambda x: np.hypot(*ev(x).point.T), edges)[1]

@@ -10,10 +10,11 @@ import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from camfab.design.knots import KnotFile, KnotTable, KnotWarning, build_knot_table
+from camfab.design.knots import KnotFile, KnotTable, build_knot_table
 from camfab.design.program import MotionProgram
 from camfab.errors import SpecError
 from camfab.formats import load_design, load_motion_table, read_knot_file, read_knots_csv, read_knots_xlsx
+from camfab.results import Finding
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "camfab" / "templates" / "examples"
 VALVE_UNITS = {"angle": "deg", "s": "m", "v": "m/s", "a": "m/s2"}
@@ -223,14 +224,18 @@ def test_printed_puntos_load_evaluate_and_warn(name, row):
 
     warns = t.warnings()
     assert warns, "rounded knots must be flagged"
-    assert all(isinstance(w, KnotWarning) and w.ratio > 5 and w.quantity == "A" for w in warns)
+    # implied peak (value) over the largest knot value (limit), of the acceleration
+    assert all(isinstance(w, Finding) and w.value / w.limit > 5 and "the acceleration implied" in w.message
+               for w in warns)
     ramp = [w for w in warns if 22 <= w.from_deg < 28]
-    assert ramp and all(w.unit == "m/s2" for w in ramp)
+    assert ramp and all(f"{w.value:.6g} m/s2," in w.message for w in ramp)
     # the mirrored seating ramp is flagged as well
     assert {round(w.from_deg) for w in warns} >= {22, 24, 194, 196}
-    d = warns[0].as_dict()
+    segments = [int(w.message.split()[1]) for w in warns]
+    assert segments == sorted(segments) and all(w.to_deg > w.from_deg for w in warns)
+    d = warns[0].to_dict()
     assert d["code"] == "KNOT_INCONSISTENT" and d["severity"] == "warning"
-    assert {"segment", "from_deg", "to_deg", "implied_peak", "message"} <= set(d)
+    assert {"code", "severity", "from_deg", "to_deg", "value", "limit", "message"} == set(d)
     assert "inconsistent" in d["message"]
     # interpolated as printed the valve accelerates at > 10 000 m/s² (spec §3.6)
     peak_a = max(abs(p) for p in (prog.peaks()[2].max, prog.peaks()[2].min)) * OMEGA_1500**2 / 1e3
@@ -342,8 +347,8 @@ def test_program_below_zero_is_rejected_with_the_segment():
 def test_jerk_warning_for_degree_7():
     rows = [[0, 0, 0, 0, 0], [90, 5, 0, 0, 0.01], [180, 0, 0, 0, -0.01]]
     warns = table(rows, 7).warnings()
-    assert {w.quantity for w in warns} == {"J"}
-    assert all(w.unit == "mm/rad3" for w in warns)
+    assert warns and all("the jerk implied" in w.message for w in warns)
+    assert all(f"{w.value:.6g} mm/rad3," in w.message for w in warns)
 
 
 def test_degree_5_ignores_a_jerk_column():

@@ -11,10 +11,10 @@ from hypothesis import strategies as st
 
 from camfab.design.mechanisms import (OscillatingFlat, OscillatingRoller, TranslatingCamRoller, TranslatingFlat,
                                       TranslatingRoller)
-from camfab.design.checks import positive_ranges
-from camfab.design.profile import CamGeometry, integrate
+from camfab.design.profile import CamGeometry
 from camfab.design.program import MotionProgram
 from camfab.errors import SpecError
+from camfab.numeric import integrate, positive_ranges
 
 from ..conftest import EJEMPLO9RT, EJEMPLO11RO, EXAMPLES
 

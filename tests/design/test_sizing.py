@@ -69,8 +69,8 @@ def test_pressure_angle_oscillating():
 ])
 def test_no_undercut(make, prog):
     rb = sizing.min_base_radius_no_undercut(make(30.0), prog)
-    roc = check(CamGeometry(make(rb), prog)).summary["radius_of_curvature_mm"]
-    assert roc["pitch_min_convex"] == pytest.approx(make(rb).roller_radius_mm, rel=1e-9)
+    roc = check(CamGeometry(make(rb), prog)).curvature
+    assert roc.pitch_min_convex == pytest.approx(make(rb).roller_radius_mm, rel=1e-9)
     _active(make, rb, prog, "UNDERCUT", also=("CUSP",))
     assert "CUSP" in _codes(make(rb), prog)
 
@@ -102,8 +102,8 @@ def test_optimal_offset():
         assert peak <= sizing.peak_pressure_angle_deg(TranslatingRoller(35, 7, e + de), E9) + 1e-9
     assert peak < sizing.peak_pressure_angle_deg(mech, E9) - 1
     # at the optimum the rise and return peaks balance
-    pa = check(CamGeometry(TranslatingRoller(35, 7, e), E9)).summary["pressure_angle_deg"]
-    assert pa["max"] == pytest.approx(-pa["min"], abs=1e-4)
+    pa = check(CamGeometry(TranslatingRoller(35, 7, e), E9)).pressure_angle
+    assert pa.max == pytest.approx(-pa.min, abs=1e-4)
     assert sizing.optimal_offset(TranslatingRoller(35, 7, 0.0, "ccw"), E9) == pytest.approx(-e, abs=1e-4)
     # a symmetric law needs no offset
     assert sizing.optimal_offset(TranslatingRoller(50, 5), E1) == pytest.approx(0.0, abs=1e-4)

@@ -94,9 +94,9 @@ def test_dynamics_figure_only_for_designs_with_dynamics(valve, e9):
     assert "drive torque" in bottom.get_ylabel()
     np.testing.assert_allclose(bottom.lines[0].get_ydata(), _dynamics(spec, geom).evaluate(x).drive, rtol=1e-12)
     # the exact extremes of the summary are marked
-    cf = rep.summary["dynamics"]["contact_force_n"]
+    cf = rep.dynamics.contact_force
     dots = [(ln.get_xdata()[0], ln.get_ydata()[0]) for ln in top.lines if ln.get_marker() == "o"]
-    assert (cf["at_min_deg"], cf["min"]) in dots and (cf["at_max_deg"], cf["max"]) in dots
+    assert (cf.at_min, cf.min) in dots and (cf.at_max, cf.max) in dots
     assert top.get_xlim() == (0.0, 360.0)
 
 
@@ -115,7 +115,7 @@ def test_jump_and_below_safety_ranges_are_shaded(press_fast):
     y = top.lines[0].get_ydata()
     xs = top.lines[0].get_xdata()
     inside = (xs > jumps[0].from_deg) & (xs < jumps[0].to_deg)
-    assert np.all(y[inside] < 0) and np.nanmin(y) == pytest.approx(rep.summary["dynamics"]["contact_force_n"]["min"],
+    assert np.all(y[inside] < 0) and np.nanmin(y) == pytest.approx(rep.dynamics.contact_force.min,
                                                                    abs=0.01)
 
 
@@ -135,7 +135,7 @@ def test_self_locking_follower_stays_readable():
     assert len(locks) == 2
     top = dynamics_figure(spec, geom, rep).axes[0]
     y = top.lines[0].get_ydata()
-    assert np.nanmax(np.abs(y)) < 1e3 < abs(rep.summary["dynamics"]["contact_force_n"]["min"])
+    assert np.nanmax(np.abs(y)) < 1e3 < abs(rep.dynamics.contact_force.min)
     assert top.get_ylim()[1] < 1e3  # the ±1e13 extremes are not drawn
     spans = {(round(p.get_x(), 6), round(p.get_x() + p.get_width(), 6)) for p in top.patches}
     assert {(round(f.from_deg, 6), round(f.to_deg, 6)) for f in locks} <= spans
@@ -155,7 +155,7 @@ def test_translating_cam_figure_shows_the_drive_force(wedge):
     # at the top of the cycloidal rise S = 10 mm, S' = S'' = 0 and the normal is vertical: N = F0 + k·S
     s = _dynamics(spec, geom).evaluate([100.0])
     assert s.contact_force[0] == pytest.approx(20.0 + 1.0e3 * 0.010, rel=1e-9)
-    assert rep.summary["dynamics"]["contact_force_n"]["max"] == pytest.approx(30.0, rel=1e-9)
+    assert rep.dynamics.contact_force.max == pytest.approx(30.0, rel=1e-9)
 
 
 # ---------------------------------------------------------------------------
@@ -173,10 +173,10 @@ def test_html_report_has_the_dynamics_section(valve, valve_files):
     assert '<figure id="plot-dynamics"' in page and 'src="plots/dynamics.svg"' in page
     assert valve_files["plots/dynamics.png"].startswith(b"\x89PNG") and b"<svg" in valve_files["plots/dynamics.svg"]
     assert page.count('data-plot="dynamics"') == 1  # shown in its section, not again among the plots
-    d = rep.summary["dynamics"]
-    want = [d["contact_force_n"]["max"], d["contact_force_n"]["min"], d["safety_force_n"],
-            d["bearing_force_n"]["max"], d["drive_torque_nm"]["max"], d["drive_torque_nm"]["min"],
-            d["work_per_cycle_j"], d["mean_power_w"], d["preload_needed"]["value"], d["jump_speed"]["value"]]
+    d = rep.dynamics
+    assert d.torque
+    want = [d.contact_force.max, d.contact_force.min, d.safety_force_n, d.bearing_force.max, d.drive.max,
+            d.drive.min, d.work_per_cycle_j, d.mean_power_w, d.preload_needed.value, d.jump_speed.value]
     assert _table_values(page, "dynamics-table") == want  # exact floats, in table order
     assert want[1] == pytest.approx(193.913, abs=1e-3) and want[2] == 100.0
     for text in ("Contact force (N)", "Drive torque (N·m)", "Work per cycle (J)", "Mean power (W)",
@@ -197,7 +197,7 @@ def test_html_report_flags_a_jumping_follower(press_fast):
     assert status["Jump speed (rpm)"] == "bad" and status["Safety force (N)"] == "ok"
     assert "The follower leaves the cam (N &lt; 0): see the findings" in page
     assert 'data-code="FOLLOWER_JUMP"' in page
-    assert _table_values(page, "dynamics-table")[1] == rep.summary["dynamics"]["contact_force_n"]["min"] < 0
+    assert _table_values(page, "dynamics-table")[1] == rep.dynamics.contact_force.min < 0
 
 
 def test_html_report_without_dynamics(e9_files):
@@ -239,23 +239,21 @@ def test_xlsx_dynamics_sheet_values(valve):
     # physics spot checks: base-circle dwell N = preload, friction = μN, power = T·ω
     assert data[300, 1] == pytest.approx(250.0, rel=1e-12) and data[300, 2] == pytest.approx(0.06 * 250.0, rel=1e-12)
     np.testing.assert_allclose(data[:, 5], data[:, 4] * spec.speed, rtol=1e-12, atol=1e-9)
-    d = rep.summary["dynamics"]["contact_force_n"]
-    assert d["min"] <= np.nanmin(data[:, 1]) and np.nanmax(data[:, 1]) <= d["max"] * (1 + 1e-12)  # exact extremes
+    d = rep.dynamics.contact_force
+    assert d.min <= np.nanmin(data[:, 1]) and np.nanmax(data[:, 1]) <= d.max * (1 + 1e-12)  # exact extremes
 
 
 def test_xlsx_dynamics_summary_in_the_checks_sheet(press_fast):
     spec, geom, rep = press_fast
     ws = _book(spec, geom, rep)["Checks"]
     rows = {r[0]: r[1:5] for r in ws.iter_rows(values_only=True) if r[0]}
-    d = rep.summary["dynamics"]
+    d = rep.dynamics
     exact = lambda v: pytest.approx(v, rel=1e-15)  # noqa: E731 - openpyxl stores floats with 16 digits
-    assert rows["Minimum contact force"] == (exact(d["contact_force_n"]["min"]), "N",
-                                             exact(d["contact_force_n"]["at_min_deg"]), None)
-    assert rows["Maximum drive torque"][:3] == (exact(d["drive_torque_nm"]["max"]), "N·m",
-                                                exact(d["drive_torque_nm"]["at_max_deg"]))
+    assert rows["Minimum contact force"] == (exact(d.contact_force.min), "N", exact(d.contact_force.at_min), None)
+    assert d.torque and rows["Maximum drive torque"][:3] == (exact(d.drive.max), "N·m", exact(d.drive.at_max))
     assert rows["Safety force"][:2] == (50, "N")
-    assert rows["Preload needed"][:2] == (exact(d["preload_needed"]["value"]), "N·m")
-    assert rows["Jump speed"][:2] == (exact(d["jump_speed"]["value"]), "rpm")
+    assert rows["Preload needed"][:2] == (exact(d.preload_needed.value), "N·m")
+    assert rows["Jump speed"][:2] == (exact(d.jump_speed.value), "rpm")
     assert rows["Work per cycle"][1] == "J" and rows["Mean power"][1] == "W"
     assert "FOLLOWER_JUMP" in rows  # findings still follow
 
@@ -280,8 +278,8 @@ def test_xlsx_oscillating_step_and_translating_cam(press, wedge):
     np.testing.assert_allclose(data[idx, 1], ref.contact_force, rtol=1e-12)
     np.testing.assert_allclose(data[idx, 4], ref.drive, rtol=1e-12, atol=1e-12)
     rows = {r[0]: r[1:4] for r in wb["Checks"].iter_rows(values_only=True) if r[0]}
-    assert rows["Maximum drive force"][:2] == (pytest.approx(rep.summary["dynamics"]["drive_force_n"]["max"],
-                                                             rel=1e-15), "N")
+    assert not rep.dynamics.torque
+    assert rows["Maximum drive force"][:2] == (pytest.approx(rep.dynamics.drive.max, rel=1e-15), "N")
 
 
 def test_no_dynamics_sheet_without_dynamics(e9):
@@ -364,8 +362,8 @@ def test_form_closed_figure_xlsx_and_html(width):
     from camfab.report.plots import report_figures
 
     spec, geom, rep = width
-    d = rep.summary["dynamics"]
-    assert d["form_closed"] and [round(a, 6) for a, _ in d["load_reversals_deg"]] == [60.0, 240.0]
+    d = rep.dynamics
+    assert d.form_closed and [round(a, 6) for a, _ in d.load_reversals] == [60.0, 240.0]
     ref = dynamics_model(spec, geom)
     top, _ = report_figures(spec, geom, rep)["dynamics"].axes
     c = geom.profiles[0]
@@ -384,5 +382,5 @@ def test_form_closed_figure_xlsx_and_html(width):
     for text in ("Contact force, follower 2 (N)", "Load reversals", "60.0°, 240.0°", "Form-closed follower"):
         assert text in page, text
     rows = {r[0]: r[1:5] for r in _book(spec, geom, rep)["Checks"].iter_rows(values_only=True) if r[0]}
-    assert rows["Maximum contact force, follower 2"][0] == pytest.approx(d["second_contact_force_n"]["max"], rel=1e-15)
+    assert rows["Maximum contact force, follower 2"][0] == pytest.approx(d.second_contact_force.max, rel=1e-15)
     assert "Jump speed" not in rows and "Safety force" not in rows

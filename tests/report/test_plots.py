@@ -89,7 +89,7 @@ def test_pressure_angle_violations_are_shaded(bad, e9):
 
 
 def test_finding_spans_split_a_wrapping_range(e9):
-    from camfab.design.motion_report import Finding
+    from camfab.results import Finding, IssueCode, Severity
 
-    f = Finding("UNDERCUT", "error", 350.0, 10.0, 1.0, 2.0, "x")
-    assert finding_spans([f], ("UNDERCUT",), axis_of(e9[0].program())) == [(350.0, 360.0), (0.0, 10.0)]
+    f = Finding(IssueCode.UNDERCUT, Severity.ERROR, 350.0, 10.0, 1.0, 2.0, "x")
+    assert finding_spans([f], (IssueCode.UNDERCUT,), axis_of(e9[0].program())) == [(350.0, 360.0), (0.0, 10.0)]

@@ -198,10 +198,9 @@ def test_checks_sheet(e9_book):
                                           "Continuous")
     assert table["Velocity (mm/s)"][0] == pytest.approx(peaks["V"]["max"], rel=1e-12)
     assert table["Jerk (mm/s3)"][2] == "Discontinuous" and table["Acceleration (mm/s2)"][2] == "Continuous"
-    pa = report.summary["pressure_angle_deg"]
-    assert table["Pressure angle (deg)"] == (pytest.approx(pa["max"]), pytest.approx(pa["min"]), "Acceptable")
-    assert table["Convex radius of curvature (mm)"][1] == pytest.approx(
-        report.summary["radius_of_curvature_mm"]["min_convex"])
+    pa = report.pressure_angle
+    assert table["Pressure angle (deg)"] == (pytest.approx(pa.max), pytest.approx(pa.min), "Acceptable")
+    assert table["Convex radius of curvature (mm)"][1] == pytest.approx(report.curvature.min_convex)
     fhead = [i for i, r in enumerate(rows) if r[0] == "Code"][0]
     assert rows[fhead][:4] == ("Code", "Severity", "From (deg)", "To (deg)")
     found = [r for r in rows[fhead + 1:] if r[0]]

@@ -1,0 +1,148 @@
+"""What every check rule shares: the limits a cam is judged against, a rule's result, and the
+dense sample of a contact that all the rules of that contact read.
+
+A rule is a plain function — of a contact ``(contact, limits, sample)`` or of the whole cam
+``(geometry, limits, samples)`` — that returns its findings and the report fields it fills.
+"""
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ... import numeric
+from ...results import Finding
+from ..kinds import ContactKind
+from ..profile import Contact, ProfileSample
+
+__all__ = ["Limits", "RuleResult", "ContactSample", "QUANTITIES", "CUSP_TOL_MM", "DEFAULT_PRESSURE_LIMIT_DEG",
+           "radius", "span_text"]
+
+#: a radius margin within this many mm of its limit is a cusp (not an undercut)
+CUSP_TOL_MM = 1e-7
+#: pressure-angle limits (degrees) by follower motion (CAM-DAS, after Norton)
+DEFAULT_PRESSURE_LIMIT_DEG = {"translating": 30.0, "oscillating": 35.0}
+
+#: a quantity of a profile sample: (n,) values from a :class:`ProfileSample` of n parameters
+Quantity = Callable[[ProfileSample], np.ndarray | None]
+
+
+@dataclass(frozen=True)
+class Limits:
+    """What the checks judge a cam against.
+
+    Attributes
+    ----------
+    pressure_angle_deg : float, optional
+        Limit on |δ| (degrees); default 30 (translating followers and cams) or 35 (oscillating).
+    tool_radius_mm : float, optional
+        Cutter radius: concave stretches tighter than it are reported.
+    face_margin_mm : float
+        Safety margin added to each required flat-face length (mm).
+    allow_acceleration_jump : bool
+        Accept acceleration jumps (constant-width / constant-diameter cams).
+    speed : float
+        ω in rad/s (mm/s for a translating cam): the motion peaks are given in time units.
+    """
+
+    pressure_angle_deg: float | None = None
+    tool_radius_mm: float | None = None
+    face_margin_mm: float = 0.0
+    allow_acceleration_jump: bool = False
+    speed: float = 1.0
+
+
+@dataclass(frozen=True)
+class RuleResult:
+    """A rule's findings and the :class:`~camfab.results.CheckReport` fields it fills (by field
+    name; a field filled by several profiles is merged with its ``merged`` method)."""
+
+    findings: tuple[Finding, ...] = ()
+    fields: dict[str, Any] = field(default_factory=dict)
+
+
+def radius(s: ProfileSample) -> np.ndarray:
+    """Distance of the contact point from the cam centre (mm)."""
+    return np.hypot(s.point[:, 0], s.point[:, 1])
+
+
+#: the frame-independent quantities whose extremes the rules read, by name, with the contacts they
+#: apply to; a contact's applicable ones are all searched together on the first request
+QUANTITIES: dict[str, tuple[Quantity, Callable[[Contact], bool]]] = {
+    "curvature_pitch": (lambda s: s.curvature_pitch, lambda c: c.kind is ContactKind.ROLLER),
+    "rho": (lambda s: s.rho, lambda c: c.kind is not ContactKind.ROLLER),
+    "pressure_angle": (lambda s: s.pressure_angle, lambda c: c.kind is ContactKind.ROLLER),
+    "face_position": (lambda s: s.face_position, lambda c: c.has_face),
+    "radius": (radius, lambda c: c.closed),
+}
+
+
+class ContactSample:
+    """One contact evaluated once on the dense grid of its breakpoints (fixed frame), shared by every
+    rule of that contact: a search given these values does not sample the contact again.
+
+    The checked quantities (curvatures, pressure angle, face position, |point|, point × point′) do
+    not depend on the frame, so the fixed-frame sample (no rotation into the cam frame) serves.
+    The extremes of the :data:`QUANTITIES` that apply to the contact are searched together (one
+    evaluation per round for all of them) when a rule first asks for one, and kept.
+    """
+
+    def __init__(self, contact: Contact):
+        self.contact = contact
+        self.edges = contact.breakpoints
+        self.grid = numeric.dense_grid(self.edges)
+        self._extremes: dict[str, tuple[numeric.Optimum, numeric.Optimum]] | None = None
+
+    @functools.cached_property
+    def dense(self) -> ProfileSample:
+        """The contact at every sample of :attr:`grid`."""
+        return self.contact.evaluate_fixed(self.grid.x)
+
+    def _rows(self, quantities: tuple[Quantity, ...]) -> Callable[[np.ndarray], np.ndarray]:
+        def f(x: np.ndarray) -> np.ndarray:
+            s = self.contact.evaluate_fixed(x)
+            return np.stack([np.asarray(q(s), dtype=float) for q in quantities])
+        return f
+
+    def extrema(self, quantities: tuple[Quantity, ...], maximize: tuple[bool, ...],
+                rows: tuple[int, ...]) -> list[numeric.Optimum]:
+        """Exact extrema over the contact's period: search i looks at ``quantities[rows[i]]``."""
+        values = np.stack([np.asarray(q(self.dense), dtype=float) for q in quantities])
+        return numeric.extrema(self._rows(quantities), self.edges, maximize, rows=rows, values=values)
+
+    def extremes(self, name: str) -> tuple[numeric.Optimum, numeric.Optimum]:
+        """``(minimum, maximum)`` of the quantity ``name`` of :data:`QUANTITIES`."""
+        if self._extremes is None:
+            names = [n for n, (_, applies) in QUANTITIES.items() if applies(self.contact)]
+            found = self.extrema(tuple(QUANTITIES[n][0] for n in names), (False, True) * len(names),
+                                 tuple(k for k in range(len(names)) for _ in (0, 1)))
+            self._extremes = {n: (found[2 * k], found[2 * k + 1]) for k, n in enumerate(names)}
+        if name not in self._extremes:
+            lo, hi = self.extrema((QUANTITIES[name][0],), (False, True), (0, 0))
+            self._extremes[name] = (lo, hi)
+        return self._extremes[name]
+
+    def ranges(self, *quantities: Quantity) -> list[list[numeric.Range]]:
+        """Where each quantity is > 0 (all searched together), with its largest value per range."""
+        values = np.stack([np.asarray(q(self.dense), dtype=float) for q in quantities])
+        return numeric.positive_ranges(self._rows(quantities), self.edges, closed=self.contact.closed,
+                                       values=values)
+
+    def user(self, x: float) -> float:
+        """A parameter in user units: degrees of cam angle, or mm of travel."""
+        return math.degrees(x) if self.contact.axis.rotating else float(x)
+
+    @property
+    def unit(self) -> str:
+        """``"°"`` or ``" mm"``, to follow a number in a message."""
+        return self.contact.axis.x_symbol
+
+
+def span_text(sample: ContactSample, lo: float, hi: float) -> str:
+    """``"at A°"`` or ``"from A° to B°"`` (user units) for a range of parameters."""
+    a, b, u = sample.user(lo), sample.user(hi), sample.unit
+    return f"at {a:.6g}{u}" if abs(b - a) < 1e-9 else f"from {a:.6g}{u} to {b:.6g}{u}"

@@ -1,0 +1,94 @@
+"""The curvature rule: undercut, cusp and concave stretches tighter than the cutter.
+
+* ``UNDERCUT`` (error) — rollers: the pitch curve is convex with radius 0 < ρ_p < R_r (the
+  roller cannot follow it: judged on the pitch curve, whose radius is the profile's plus R_r);
+  flat faces: ρ < 0 (the profile crosses itself between two cusps).
+* ``CUSP`` (error) — the limit case: ρ_p = R_r (roller) or ρ = 0 (flat face) within
+  :data:`~.common.CUSP_TOL_MM`: the profile has a sharp point.
+* ``CONCAVE_RADIUS_BELOW_ROLLER`` (warning) — a concave stretch whose radius is smaller than the
+  roller or the cutter (the larger).  On a true roller envelope the concave radius is
+  |ρ_p| + R_r > R_r, so it fires only for a cutter larger than the roller: it names the stretches
+  such a cutter cannot finish, and the largest tool that fits.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ...results import Curvature, Finding, IssueCode, Severity
+from ..kinds import ContactKind
+from ..profile import Contact
+from .common import CUSP_TOL_MM, ContactSample, Limits, RuleResult, span_text
+
+__all__ = ["curvature_rule"]
+
+
+def curvature_rule(contact: Contact, limits: Limits, sample: ContactSample) -> RuleResult:
+    """Undercut, cusp and concave-radius findings, and the radius-of-curvature summary."""
+    if contact.kind is ContactKind.ROLLER:
+        return _roller(contact, limits, sample)
+    return _face(sample)
+
+
+def _cusp(sample: ContactSample, x: float, value: float, limit: float, why: str) -> Finding:
+    a = sample.user(x)
+    return Finding(IssueCode.CUSP, Severity.ERROR, a, a, value, limit,
+                   f"cusp at {a:.6g}{sample.unit}: {why}, so the profile has a sharp point with very high contact "
+                   "stress. Enlarge the base circle (or use a smaller roller)")
+
+
+def _roller(contact: Contact, limits: Limits, sample: ContactSample) -> RuleResult:
+    """Rollers (knife edges: radius 0): judged on the pitch-curve curvature κ_p."""
+    rr = contact.roller_radius
+    lim = max(rr, limits.tool_radius_mm or 0.0)
+    (xb, kmin), (xa, kmax) = sample.extremes("curvature_pitch")
+    convex, concave = kmax > 0, kmin < 0
+    summary = Curvature(1.0 / kmax - rr if convex else None, sample.user(xa) if convex else None,
+                        1.0 / -kmin + rr if concave else None, sample.user(xb) if concave else None,
+                        1.0 / kmax if convex else None, None)
+    undercut = rr > 0 and convex and rr - 1.0 / kmax > CUSP_TOL_MM
+    tight = lim > 0 and concave and 1.0 / -kmin + rr < lim
+    wanted = ([lambda s: rr * s.curvature_pitch - 1.0] if undercut else []) + (
+        [lambda s: np.where(s.curvature_pitch < 0, -lim * s.curvature - 1.0, -1.0)] if tight else [])
+    found = sample.ranges(*wanted) if wanted else []
+    out: list[Finding] = []
+    if undercut:
+        out += _undercuts(sample, found.pop(0), rr)
+    elif rr > 0 and convex and rr - 1.0 / kmax >= -CUSP_TOL_MM:
+        out.append(_cusp(sample, xa, 1.0 / kmax, rr, "the pitch-curve radius equals the roller radius"))
+    if tight:
+        fits = 1.0 / -kmin + rr
+        out += [Finding(IssueCode.CONCAVE_RADIUS_BELOW_ROLLER, Severity.WARNING, sample.user(lo), sample.user(hi),
+                        lim / (1.0 + gw), lim,
+                        f"concave stretch {span_text(sample, lo, hi)} with radius down to {fits:.6g} mm, tighter than "
+                        f"the {lim:.6g} mm cutter; the largest tool radius that fits is {fits:.6g} mm")
+                for lo, hi, _, gw in found.pop(0)]
+    return RuleResult(tuple(out), {"curvature": summary})
+
+
+def _undercuts(sample: ContactSample, ranges, rr: float) -> list[Finding]:
+    """UNDERCUT from the ranges where R_r·κ_p − 1 > 0 (the worst value gives the smallest ρ_p)."""
+    out = []
+    for lo, hi, xw, gw in ranges:
+        rp = rr / (1.0 + gw)
+        out.append(Finding(IssueCode.UNDERCUT, Severity.ERROR, sample.user(lo), sample.user(hi), rp, rr,
+                           f"undercut {span_text(sample, lo, hi)}: the pitch curve is convex with radius down to "
+                           f"{rp:.6g} mm (at {sample.user(xw):.6g}{sample.unit}), smaller than the roller "
+                           f"({rr:.6g} mm); the roller cannot follow the law there. Enlarge the base circle or use a "
+                           "smaller roller"))
+    return out
+
+
+def _face(sample: ContactSample) -> RuleResult:
+    """Flat faces: judged on the profile radius ρ."""
+    (xa, rmin), (_, rmax) = sample.extremes("rho")
+    summary = Curvature(rmin, sample.user(xa), None, None, None, rmax)
+    out: list[Finding] = []
+    if rmin < -CUSP_TOL_MM:
+        for lo, hi, xw, gw in sample.ranges(lambda s: -s.rho)[0]:
+            out.append(Finding(IssueCode.UNDERCUT, Severity.ERROR, sample.user(lo), sample.user(hi), -gw, 0.0,
+                               f"undercut {span_text(sample, lo, hi)}: the radius of curvature is negative (down to "
+                               f"{-gw:.6g} mm at {sample.user(xw):.6g}{sample.unit}); the profile crosses itself "
+                               "between two cusps and the face cannot follow the law. Enlarge the base circle"))
+    elif rmin <= CUSP_TOL_MM:
+        out.append(_cusp(sample, xa, rmin, 0.0, "the radius of curvature reaches 0"))
+    return RuleResult(tuple(out), {"curvature": summary})
