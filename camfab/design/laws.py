@@ -128,6 +128,8 @@ class Law:
 
     #: internal breakpoints in ``u`` (open interval (0, 1)) where the formula changes
     breaks: tuple[float, ...] = ()
+    #: True when f does not depend on u at all (its value at any u, NaN included, is f(0))
+    constant: bool = False
 
     def __init__(self, name: str = "", title: str = "", cv: float = 0.0, ca: float = 0.0,
                  cj: float = 0.0) -> None:
@@ -229,6 +231,8 @@ class Law:
 
 class Dwell(Law):
     """``f = 0``: the follower rests."""
+
+    constant = True
 
     def _eval(self, u: np.ndarray, nu: int) -> np.ndarray:
         return np.zeros_like(u, dtype=float)

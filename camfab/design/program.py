@@ -102,7 +102,7 @@ class MotionProgram:
     def segment_index(self, x: np.ndarray) -> np.ndarray:
         """Index of the segment containing each ``x`` (already reduced to [0, period))."""
         idx = np.searchsorted(self._starts, x, side="right") - 1
-        return np.clip(idx, 0, len(self.segments) - 1)
+        return np.maximum(idx, 0)  # ≤ n − 1 already: NaN sorts last
 
     def evaluate(self, x, orders: Sequence[int] = (0, 1, 2, 3)) -> np.ndarray:
         """S and its derivatives at ``x``.
