@@ -52,7 +52,7 @@ middle.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -95,7 +95,7 @@ def horner(c, u):
     -------
     float or array of the broadcast shape of ``c[..., 0]`` and ``u``
     """
-    cols = np.moveaxis(c, -1, 0) if isinstance(c, np.ndarray) else c
+    cols = c.transpose((c.ndim - 1, *range(c.ndim - 1))) if isinstance(c, np.ndarray) else c
     out = cols[-1] + u * 0.0
     for cj in cols[-2::-1]:
         out = cj + out * u
@@ -285,7 +285,7 @@ class Polynomial(Law):
         return super().critical_points(nu, lo, hi)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True)
 class Wave:
     """One harmonic term ``amp·sin(w·(u + shift) + phase)`` (a cosine has phase π/2)."""
 
@@ -293,6 +293,7 @@ class Wave:
     w: float
     phase: float = 0.0
     shift: float = 0.0
+    _factors: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def derivative(self, u: np.ndarray, nu: int) -> np.ndarray:
         """``amp·wᵛ·sin(w·(u + shift) + phase + νπ/2)``."""
@@ -301,10 +302,14 @@ class Wave:
 
     def rows(self, u: np.ndarray, orders: Sequence[int]) -> np.ndarray:
         """:meth:`derivative` for every order, one sine call (same values)."""
+        key = tuple(orders)
+        hit = self._factors.get(key)
+        if hit is None:  # the amplitudes amp·wᵛ and phases φ + νπ/2 as columns
+            hit = self._factors[key] = (np.array([[self.amp * self.w**nu] for nu in orders]),
+                                        np.array([[self.phase + nu * PI / 2] for nu in orders]))
+        a, ph = hit
         arg = u + self.shift if self.shift else u
-        a = np.array([self.amp * self.w**nu for nu in orders])
-        ph = np.array([self.phase + nu * PI / 2 for nu in orders])
-        return a[:, None] * np.sin(self.w * arg + ph[:, None])
+        return a * np.sin(self.w * arg + ph)
 
 
 class Harmonic(Law):
