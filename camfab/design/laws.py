@@ -53,6 +53,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -77,7 +78,7 @@ PI = np.pi
 _SCAN_POINTS = 129
 
 
-def horner(c, u):
+def horner(c: Sequence[float] | np.ndarray, u: Any) -> Any:
     """``Σ c[j]·uʲ`` by Horner's rule: ``c[-1] + u·0``, then ``c[j] + out·u`` down to j = 0.
 
     Operation for operation as :func:`numpy.polynomial.polynomial.polyval` (so bit-identical
