@@ -5,12 +5,14 @@ same order): ``(lift·f⁽ᵛ⁾(u) + s0)/βᵛ`` for a standard law (``+ s0`` a
 there), ``p⁽ᵛ⁾(u)/βᵛ`` for a polynomial segment, ``u = (x − start)/β``.
 
 * :func:`by_segment` — the reference path: the samples are grouped by segment and each
-  segment evaluates its own with scalar parameters.  Fastest with many samples per segment.
+  segment evaluates its own (:meth:`Segment.rows`) with scalar parameters.  Fastest with
+  many samples per segment.
 * :class:`Grouped` — the samples are grouped by *law*: each law evaluates the samples of
   all its segments in one call (the normalised shape does not depend on the segment), then
-  lift, S0 and β are applied per sample; the polynomial segments are evaluated together
-  with per-sample coefficients.  Fastest with few samples per segment (a check's searches),
-  where the cost is the number of numpy calls, not their length.
+  lift, S0 and β are applied per sample; the polynomial laws, and the polynomial segments,
+  are each evaluated together with per-sample coefficients, and a dwell's values are looked
+  up.  Fastest with few samples per segment (a check's searches), where the cost is the
+  number of numpy calls, not their length.
 """
 from __future__ import annotations
 
@@ -58,7 +60,7 @@ def by_segment(segments: Sequence[Segment], xr: np.ndarray, idx: np.ndarray, ord
 _CONSTANT, _POLY_LAW, _POLY_SEGMENT = "constant", "polynomial law", "polynomial segment"
 
 
-def _group_key(seg: Segment):
+def _group_key(seg: Segment) -> str | Law:
     if seg.formula.constant:
         return _CONSTANT
     if seg.coeffs is not None:
@@ -139,7 +141,7 @@ class Grouped:
         """``out[:, i]`` = the orders at ``xr[i]`` (see :func:`by_segment` for the arguments)."""
         for g, sel in self._parts(idx):
             key, si = self.keys[g], idx[sel]
-            if key is _CONSTANT:
+            if key == _CONSTANT:
                 out[:, sel] = self._table("constant", orders, self._constants)[:, si]
                 continue
             u = (xr[sel] - self.start[si]) / self.span[si]
@@ -147,7 +149,7 @@ class Grouped:
                 v = key.rows(u, orders)
             else:
                 v = horner(self._table("coef", orders, self._coefficients)[:, si, :], u)
-            if key is not _POLY_SEGMENT:
+            if key != _POLY_SEGMENT:
                 v *= self.lift[si]
                 for r, nu in enumerate(orders):
                     if nu == 0:
