@@ -176,7 +176,9 @@ class Law:
 
         ``f⁽ᵛ⁺¹⁾`` is scanned at 129 points and every sign change polished by Brent's
         method to ~1e-15; at a flat end (derivative exactly 0) the sign is taken just inside,
-        so an extremum in the first or last cell is still bracketed.
+        so an extremum in the first or last cell is still bracketed.  The search runs on f
+        itself, so the points do not depend on a segment's lift or span (nor on which
+        programs were analysed before).
         """
         key = (nu, float(lo), float(hi))
         hit = self._critical.get(key)
