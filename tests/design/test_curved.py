@@ -195,8 +195,8 @@ def test_checks_on_a_mushroom_follower():
     # exact extremes: never beaten by a dense sample, and within its resolution of it
     assert 0 <= face[0].value + s.face_position.min() < 1e-5
     assert 0 <= face[1].value - s.face_position.max() < 1e-5
-    pa = rep.summary["pressure_angle_deg"]
-    assert pa["max"] == pytest.approx(math.degrees(s.pressure_angle.max()), abs=1e-4) and pa["limit"] == 30.0
+    pa = rep.pressure_angle
+    assert pa.max == pytest.approx(math.degrees(s.pressure_angle.max()), abs=1e-4) and pa.limit == 30.0
 
 
 def test_a_small_face_radius_on_a_steep_cam_undercuts_like_the_roller():

@@ -1,8 +1,9 @@
 """The fast evaluation paths agree exactly with the reference formulas.
 
-``MotionProgram.evaluate`` evaluates few samples law by law (or all common laws with one
-formula) and many samples segment by segment; every path must give, value for value, what
-``Segment.values`` gives (the operation-for-operation definition).  ``check`` runs its
+``MotionProgram.evaluate`` evaluates few samples law by law and many samples segment by
+segment; every path must give, value for value, what ``Segment.values`` gives (the
+operation-for-operation definition), and every law's several-orders and single-point
+evaluations what its reference evaluation ``law(u, nu)`` gives.  ``check`` runs its
 extremum and range searches on one shared dense sample per contact, several searches refined
 together; each must give exactly what the standalone searches (``extremum``, ``positive_ranges``)
 give.
@@ -16,10 +17,10 @@ import pytest
 
 import camfab.design.program as program_mod
 from camfab.design.checks import check
-from camfab.design.laws import law_names
+from camfab.design.laws import LAWS, Piecewise, law_names
 from camfab.design.mechanisms import OscillatingRoller, TranslatingFlat, TranslatingRoller
 from camfab.design.profile import CamGeometry
-from camfab.design.program import MotionProgram
+from camfab.design.program import MotionProgram, Segment
 from camfab.numeric import extremum, positive_ranges
 
 PI = math.pi
@@ -53,20 +54,64 @@ def _reference(prog: MotionProgram, x: np.ndarray, orders) -> np.ndarray:
     return out
 
 
-@pytest.mark.parametrize("grouped,uniform", [(0, 0), (10**9, 0), (10**9, 10**9)])
-def test_every_evaluation_path_is_bit_identical(monkeypatch, grouped, uniform):
+@pytest.mark.parametrize("grouped", [0, 10**9], ids=["by-segment", "grouped"])
+def test_every_evaluation_path_is_bit_identical(monkeypatch, grouped):
     prog = _every_law_program()
     monkeypatch.setattr(program_mod, "_GROUPED_MAX", grouped)
-    monkeypatch.setattr(program_mod, "_UNIFORM_MAX", uniform)
     bp = prog.breakpoints
     x = np.r_[np.random.default_rng(3).uniform(-1.0, 7.0, 600), bp, np.nextafter(bp, -9.0), np.nextafter(bp, 9.0)]
-    for xs in (x, x[:40], np.r_[x[:20], np.nan, np.inf]):
-        for orders in ((0, 1, 2, 3), (3, 0), (4,), (2,)):
+    for xs in (x, x[:40], x[:1], np.r_[x[:20], np.nan, np.inf]):
+        for orders in ((0, 1, 2, 3), (3, 0), (4,), (2,), (1, 1), (6, 0)):
             with np.errstate(invalid="ignore"):
                 got = prog.evaluate(xs, orders)
                 ref = _reference(prog, xs, orders)
             assert np.array_equal(got, ref, equal_nan=True)
             assert np.array_equal(np.signbit(got), np.signbit(ref))
+
+
+def _law_points(law) -> np.ndarray:
+    b = np.asarray(law.breaks)
+    return np.r_[np.random.default_rng(5).uniform(0.0, 1.0, 300), 0.0, 1.0, b, np.nextafter(b, -1.0),
+                 np.nextafter(b, 2.0)]
+
+
+def _every_law():
+    """Every standard law and every piece of a piecewise law."""
+    for law in LAWS.values():
+        yield law
+        if isinstance(law, Piecewise):
+            yield from law.pieces
+
+
+@pytest.mark.parametrize("law", list(_every_law()), ids=repr)
+def test_law_rows_and_points_equal_the_reference(law):
+    u = _law_points(law)
+    for orders in ((0, 1, 2, 3, 4), (3, 1), (0,), (5, 2)):
+        rows = law.rows(u, orders)
+        for r, nu in enumerate(orders):
+            ref = law(u, nu)
+            assert np.array_equal(rows[r], ref) and np.array_equal(np.signbit(rows[r]), np.signbit(ref))
+    for nu in range(5):
+        ref = law(u, nu)
+        assert [law.scalar(float(t), nu) for t in u] == list(ref)
+        assert [law.point(float(t), nu) for t in u[-8:]] == list(ref[-8:])
+    for nu in range(4):
+        cu, cf = law.extremum_candidates(nu)
+        assert np.array_equal(cf, law(cu, nu))
+
+
+@pytest.mark.parametrize("name", sorted(LAWS))
+@pytest.mark.parametrize("lift", [7.5, -3.0])
+def test_segment_rows_and_points_equal_values(name, lift):
+    segs = [Segment(name, lift, 0.7, 1.0, 4.0), Segment("hermite7", 1.0, 0.3, 0.0, 2.0,
+                                                         (2.0, -1.0, 0.5, 3.0, 0.25, -7.0, 1.5, 0.125))]
+    for seg in segs:
+        u = _law_points(seg.formula)
+        rows = seg.rows(u.copy(), (0, 1, 2, 3, 4))
+        for nu in range(5):
+            ref = seg.values(u, nu)
+            assert np.array_equal(rows[nu], ref)
+            assert [seg.value_at(float(t), nu) for t in u[-6:]] == list(ref[-6:])
 
 
 def test_exact_analyses_are_computed_once():
