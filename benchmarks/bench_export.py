@@ -16,7 +16,7 @@ from camfab.cli import resolve_design_path
 from camfab.design.assemble import geometry_from_spec
 from camfab.design.spec import load_design
 from camfab.offset.cutter import profile_curve, tool_centre_path
-from camfab.offset.discretize import arcs
+from camfab.discretize import arcs
 
 TOLS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
 

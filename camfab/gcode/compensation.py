@@ -42,7 +42,7 @@ from typing import Sequence
 
 import numpy as np
 
-from camfab.gcode.geom import TWO_PI, arc_sweep
+from camfab.geom2d import TWO_PI, arc_sweep
 from camfab.gcode.parse import Move
 
 __all__ = ["CompProblem", "CompensatedPath", "simulate_compensation", "move_lengths"]

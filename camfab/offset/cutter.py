@@ -17,9 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..discretize import ArcDiscretisation, ParametricCurve, arcs, measure_deviation, polyline, validate_tol
 from ..errors import GeometryError
 from ..tolerances import DEFAULT_EXPORT_TOL_MM
-from .discretize import ArcDiscretisation, ParametricCurve, arcs, measure_deviation, polyline, validate_tol
 from .outline import translating_outline
 
 __all__ = ["profile_curve", "pitch_curve", "offset_curve", "concave_limit", "ToolCentrePath",

@@ -14,7 +14,7 @@ from camfab.design.assemble import check_design, geometry_from_spec
 from camfab.design.spec import design_from_dict, load_design
 from camfab.errors import SpecError
 from camfab.offset.cutter import profile_curve
-from camfab.offset.discretize import measure_deviation
+from camfab.discretize import measure_deviation
 from tests.conftest import EXAMPLES, base_design
 
 ezdxf = pytest.importorskip("ezdxf")

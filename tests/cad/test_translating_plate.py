@@ -16,7 +16,7 @@ from camfab.errors import GeometryError, SpecError
 from camfab.gcode import Job, dumps, parse, verify
 from camfab.gcode.cam import cam_program, signed_distance
 from camfab.offset.cutter import offset_curve, pitch_curve, profile_curve, tool_centre_path
-from camfab.offset.discretize import Chain, arcs, measure_deviation, polyline
+from camfab.discretize import Chain, arcs, measure_deviation, polyline
 from camfab.offset.outline import translating_outline
 from tests.conftest import EXAMPLES, base_design
 

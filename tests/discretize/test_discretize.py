@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 from scipy.spatial import cKDTree
 
 from camfab.design.program import MotionProgram
-from camfab.offset.discretize import (
+from camfab.discretize import (
     ArcDiscretisation,
     Chain,
     Discretisation,
