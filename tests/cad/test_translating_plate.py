@@ -165,8 +165,9 @@ def test_tool_path_rounds_the_plate_corners():
 def test_concave_stretch_tighter_than_the_cutter_is_refused():
     spec = _wedge()
     c = geometry_from_spec(spec).profiles[0]
-    with pytest.raises(GeometryError, match="largest cutter"):
+    with pytest.raises(GeometryError, match="largest cutter") as e:
         tool_centre_path(c, 200.0, tol=1e-3)
+    assert " mm–" in str(e.value) and "°" not in str(e.value)  # the stretch is named in mm of travel
 
 
 def test_plate_without_height_and_bore_are_refused(tmp_path):
