@@ -332,7 +332,9 @@ def fit_spline(curve: ParametricCurve, sur: tuple, tol: float, anchored: bool = 
     for _ in range(_SPAN_REFITS + 1):
         cat = [np.concatenate([c[i] for c in parts]) for i in range(5)]
         labels = np.concatenate([np.full(c[0].shape[0], spans[j].label) for j, c in enumerate(parts)])
-        chain, labels = _merge_wrap(Chain(*cat), labels)
+        chain = Chain(*cat)
+        if curve.closed:
+            chain, labels = _merge_wrap(chain, labels)
         merged = merge_cocircular(chain, labels)
         dev = measure_deviation(merged, curve)
         if dev.max <= tol:

@@ -98,10 +98,10 @@ class Chain:
 
     # ---- constructors ------------------------------------------------
     @classmethod
-    def from_polyline(cls, points) -> Chain:
-        """Closed polyline through ``points`` ``(n, 2)`` (closing segment added if needed)."""
+    def from_polyline(cls, points, closed: bool = True) -> Chain:
+        """Polyline through ``points`` ``(n, 2)``; a closed one gets its closing segment if needed."""
         p = np.asarray(points, dtype=float).reshape(-1, 2)
-        if not np.array_equal(p[0], p[-1]):
+        if closed and not np.array_equal(p[0], p[-1]):
             p = np.vstack([p, p[:1]])
         s, e = p[:-1], p[1:]
         w = e - s
@@ -110,17 +110,20 @@ class Chain:
         return cls(s[keep], unit(w[keep]), np.zeros(int(keep.sum())), length[keep], e[keep])
 
     @classmethod
-    def from_bulges(cls, rows) -> Chain:
-        """Closed chain from ``(x, y, bulge)`` rows, as in a DXF LWPOLYLINE.
+    def from_bulges(cls, rows, closed: bool = True) -> Chain:
+        """Chain from ``(x, y, bulge)`` rows, as in a DXF LWPOLYLINE.
 
         The bulge of row ``i`` (``tan(sweep/4)``, > 0 counter-clockwise)
-        belongs to the segment from vertex ``i`` to vertex ``i + 1``.
+        belongs to the segment from vertex ``i`` to vertex ``i + 1`` (the last row's to vertex 0
+        when ``closed``; an open chain ignores the last bulge).
         """
         r = np.asarray(rows, dtype=float).reshape(-1, 3)
-        s = r[:, :2]
-        e = np.roll(s, -1, axis=0)
+        if closed:
+            s, e, bulge = r[:, :2], np.roll(r[:, :2], -1, axis=0), r[:, 2]
+        else:  # the last row only ends the last entity
+            s, e, bulge = r[:-1, :2], r[1:, :2], r[:-1, 2]
         keep = np.any(s != e, axis=1)
-        s, e, bulge = s[keep], e[keep], r[keep, 2]
+        s, e, bulge = s[keep], e[keep], bulge[keep]
         w = e - s
         chord = np.hypot(w[:, 0], w[:, 1])
         sweep = 4.0 * np.arctan(bulge)

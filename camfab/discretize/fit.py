@@ -6,8 +6,8 @@ directions (curve samples to the entities and entity samples to the curve, with 
 of each distance) and refined until the measured worst deviation is below ``tol·(1 - MARGIN)``; the
 result is then verified once more by the independent, global
 :func:`~camfab.discretize.measure.measure_deviation`.  Every breakpoint where the tangent jumps (a
-kink) is a vertex of the result; polylines keep every breakpoint, arc chains may run across
-breakpoints where the curve is tangent continuous.
+kink) is a vertex of the result, and so are an open curve's ends; polylines keep every breakpoint, arc
+chains may run across breakpoints where the curve is tangent continuous.
 
 Polyline: the initial grid follows the chord-error estimate ``L²κ/8``; intervals whose measured
 deviation exceeds ``tol·(1 - MARGIN)`` are cut; a second grid equidistributing the measured errors
@@ -51,12 +51,12 @@ __all__ = ["polyline", "arcs"]
 
 
 def polyline(curve: ParametricCurve, *, tol: float = DEFAULT_EXPORT_TOL_MM) -> Discretisation:
-    """Closed polyline whose segments lie within ``tol`` of the exact curve.
+    """Polyline whose segments lie within ``tol`` of the exact curve.
 
     Parameters
     ----------
     curve : ParametricCurve
-        The exact closed curve.
+        The exact curve, closed or open.
     tol : float, keyword-only
         Maximum distance (mm) between the segments and the curve, in ``[1e-6, 0.1]``.
 
@@ -71,18 +71,20 @@ def polyline(curve: ParametricCurve, *, tol: float = DEFAULT_EXPORT_TOL_MM) -> D
     ToleranceError
         If ``tol`` is outside the accepted range.
     CurveError
-        If the curve is not closed.
+        If a closed curve's ends do not meet.
     """
     tol = validate_tol(tol)
     check_closed(curve, tol)
 
     def build(nodes):
         pts = points_at(curve, nodes)
-        pts[-1] = pts[0]
+        if curve.closed:
+            pts[-1] = pts[0]
         return pts
 
     nodes, measured = fit_grid(curve, tol, "line", lambda nodes: measure_deviation(build(nodes), curve).max)
-    return Discretisation(params=nodes, points=build(nodes), max_deviation=float(measured), tol=tol)
+    return Discretisation(params=nodes, points=build(nodes), max_deviation=float(measured), tol=tol,
+                          closed=curve.closed)
 
 
 class _BiarcGrids:
@@ -109,12 +111,12 @@ class _BiarcGrids:
 
 
 def arcs(curve: ParametricCurve, *, tol: float = DEFAULT_EXPORT_TOL_MM) -> ArcDiscretisation:
-    """Closed G1 chain of circular arcs within ``tol`` of the exact curve (see the module notes).
+    """G1 chain of circular arcs within ``tol`` of the exact curve (see the module notes).
 
     Parameters
     ----------
     curve : ParametricCurve
-        The exact closed curve.
+        The exact curve, closed or open.
     tol : float, keyword-only
         Maximum distance (mm) between the chain and the curve, in ``[1e-6, 0.1]``.
 
@@ -129,7 +131,7 @@ def arcs(curve: ParametricCurve, *, tol: float = DEFAULT_EXPORT_TOL_MM) -> ArcDi
     ToleranceError
         If ``tol`` is outside the accepted range.
     CurveError
-        If the curve is not closed.
+        If a closed curve's ends do not meet.
     """
     tol = validate_tol(tol)
     check_closed(curve, tol)
@@ -143,4 +145,4 @@ def arcs(curve: ParametricCurve, *, tol: float = DEFAULT_EXPORT_TOL_MM) -> ArcDi
         build = _BiarcGrids(curve, sur[0].as_curve(), tol)
         nodes, _ = fit_grid(curve, tol, "biarc", lambda nodes: build(nodes)[1], sur)
         chain, measured = build(nodes)
-    return ArcDiscretisation.from_chain(chain, nodes, measured, tol)
+    return ArcDiscretisation.from_chain(chain, nodes, measured, tol, curve.closed)

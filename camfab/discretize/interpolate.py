@@ -344,7 +344,8 @@ def biarc_chain(curve: ParametricCurve, nodes: np.ndarray, fit_curve: Parametric
     pieces = piece_index(curve, 0.5 * (a + b))
     bp = curve.breakpoints
     pts = points_at(curve, nodes)
-    pts[-1] = pts[0]  # one evaluation per node: ends[i] == starts[i + 1] bit for bit
+    if curve.closed:
+        pts[-1] = pts[0]  # one evaluation per node: ends[i] == starts[i + 1] bit for bit
     ent = _interval_entities(fit_curve or curve, a, b, bp[pieces], bp[pieces + 1], "biarc", pts[:-1], pts[1:])
     start = ent["s"].reshape(-1, 2)
     end = ent["e"].reshape(-1, 2)

@@ -25,8 +25,9 @@ from .surrogate import HermiteSurrogate
 __all__ = ["as_chain", "measure_deviation", "max_deviation"]
 
 
-def as_chain(entities) -> Chain:
-    """Any entities :func:`measure_deviation` accepts as a closed :class:`Chain`.
+def as_chain(entities, closed: bool = True) -> Chain:
+    """Any entities :func:`measure_deviation` accepts as a :class:`Chain`; arrays of vertex rows are
+    closed or open as ``closed`` says (an arc chain or discretisation knows).
 
     Raises
     ------
@@ -38,12 +39,12 @@ def as_chain(entities) -> Chain:
     if isinstance(entities, (Discretisation, ArcDiscretisation)):
         return entities.chain()
     if isinstance(entities, ArcChain):
-        entities = entities.lwpolyline
+        entities, closed = entities.lwpolyline, entities.closed
     arr = np.asarray(entities, dtype=float)
     if arr.ndim == 2 and arr.shape[1] == 2:
-        return Chain.from_polyline(arr)
+        return Chain.from_polyline(arr, closed)
     if arr.ndim == 2 and arr.shape[1] == 3:
-        return Chain.from_bulges(arr)
+        return Chain.from_bulges(arr, closed)
     raise GeometryError("entities must be a Chain, an ArcChain, a discretisation, an (n, 2) polyline or "
                         f"(n, 3) (x, y, bulge) rows; got shape {arr.shape}")
 
@@ -71,12 +72,15 @@ class _CurveProjector:
         self.curve = sur.curve
         self.x = sur.x
         self.n = sur.x.size - 1
-        self.tree = cKDTree(sur.points[:-1])
+        self.tree = cKDTree(sur.points[:-1] if self.curve.closed else sur.points)
 
     def __call__(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Distance from each ``x`` ``(N, 2)`` to the curve and the foot parameter."""
         _, j = self.tree.query(x)
-        iv = np.stack([(j - 1) % self.n, j], axis=1)  # (N, 2)
+        if self.curve.closed:
+            iv = np.stack([(j - 1) % self.n, j], axis=1)  # (N, 2)
+        else:
+            iv = np.stack([np.maximum(j - 1, 0), np.minimum(j, self.n - 1)], axis=1)
         a, h = self.x[iv], self.x[iv + 1] - self.x[iv]
         c = self.sur.coef[:, iv]
         xx = x[:, None, :]
@@ -119,15 +123,18 @@ def _curve_to_chain(chain: Chain, curve: ParametricCurve, sur: HermiteSurrogate,
     """Largest distance from the exact curve to the chain and its parameter: exact distances of the
     surrogate's exact samples, the worst local maxima refined by nested grids of exact points."""
     ts = sur.x
-    d_a, _ = chain.distance(sur.points[:-1])
     n_t = ts.size - 1
+    d_a, _ = chain.distance(sur.points[:-1] if curve.closed else sur.points)
 
     def g_a(t):
         return chain.distance(points_at(curve, t.ravel()))[0].reshape(t.shape)
 
-    top = _local_maxima(d_a, True, refine_top)
-    lo_t = np.where(top > 0, ts[top - 1], ts[n_t - 1] - curve.period)
-    hi_t = ts[top + 1]
+    top = _local_maxima(d_a, curve.closed, refine_top)
+    if curve.closed:
+        lo_t = np.where(top > 0, ts[top - 1], ts[n_t - 1] - curve.period)
+        hi_t = ts[top + 1]
+    else:
+        lo_t, hi_t = ts[np.maximum(top - 1, 0)], ts[np.minimum(top + 1, n_t)]
     best_a = _zoom_max(g_a, lo_t, hi_t) if top.size else np.zeros(0)
     i_a = int(np.argmax(d_a))
     worst_a, at_a = float(d_a[i_a]), float(ts[i_a])
@@ -170,8 +177,9 @@ def measure_deviation(entities, curve: ParametricCurve, *, samples: int = 20000,
     Parameters
     ----------
     entities : Chain, ArcChain, Discretisation or array_like
-        An arc chain or discretisation, ``(n, 2)`` polyline vertices (closed implicitly) or
-        ``(n, 3)`` rows ``(x, y, bulge)`` of a closed LWPOLYLINE, e.g. read back from a file.
+        An arc chain or discretisation, ``(n, 2)`` polyline vertices or ``(n, 3)`` rows
+        ``(x, y, bulge)`` of an LWPOLYLINE, e.g. read back from a file (closed implicitly when the
+        curve is closed).
     curve : ParametricCurve
         The exact curve.
     samples : int, optional
@@ -187,7 +195,7 @@ def measure_deviation(entities, curve: ParametricCurve, *, samples: int = 20000,
     Deviation
         ``max``, both one-way maxima (mm) and where the maximum occurs.
     """
-    chain = as_chain(entities)
+    chain = as_chain(entities, curve.closed)
     if chain.n == 0:
         raise GeometryError("no entities to measure: give at least one line or arc")
     sur = HermiteSurrogate(curve, max(int(samples), 8 * chain.n), min_count=8)

@@ -43,7 +43,7 @@ class Deviation:
 
 @dataclass(frozen=True)
 class Discretisation:
-    """A closed polyline within ``tol`` of an exact curve.
+    """A polyline within ``tol`` of an exact curve.
 
     Attributes
     ----------
@@ -51,17 +51,20 @@ class Discretisation:
         Curve parameters of the vertices, from 0 to ``period`` inclusive; every
         breakpoint is among them.
     points : (n, 2) ndarray
-        The vertices ``P(params)``; ``points[-1] == points[0]`` (closed).
+        The vertices ``P(params)`` (mm); ``points[-1] == points[0]`` when closed.
     max_deviation : float
-        Measured two-way maximum distance between the segments and the curve.
+        Measured two-way maximum distance between the segments and the curve (mm).
     tol : float
         The requested tolerance; ``max_deviation <= tol``.
+    closed : bool
+        Whether the curve (and the polyline) is closed.
     """
 
     params: np.ndarray
     points: np.ndarray
     max_deviation: float
     tol: float
+    closed: bool = True
 
     @property
     def n_entities(self) -> int:
@@ -70,16 +73,16 @@ class Discretisation:
 
     def chain(self) -> Chain:
         """The segments as a :class:`Chain`."""
-        return Chain.from_polyline(self.points)
+        return Chain.from_polyline(self.points, self.closed)
 
     def arc_chain(self) -> ArcChain:
         """The segments as an :class:`~camfab.geom2d.ArcChain` of lines with the measured deviation."""
-        return ArcChain.from_polyline(self.points, max_deviation=self.max_deviation)
+        return ArcChain.from_polyline(self.points, closed=self.closed, max_deviation=self.max_deviation)
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
 class ArcDiscretisation(ArcChain):
-    """A closed chain of arcs (and lines) within ``tol`` of a curve, tangent-continuous except at its kinks.
+    """A chain of arcs (and lines) within ``tol`` of a curve, tangent-continuous except at its kinks.
 
     An :class:`~camfab.geom2d.ArcChain` (``starts``, ``ends``, ``centres``, ``sweeps``, ``bulges``,
     ``closed``; ``ends[i] == starts[i + 1]`` exactly; ``max_deviation`` measured, ``<= tol``) with the
@@ -105,13 +108,14 @@ class ArcDiscretisation(ArcChain):
     tol: float
 
     @classmethod
-    def from_chain(cls, chain: Chain, params: np.ndarray, measured: float, tol: float) -> ArcDiscretisation:
-        """The closed chain ``chain`` as arcs with centres, sweeps and bulges (``tan(sweep/4)``)."""
+    def from_chain(cls, chain: Chain, params: np.ndarray, measured: float, tol: float,
+                   closed: bool = True) -> ArcDiscretisation:
+        """The chain ``chain`` as arcs with centres, sweeps and bulges (``tan(sweep/4)``)."""
         line = chain.curvature == 0
         ksafe = np.where(line, 1.0, chain.curvature)
         centres = np.where(line[:, None], np.nan, chain.start + J(chain.tangent) / ksafe[:, None])
         sweeps = chain.sweep
-        return cls(chain.start, chain.end, centres, sweeps, np.tan(sweeps / 4.0), True, float(measured),
+        return cls(chain.start, chain.end, centres, sweeps, np.tan(sweeps / 4.0), closed, float(measured),
                    params=params, tangents=chain.tangent, tol=tol)
 
     @property

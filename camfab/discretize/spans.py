@@ -86,6 +86,7 @@ def _circle_pieces(curve: ParametricCurve, sur: HermiteSurrogate, tol: float):
     t_out = unit(sur.derivative(hi, idx))
     prev = np.roll(t_out, 1, axis=0)
     g1 = np.abs(np.arctan2(cross(prev, t_in), dot(prev, t_in))) < _G1_RAD
+    g1[0] &= curve.closed  # an open curve's start is a corner
     tt = lo[:, None] + (hi - lo)[:, None] * np.linspace(0.0, 1.0, 17)
     pts = points_at(curve, tt)
     # the tangent at the start of the circle through samples 0, 4, 8 (parallel to the line through
@@ -218,7 +219,7 @@ def span_ends(sur: HermiteSurrogate, span: Span):
         pt = None
         for i in (sur.first[piece], sur.first[piece + 1]):
             if t == sur.x[i]:
-                pt = sur.points[i] if i < sur.x.size - 1 else sur.points[0]
+                pt = sur.points[i]  # (a closed curve's last sample is its first, bit for bit)
         if pt is None:
             pt = sur.point(np.array([t]), piece)[0]
         ends.append((pt, unit(sur.derivative(np.array([t]), piece)[0])))

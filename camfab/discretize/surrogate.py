@@ -28,7 +28,8 @@ class HermiteSurrogate:
         piece = np.repeat(np.arange(lo.size), counts)
         a, b = x[:-1], x[1:]
         p = points_at(curve, x)
-        p[-1] = p[0]
+        if curve.closed:
+            p[-1] = p[0]
         d = derivatives_at(curve, np.concatenate([a, b]), np.tile(lo[piece], 2), np.tile(hi[piece], 2))
         d0, d1 = d[:a.size], d[a.size:]
         h = (b - a)[:, None]
@@ -49,9 +50,9 @@ class HermiteSurrogate:
 
     def _local(self, t, piece):
         """Offset ``u`` of ``t`` in its cubic and that cubic's coefficients (``t`` wrapped into the
-        period unless a ``piece`` is given)."""
+        period of a closed curve unless a ``piece`` is given)."""
         t = np.asarray(t, dtype=float)
-        if piece is None:
+        if piece is None and self.curve.closed:
             t = np.where((t < 0) | (t > self.curve.period), np.mod(t, self.curve.period), t)
         i = self._index(t, piece)
         return (t - self.x[i])[..., None], self.coef[:, i]
@@ -73,7 +74,9 @@ class HermiteSurrogate:
         return 2 * c[2] + 6 * u * c[3]
 
     def as_curve(self) -> ParametricCurve:
-        return ParametricCurve(self.point, self.curve.breakpoints, self.curve.period, self.derivative)
+        """The surrogate as a curve (same breakpoints, period and closure)."""
+        return ParametricCurve(self.point, self.curve.breakpoints, self.curve.period, self.derivative,
+                               self.curve.closed)
 
     def error(self) -> float:
         """Largest distance between surrogate and exact curve at the interval midpoints (one call)."""

@@ -12,8 +12,8 @@ import pytest
 
 from camfab.design.assemble import geometry_from_spec
 from camfab.design.spec import design_from_dict, load_design
-from camfab.offset.cutter import pitch_curve, profile_curve
 from camfab.discretize import arcs
+from camfab.offset.cutter import pitch_curve, profile_curve
 
 from .test_discretize import Dense, assert_chain_consistent, check_arcs, tangent_jumps
 
