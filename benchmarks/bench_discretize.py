@@ -139,7 +139,7 @@ def main(argv=None) -> None:
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     from typical_cam import typical_geometry
 
-    from camfab.offset.cutter import profile_curve
+    from camfab.offset import profile_curve
 
     spec, geom = typical_geometry()
     print(f"\ntypical 12-segment roller cam ({spec.name}): Rb = 60 mm, Rr = 10 mm, peak pressure angle 29.2°")

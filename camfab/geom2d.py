@@ -305,17 +305,13 @@ class ArcChain:
         chord = np.hypot(d[:, 0], d[:, 1])
         th = 4 * np.arctan(self.bulges)
         u = d / chord[:, None]
-        c, s = np.cos(-th / 2), np.sin(-th / 2)  # start tangent = chord turned back by half the sweep
-        t0 = np.column_stack([u[:, 0] * c - u[:, 1] * s, u[:, 0] * s + u[:, 1] * c])
-        c, s = np.cos(th / 2), np.sin(th / 2)  # end tangent = chord turned on by half the sweep
-        t1 = np.column_stack([u[:, 0] * c - u[:, 1] * s, u[:, 0] * s + u[:, 1] * c])
-        t_in = np.roll(t1, 1, axis=0)  # tangent arriving at each vertex
-        if np.any(np.abs(t_in[:, 0] * t0[:, 1] - t_in[:, 1] * t0[:, 0]) > angle_tol) or np.any(
-                (t_in * t0).sum(1) <= 0):
+        t0 = rotate(u, -th / 2)  # start tangent = chord turned back by half the sweep
+        t_in = np.roll(rotate(u, th / 2), 1, axis=0)  # end tangent (chord turned on), arriving at each vertex
+        if np.any(np.abs(cross(t_in, t0)) > angle_tol) or np.any(dot(t_in, t0) <= 0):
             return None
         ccw = self.area() > 0
         sign = 1.0 if ccw else -1.0  # outward = right of the direction of travel on a ccw chain
-        normal = sign * np.column_stack([t0[:, 1], -t0[:, 0]])
+        normal = sign * -J(t0)
         with np.errstate(divide="ignore", invalid="ignore"):
             radius = np.where(th != 0, chord / (2 * np.abs(np.sin(th / 2))), np.inf)
         # an arc turning the chain's way (convex) grows by the distance, the other way shrinks

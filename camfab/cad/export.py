@@ -3,7 +3,8 @@
 Everything is built in memory first and written only when every requested
 artifact succeeded, each file atomically, so an error never leaves partial
 output.  Only the stages a job asks for run (cadquery is imported only for
-STEP, tool paths only when a cutter is given).
+STEP, trimesh only for STL, tool paths only when a cutter is given).  Every
+writer takes the profiles as :class:`~camfab.geom2d.ArcChain` values.
 """
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ from ..geom2d import ArcChain
 from ..io import atomic_write
 from ..offset.cutter import pitch_curve, profile_curve, tool_centre_path
 from . import dxf as dxf_mod
+from . import step, stl
 from .plate import PlateSpec, bore_loop
 
 __all__ = ["Artifact", "CamShapes", "cam_shapes", "build_artifacts", "write_artifacts", "FORMATS"]
@@ -110,8 +112,6 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
         say("DXF")
         out.append(_dxf(spec, geometry, shapes, plate, tol, dxf_flavour, tool_paths))
     if "stl" in formats:
-        from . import stl
-
         for i, curve in enumerate(shapes.curves):
             say(f"STL{_suffix(i, n)}")
             # arcs within tol/2 of the curve, flattened within tol/2 of the arcs: within tol overall
@@ -120,8 +120,6 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
             data = stl.dumps(fine, plate, tol=tol / 2, name=spec.name)
             out.append(Artifact(f"{spec.name}{_suffix(i, n)}.stl", data, "stl", None, dev))
     if "step" in formats:
-        from . import step
-
         for i, (loop, dev) in enumerate(zip(shapes.profiles, shapes.profile_deviation, strict=True)):
             say(f"STEP{_suffix(i, n)}")
             text = step.dumps(loop, plate, name=f"{spec.name}{_suffix(i, n)}")
