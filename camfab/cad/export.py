@@ -12,7 +12,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..discretize import arcs, measure_deviation, validate_tol
+from ..discretize import ArcDiscretisation, arcs, measure_deviation, validate_tol
 from ..geom2d import ArcChain
 from ..io import atomic_write
 from ..offset.cutter import pitch_curve, profile_curve, tool_centre_path
@@ -41,7 +41,7 @@ class Artifact:
 class CamShapes:
     """Arc chains of every profile (and pitch curve) of a cam, each with its measured deviation (mm)."""
 
-    profiles: tuple[ArcChain, ...]
+    profiles: tuple[ArcDiscretisation, ...]
     pitch: tuple[ArcChain, ...]
     curves: tuple  # exact ParametricCurve of each profile
     tol: float
@@ -137,7 +137,7 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
 def _dxf(spec, geometry, shapes: CamShapes, plate: PlateSpec, tol: float, flavour: str,
          tool_paths: bool) -> Artifact:
     f = spec.follower
-    tools = ()
+    tools: tuple[ArcChain, ...] = ()
     tool_d = spec.manufacturing.tool_diameter_mm
     if tool_paths and tool_d:
         tools = tuple(tool_centre_path(c, tool_d / 2, tol=tol).arcs for c in geometry.profiles)

@@ -1,7 +1,8 @@
 """camfab.discretize - exact plane curves to lines and arcs with a measured two-way deviation.
 
-It knows nothing of cams: a curve is a :class:`ParametricCurve` (points and derivatives at parameters,
-breakpoints where its formula changes, closed or open; :func:`curvature_at` gives its curvature).  :func:`polyline` and :func:`arcs` return entities whose
+It knows nothing of cams: a curve is a :class:`ParametricCurve` (points and derivatives at
+parameters, breakpoints where its formula changes, closed or open; :func:`curvature_at` gives its
+curvature).  :func:`polyline` and :func:`arcs` return entities whose
 two-way maximum distance from the exact curve is measured and at most the tolerance;
 :func:`measure_deviation` measures any lines and arcs (read back from a file, for instance) against
 the curve.  An arc discretisation is an :class:`~camfab.geom2d.ArcChain`, what every writer reads.

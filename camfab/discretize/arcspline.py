@@ -197,7 +197,8 @@ def _tanlen(kk, ll):
 def _lay_backward(p1, t1, k, ell, j: int):
     """Arcs ``j + 2 … m - 1`` laid backward from ``p1`` (tangent ``t1``): their starts and start tangents,
     and the point and tangent angle where the closing biarc must end."""
-    b_starts, b_tans = [], []
+    b_starts: list[np.ndarray] = []
+    b_tans: list[np.ndarray] = []
     end_p, end_ang = p1, math.atan2(t1[1], t1[0])
     for i in range(ell.size - 1, j + 1, -1):
         ang_s = end_ang - k[i] * ell[i]
@@ -309,7 +310,8 @@ def _span_deviations(curve: ParametricCurve, spans: list, parts: list, merged: C
     return worst
 
 
-def fit_spline(curve: ParametricCurve, sur: tuple, tol: float, anchored: bool = True):
+def fit_spline(curve: ParametricCurve, surrogate: tuple[HermiteSurrogate, float], tol: float,
+               anchored: bool = True) -> tuple[Chain, float, np.ndarray] | None:
     """The free arc spline within ``tol`` (measured on the exact curve) and its span-end parameters, or None.
 
     Spans are independent (their ends are fixed points with fixed tangents), so
@@ -317,7 +319,7 @@ def fit_spline(curve: ParametricCurve, sur: tuple, tol: float, anchored: bool = 
     the worst deviation and every span whose exact curve samples lie farther than ``tol`` from the
     chain), each to a target lowered by its measured / model error ratio.
     """
-    sur, sur_err = sur
+    sur, sur_err = surrogate
     target = _SPLINE_FILL * tol - sur_err
     if not (target > 0):
         return None

@@ -20,7 +20,7 @@ from ..geom2d import cross, dot, unit
 from .chain import Chain
 from .curve import ParametricCurve, derivatives_at, piece_index, points_at
 from .entities import MAX_TURNING_RAD, biarc, entity_distance, entity_point
-from .surrogate import fit_surrogate
+from .surrogate import HermiteSurrogate, fit_surrogate
 from .tolerance import MARGIN
 
 __all__ = ["fit_grid", "biarc_chain"]
@@ -232,7 +232,7 @@ def _initial_grid(curve: ParametricCurve, target: float, kind: str) -> np.ndarra
     steps turning at most :data:`MAX_TURNING_RAD`.  Both keep at least that
     turning bound.
     """
-    grids = []
+    grids: list[np.ndarray] = []
     for lo, hi in zip(*curve.pieces, strict=True):
         t, p = _piece_samples(curve, float(lo), float(hi))
         n_min = max(1, math.ceil(_turning(p) / MAX_TURNING_RAD))
@@ -248,7 +248,7 @@ def _initial_grid(curve: ParametricCurve, target: float, kind: str) -> np.ndarra
             grids.append(_place(float(lo), float(hi), t, density, n)[:-1])
         else:
             grids.append(np.linspace(float(lo), float(hi), n_min + 1)[:-1])
-    grids.append([curve.period])
+    grids.append(np.array([curve.period]))
     return np.concatenate(grids)
 
 
@@ -295,7 +295,7 @@ def _equidistribute(curve: ParametricCurve, nodes: np.ndarray, dev: np.ndarray, 
     """
     power = 2.0 if kind == "line" else 3.0
     share = np.maximum((np.maximum(dev, 0.0) / (fill * target)) ** (1.0 / power), 1e-6)
-    grids = []
+    grids: list[np.ndarray] = []
     for lo, hi in zip(*curve.pieces, strict=True):
         sel = (nodes[:-1] >= lo) & (nodes[:-1] < hi)
         t = np.append(nodes[:-1][sel], hi)
@@ -303,18 +303,19 @@ def _equidistribute(curve: ParametricCurve, nodes: np.ndarray, dev: np.ndarray, 
         n_min = max(1, math.ceil(_turning(p) / MAX_TURNING_RAD))
         n = max(n_min, math.ceil(float(share[sel].sum())))
         grids.append(_place(float(lo), float(hi), t, share[sel] / np.diff(t), n)[:-1])
-    grids.append([curve.period])
+    grids.append(np.array([curve.period]))
     return np.concatenate(grids)
 
 
 def fit_grid(curve: ParametricCurve, tol: float, kind: str, verify: Callable[[np.ndarray], float],
-         sur: tuple | None = None):
+             surrogate: tuple[HermiteSurrogate, float] | None = None) -> tuple[np.ndarray, float]:
     """Adaptive grid for ``kind`` within ``tol``: initial grid, refinement, one re-spread.
 
     ``verify(nodes)`` measures the finished result globally; should it exceed
-    ``tol`` the target is tightened and refinement resumes.
+    ``tol`` the target is tightened and refinement resumes.  Returns the nodes and the measured
+    deviation.  ``surrogate``: the curve's Hermite stand-in and its error, when already built.
     """
-    sur, sur_err = sur or fit_surrogate(curve, tol)
+    sur, sur_err = surrogate or fit_surrogate(curve, tol)
     curve = sur.as_curve()  # fitting never calls the exact curve; verify() measures on it
     target = tol * (1.0 - MARGIN) - sur_err
     nodes, dev = _refine(curve, _initial_grid(curve, target, kind), target, kind)
@@ -333,8 +334,8 @@ def fit_grid(curve: ParametricCurve, tol: float, kind: str, verify: Callable[[np
                         "may have a cusp or cross itself (an undercut profile cannot be exported)")
 
 
-def biarc_chain(curve: ParametricCurve, nodes: np.ndarray, fit_curve: ParametricCurve = None
-               ) -> tuple[Chain, np.ndarray]:
+def biarc_chain(curve: ParametricCurve, nodes: np.ndarray, fit_curve: ParametricCurve | None = None
+                ) -> tuple[Chain, np.ndarray]:
     """The biarc chain of a node grid and the piece index of every entity.
 
     The nodes are exact points of ``curve``; tangents and biarc ratios may be

@@ -103,6 +103,7 @@ class ArcDiscretisation(ArcChain):
         The requested tolerance (mm).
     """
 
+    max_deviation: float  # always measured
     params: np.ndarray
     tangents: np.ndarray
     tol: float
@@ -115,8 +116,8 @@ class ArcDiscretisation(ArcChain):
         ksafe = np.where(line, 1.0, chain.curvature)
         centres = np.where(line[:, None], np.nan, chain.start + J(chain.tangent) / ksafe[:, None])
         sweeps = chain.sweep
-        return cls(chain.start, chain.end, centres, sweeps, np.tan(sweeps / 4.0), closed, float(measured),
-                   params=params, tangents=chain.tangent, tol=tol)
+        return cls(chain.start, chain.end, centres, sweeps, np.tan(sweeps / 4.0), closed,
+                   max_deviation=float(measured), params=params, tangents=chain.tangent, tol=tol)
 
     @property
     def end_tangents(self) -> np.ndarray:

@@ -138,15 +138,16 @@ class SpanModel:
         self.M = _cumhermite(*self.m_fp, s)                              # ∫ s·n ds
         self.nN, self.nM = dot(nrm, self.N), dot(nrm, self.M)
         self._nm = (np.hstack([self.N, self.M]), np.hstack([nrm, self.m_fp[0]]), np.hstack([dn, self.m_fp[1]]))
-        self._last = (None, None)
+        self._last_key: bytes | None = None
+        self._last_nm: tuple[np.ndarray, np.ndarray] = (np.empty((0, 2)), np.empty((0, 2)))
 
     def NM_at(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(N(x), M(x))`` between grid points (the last query is cached)."""
         key = x.tobytes()
-        if self._last[0] != key:
+        if self._last_key != key:
             v = _hermite_at(x, self.s, *self._nm)
-            self._last = (key, (v[:, :2], v[:, 2:]))
-        return self._last[1]
+            self._last_key, self._last_nm = key, (v[:, :2], v[:, 2:])
+        return self._last_nm
 
     def system(self, knots: np.ndarray):
         """``(A, C, d)`` of the knots: ``e = A k + b`` on the grid, ``C k = d`` closes the span."""

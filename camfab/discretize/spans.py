@@ -135,7 +135,7 @@ def _anchors(curve: ParametricCurve, sur: HermiteSurrogate, tol: float, anchored
         for p in range(n):
             if not g1[p]:
                 anchors[float(bp[p])] = [None, None, True]
-        for p in np.flatnonzero(circ):
+        for p in np.flatnonzero(circ).tolist():
             arcs_p = _exact_arcs(curve, sur, int(p))
             if arcs_p is None:
                 continue

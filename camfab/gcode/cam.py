@@ -48,19 +48,24 @@ def cam_program(contact, job: Job, *, tol: float, compensation: str | None = Non
     tol_fit = max(tol * FIT_SHARE, 1e-6)
     path = tool_centre_path(contact, r, tol=tol_fit)
     if compensation:
-        contour: ArcChain = arcs(profile_curve(contact), tol=tol_fit)
+        part = arcs(profile_curve(contact), tol=tol_fit)
         job = replace(job, achieved_deviation_mm=path.max_deviation)
-        prog = contour_toolpath(contour, job, compensation=compensation)
-        return CamProgram(prog, contour.max_deviation, path.shapely_deviation, contour.n_entities)
-    contour = path.arcs if arcs_allowed else polyline(path.curve, tol=tol_fit).arc_chain()
-    job = replace(job, achieved_deviation_mm=contour.max_deviation)
+        prog = contour_toolpath(part, job, compensation=compensation)
+        return CamProgram(prog, part.max_deviation, path.shapely_deviation, part.n_entities)
+    contour: ArcChain
+    if arcs_allowed:
+        contour, dev = path.arcs, path.max_deviation
+    else:
+        line = polyline(path.curve, tol=tol_fit)
+        contour, dev = line.arc_chain(), line.max_deviation
+    job = replace(job, achieved_deviation_mm=dev)
     prog = contour_toolpath(contour, job, roughing_contours=_rough(contact, job, tol))
-    return CamProgram(prog, contour.max_deviation, path.shapely_deviation, contour.n_entities)
+    return CamProgram(prog, dev, path.shapely_deviation, contour.n_entities)
 
 
 def _rough(contact, job: Job, tol: float) -> list[ArcChain]:
     """Roughing contours, outermost first: exact offsets by tool radius + allowance + k·step-over."""
-    out = []
+    out: list[ArcChain] = []
     for k in range(job.roughing_passes, 0, -1):
         d = job.tool_radius_mm + job.roughing_allowance_mm + (k - 1) * job.stepover
         out.append(arcs(offset_curve(contact, d), tol=max(tol, 1e-3)))

@@ -197,7 +197,7 @@ def as_contour(entities) -> tuple[Segment, ...]:
     for i, s in enumerate(segs):
         if not all(math.isfinite(v) for v in s.start + s.end + (s.center or ())):
             raise GeometryError(f"contour entity {i}: non-finite coordinates")
-        if s.is_arc:
+        if s.center is not None:
             r0 = s.radius
             r1 = math.hypot(s.end[0] - s.center[0], s.end[1] - s.center[1])
             if r0 <= CLOSE_TOL_MM:

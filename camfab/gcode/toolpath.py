@@ -21,8 +21,26 @@ from __future__ import annotations
 import numpy as np
 
 from camfab.errors import GeometryError, Problem, SpecError
-from camfab.gcode.contour import ContourDistance, Segment, offset_contour, orient_contour, outward_normal
-from camfab.gcode.model import Arc, Comment, Coolant, CutterComp, Feed, Job, Program, Rapid, Spindle, ToolChange
+from camfab.gcode.contour import (
+    ContourDistance,
+    Segment,
+    offset_contour,
+    orient_contour,
+    outward_normal,
+)
+from camfab.gcode.model import (
+    Arc,
+    Comment,
+    Coolant,
+    CutterComp,
+    Feed,
+    Item,
+    Job,
+    Program,
+    Rapid,
+    Spindle,
+    ToolChange,
+)
 from camfab.geom2d import TWO_PI
 
 __all__ = ["contour_toolpath"]
@@ -42,8 +60,9 @@ def _choose_start(segs: tuple[Segment, ...], cw: bool) -> tuple[Segment, ...]:
     return (b,) + segs[i + 1:] + segs[:i] + (a,)
 
 
-def _contour_items(segs, z, feed) -> list:
-    items = []
+def _contour_items(segs, z, feed) -> list[Item]:
+    """The feed moves along a contour at height ``z``: G1 lines and G2/G3 arcs (a full circle as two)."""
+    items: list[Item] = []
     for s in segs:
         if not s.is_arc:
             items.append(Feed(s.end[0], s.end[1], z, feed))
