@@ -28,48 +28,28 @@ from .surrogate import HermiteSurrogate
 __all__ = ["fit_spline"]
 
 
-#: model samples per arc of the free arc spline, and Lawson (minimax) iterations of its start
+#: model samples per arc of the free arc spline
 _SPLINE_SAMPLES = 16
-
-
 #: the free spline's model deviation aims at this fraction of tol (less the surrogate error)
 _SPLINE_FILL = 0.97
-
-
 #: fewest model samples of one span
 _SPLINE_MIN_GRID = 129
-
-
 #: the first arc count tried is this multiple of the asymptotic estimate
 _EST_FACTOR = 1.0
-
-
 #: one arc fewer is tried while the predicted error (∝ 1/m³) stays below this multiple of the target
 _DOWN_SLACK = 1.2
-
-
 #: a span is only fitted up to this many arcs (else interpolating biarcs are used)
 _SPAN_MAX_ARCS = 64
-
-
 #: relative lengths of the two end arcs at each clamped end of a piece (an LP over C¹ patterns:
 #: a clamped end then costs about half an arc instead of tripling the error of uniform arcs)
 _END_ARCS = (0.6, 1.0)
-
-
 #: further end-arc ratios tried at the smallest failing arc count (the optimum is not monotone in it)
 _END_ARCS_ALT = ((0.7, 1.1),)
-
-
 #: refits of the spans where the measured chain exceeds tol
 _SPAN_REFITS = 4
-
-
 #: relative lengths of the two end arcs at an end whose arc curvature is fixed (next to a dwell: the
 #: arc matches the curve to second order there, so it is kept shorter)
 _FIXED_END_ARCS = (0.35, 0.9)
-
-
 #: further fixed-end ratios tried at the smallest failing count (none: they rarely paid for their time)
 _FIXED_END_ARCS_ALT: tuple = ()
 

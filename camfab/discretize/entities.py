@@ -25,12 +25,8 @@ __all__ = [
 
 #: an arc whose sweep is below this (radians) is written as a straight line
 LINE_SWEEP_RAD = 1e-9
-
-
 #: largest sweep of one arc entity (radians); merged arcs stay below it
 MAX_ARC_SWEEP_RAD = 0.999 * math.pi
-
-
 #: initial grids keep the tangent turning of one interval below this (radians)
 MAX_TURNING_RAD = math.pi / 2
 

@@ -28,30 +28,16 @@ __all__ = ["fit_grid", "biarc_chain"]
 
 #: interior curve samples per interval and samples per entity used while fitting
 _CURVE_SAMPLES = 24
-
-
 _ENTITY_SAMPLES = 17
-
-
 #: golden-section iterations of every local maximisation
 _GOLDEN_ITERS = 16
-
-
 #: Gauss-Newton steps of a projection onto the curve
 _PROJECT_ITERS = 4
-
-
 #: the biarc tangent-length ratio d1/d2 is searched in exp(±this)
 _LOG_RATIO_BOUND = 1.5
-
-
 #: intervals measured per vectorised block (bounds memory)
 _BLOCK = 2048
-
-
 _MAX_ROUNDS = 80
-
-
 _INV_PHI = (math.sqrt(5.0) - 1.0) / 2.0
 
 

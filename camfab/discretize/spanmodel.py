@@ -15,9 +15,8 @@ from .surrogate import HermiteSurrogate
 __all__ = ["span_model", "cumtrapz", "SpanModel", "equioscillate"]
 
 
+#: Lawson (minimax) reweighting iterations of the curvatures of given knots
 _LAWSON_ITERS = 8
-
-
 #: Gauss-Newton rounds equalising the arc errors (knots and curvatures together)
 _EQUI_ITERS = 8
 
@@ -53,6 +52,7 @@ def span_model(sur: HermiteSurrogate, segs, n_grid: int, curvature: bool = False
 
 
 def cumtrapz(f: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Cumulative trapezoid integral of ``f`` ``(n, ...)`` over the grid ``s`` ``(n,)``, 0 first."""
     ds = np.diff(s).reshape((-1,) + (1,) * (f.ndim - 1))
     return np.concatenate([np.zeros((1,) + f.shape[1:]), np.cumsum(0.5 * ds * (f[1:] + f[:-1]), axis=0)])
 

@@ -24,8 +24,6 @@ __all__ = ["SPLINE_SPAN", "Span", "span_density", "span_ends", "cut_spans"]
 #: most arcs of one free span: a longer smooth piece is cut into spans joined G1 at (surrogate)
 #: curve points with the curve's tangent, which keeps every linear system small
 SPLINE_SPAN = 40
-
-
 #: a breakpoint whose one-sided tangents differ by less than this (radians) is G1 (arcs may run across it)
 _G1_RAD = 1e-6
 
@@ -65,11 +63,13 @@ class Span:
     label: int = 0
 
     def sample(self, n: int) -> np.ndarray:
+        """About ``n`` parameters spread over the span by parameter length (each piece's end left out)."""
         total = sum(hi - lo for _, lo, hi in self.segs)
         return np.concatenate([np.linspace(lo, hi, max(2, int(n * (hi - lo) / total)) + 1)[:-1]
                                for _, lo, hi in self.segs])
 
     def contains(self, t: float) -> bool:
+        """Whether parameter ``t`` lies on the span."""
         return any(lo <= t <= hi for _, lo, hi in self.segs)
 
 

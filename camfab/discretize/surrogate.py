@@ -43,6 +43,7 @@ class HermiteSurrogate:
         self.points = p
 
     def _index(self, t, piece=None):
+        """The cubic holding each ``t`` (within the cubics of ``piece`` when given)."""
         i = np.searchsorted(self.x, t, side="right") - 1
         if piece is None:
             return np.clip(i, 0, self.x.size - 2)
@@ -58,10 +59,12 @@ class HermiteSurrogate:
         return (t - self.x[i])[..., None], self.coef[:, i]
 
     def point(self, t, piece=None) -> np.ndarray:
+        """``P(t)`` of the surrogate, ``t.shape + (2,)`` (inside smooth piece ``piece`` when given)."""
         u, c = self._local(t, piece)
         return c[0] + u * (c[1] + u * (c[2] + u * c[3]))
 
     def derivative(self, t, piece=None) -> np.ndarray:
+        """``dP/dt`` of the surrogate, ``t.shape + (2,)`` (inside smooth piece ``piece`` when given)."""
         u, c = self._local(t, piece)
         return c[1] + u * (2 * c[2] + 3 * u * c[3])
 
