@@ -13,7 +13,8 @@ from camfab.geom2d import ArcChain
 
 def _regular_arc_loop(r=40.0, n=4):
     ang = np.linspace(0, 2 * math.pi, n, endpoint=False)
-    return ArcChain.from_bulges(r * np.column_stack([np.cos(ang), np.sin(ang)]), np.full(n, math.tan(2 * math.pi / n / 4)))
+    return ArcChain.from_bulges(r * np.column_stack([np.cos(ang), np.sin(ang)]),
+                                np.full(n, math.tan(2 * math.pi / n / 4)))
 
 
 def _stadium():

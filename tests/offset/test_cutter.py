@@ -7,9 +7,9 @@ import pytest
 from camfab.design.assemble import geometry_from_spec
 from camfab.design.spec import load_design
 from camfab.errors import GeometryError
+from camfab.discretize import measure_deviation
 from camfab.offset.cutter import (concave_limit, offset_curve, roller_envelope_deviation,
                                   shapely_offset, tool_centre_path)
-from camfab.discretize import measure_deviation
 from tests.conftest import EXAMPLES
 
 
