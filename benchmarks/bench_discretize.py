@@ -4,8 +4,8 @@ The curve is P(φ) = (R + S(φ))·(sin φ, cos φ) with R = 40 mm and a 12-segme
 program of 30° segments (cycloidal / dwell / poly345 / dwell / poly4567 / dwell,
 lifts ±10 mm).  For every tolerance from 0.1 mm to 1e-6 mm it reports the
 number of entities, the *measured* two-way maximum deviation and the wall time
-(best of ``--repeat``) of :func:`camfab.offset.discretize.polyline` and
-:func:`camfab.offset.discretize.arcs`.
+(best of ``--repeat``) of :func:`camfab.discretize.polyline` and
+:func:`camfab.discretize.arcs`.
 
 The harsh cam has pressure angles near 40° (no real design would use it); the same table is
 then printed for the profile of a *typical* 12-segment roller cam that passes ``camfab check``
@@ -39,7 +39,7 @@ import time
 import numpy as np
 
 from camfab.design.program import MotionProgram
-from camfab.offset.discretize import ParametricCurve, arcs, polyline
+from camfab.discretize import ParametricCurve, arcs, polyline
 
 ROWS = [("cycloidal", 10, 30), ("dwell", 0, 30), ("poly345", -10, 30), ("dwell", 0, 30),
         ("poly4567", 10, 30), ("dwell", 0, 30), ("cycloidal", -10, 30), ("dwell", 0, 30),
@@ -110,7 +110,7 @@ def table(curve, repeat) -> None:
 
 def uniform_vertices(curve: ParametricCurve, tol: float) -> int:
     """Smallest n whose polyline through P(2πi/n) (uniform in angle) measures within ``tol``."""
-    from camfab.offset.discretize import max_deviation
+    from camfab.discretize import max_deviation
 
     def ok(n):
         t = np.linspace(0.0, curve.period, n + 1)[:-1]
@@ -139,7 +139,7 @@ def main(argv=None) -> None:
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     from typical_cam import typical_geometry
 
-    from camfab.offset.cutter import profile_curve
+    from camfab.offset import profile_curve
 
     spec, geom = typical_geometry()
     print(f"\ntypical 12-segment roller cam ({spec.name}): Rb = 60 mm, Rr = 10 mm, peak pressure angle 29.2°")

@@ -13,9 +13,9 @@ import time
 
 from camfab.cad.export import build_artifacts
 from camfab.design.assemble import geometry_from_spec
+from camfab.discretize import arcs
 from camfab.formats import load_design, resolve_design_path
-from camfab.offset.cutter import profile_curve, tool_centre_path
-from camfab.offset.discretize import arcs
+from camfab.offset import profile_curve, tool_centre_path
 
 TOLS = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
 

@@ -268,7 +268,7 @@ def _export_args(p: argparse.ArgumentParser) -> None:
 def cmd_export(args: argparse.Namespace) -> int:
     from .cad.export import build_artifacts, write_artifacts
     from .design.assemble import check_design, geometry_from_spec
-    from .offset.discretize import validate_tol
+    from .discretize import validate_tol
 
     spec = _load(args.file)
     formats = [f for f in ("dxf", "step", "stl") if getattr(args, f)]
@@ -344,7 +344,7 @@ def _job(spec, args, tol):
 
 
 def _tol(spec, value):
-    from .offset.discretize import validate_tol
+    from .discretize import validate_tol
 
     try:
         return validate_tol(spec.manufacturing.tolerance_mm if value is None else value)

@@ -96,7 +96,7 @@ def run_design(spec, outdir: str | Path, req: JobRequest, *,
     GeometryError, MissingDependencyError) before anything is written.
     """
     from .design.assemble import check_design, geometry_from_spec
-    from .offset.discretize import validate_tol
+    from .discretize import validate_tol
 
     say = progress or (lambda m: None)
     res = RunResult(spec.name, "")

@@ -52,9 +52,10 @@ from typing import Any
 import numpy as np
 
 from ..errors import ExportError
+from ..geom2d import ArcChain
 from ..results import Severity, Verdict
 from .dxf import _ezdxf, write_deterministic
-from .plate import BulgeLoop, bore_loop, keyway_size
+from .plate import bore_loop, keyway_size
 
 __all__ = ["PAPERS", "LAYERS", "SheetLayout", "load_template", "sheet_layout", "parse_scale", "drawing_sheet",
            "build_drawing", "title_fields", "notes_text"]
@@ -176,7 +177,7 @@ def _rect(msp, box, layer: str) -> None:
     msp.add_lwpolyline([(x0, y0), (x1, y0), (x1, y1), (x0, y1)], close=True, dxfattribs={"layer": layer})
 
 
-def _place(loop: BulgeLoop, scale: float, centre) -> list[tuple[float, float, float, float, float]]:
+def _place(loop: ArcChain, scale: float, centre) -> list[tuple[float, float, float, float, float]]:
     pts = loop.points * scale + np.asarray(centre)
     return [(float(x), float(y), 0.0, 0.0, float(b)) for (x, y), b in zip(pts, loop.bulges)]
 

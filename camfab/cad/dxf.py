@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import MissingDependencyError
-from .plate import BulgeLoop
+from ..geom2d import ArcChain, bulge_centre
 
 __all__ = ["DxfContent", "LAYERS", "FLAVOURS", "dumps", "build_document", "loop_nurbs", "write_deterministic"]
 
@@ -42,12 +42,12 @@ FLAVOURS = ("lwpolyline", "r12", "spline")
 class DxfContent:
     """What goes into the drawing; every length in mm, cam centre at the origin."""
 
-    profiles: tuple[BulgeLoop, ...]
-    pitch_curves: tuple[BulgeLoop, ...] = ()
+    profiles: tuple[ArcChain, ...]
+    pitch_curves: tuple[ArcChain, ...] = ()
     base_radius: float | None = None
     prime_radius: float | None = None
-    bore: BulgeLoop | None = None
-    tool_paths: tuple[BulgeLoop, ...] = ()
+    bore: ArcChain | None = None
+    tool_paths: tuple[ArcChain, ...] = ()
     tol_mm: float = 0.001
     deviation_mm: float | None = None
     name: str = "cam"
@@ -62,8 +62,8 @@ def _ezdxf():
     return ezdxf
 
 
-def loop_nurbs(loop: BulgeLoop) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Control points, weights and knots of a closed degree-2 rational B-spline equal to ``loop``.
+def loop_nurbs(loop: ArcChain) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Control points, weights and knots of a degree-2 rational B-spline equal to ``loop``.
 
     Lines become a straight piece (middle control point halfway, weight 1); arcs are split into
     pieces of at most 90° whose middle control point lies at the tangents' intersection with
@@ -75,7 +75,7 @@ def loop_nurbs(loop: BulgeLoop) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             ctrl += [p0, (p0 + p1) / 2]
             w += [1.0, 1.0]
             continue
-        c = BulgeLoop._centre(p0, p1, b)
+        c = bulge_centre(p0, p1, b)
         r = float(math.hypot(*(p0 - c)))
         th = 4 * math.atan(b)
         k = max(1, math.ceil(abs(th) / (math.pi / 2) - 1e-12))
@@ -88,27 +88,27 @@ def loop_nurbs(loop: BulgeLoop) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             ctrl += [q0, c + r / math.cos(d / 2) * np.array([math.cos(am), math.sin(am)])]
             w += [1.0, math.cos(d / 2)]
     m = len(ctrl) // 2
-    ctrl.append(loop.points[0])
+    ctrl.append(loop.points[0] if loop.closed else loop.ends[-1])
     w.append(1.0)
     knots = [0.0, 0.0, 0.0] + [float(j) for j in range(1, m) for _ in (0, 1)] + [float(m)] * 3
     return np.asarray(ctrl, dtype=float), np.asarray(w), np.asarray(knots)
 
 
-def _add_loop(msp, loop: BulgeLoop, layer: str, flavour: str) -> None:
+def _add_loop(msp, loop: ArcChain, layer: str, flavour: str) -> None:
     if flavour == "spline":
         ctrl, w, knots = loop_nurbs(loop)
         msp.add_rational_spline([(float(x), float(y), 0.0) for x, y in ctrl], [float(v) for v in w], degree=2,
                                 knots=[float(v) for v in knots], dxfattribs={"layer": layer})
         return
     if flavour == "lwpolyline":
-        pts = [(float(x), float(y), 0.0, 0.0, float(b)) for (x, y), b in zip(loop.points, loop.bulges)]
-        msp.add_lwpolyline(pts, format="xyseb", close=True, dxfattribs={"layer": layer})
+        pts = [(float(x), float(y), 0.0, 0.0, float(b)) for x, y, b in loop.lwpolyline]
+        msp.add_lwpolyline(pts, format="xyseb", close=loop.closed, dxfattribs={"layer": layer})
         return
     for p0, p1, b in loop.segments():
         if abs(b) < 1e-15:
             msp.add_line(tuple(p0), tuple(p1), dxfattribs={"layer": layer})
             continue
-        c = BulgeLoop._centre(p0, p1, b)
+        c = bulge_centre(p0, p1, b)
         r = float(math.hypot(*(p0 - c)))
         a0 = math.degrees(math.atan2(p0[1] - c[1], p0[0] - c[0]))
         a1 = math.degrees(math.atan2(p1[1] - c[1], p1[0] - c[0]))

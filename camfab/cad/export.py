@@ -3,21 +3,22 @@
 Everything is built in memory first and written only when every requested
 artifact succeeded, each file atomically, so an error never leaves partial
 output.  Only the stages a job asks for run (cadquery is imported only for
-STEP, tool paths only when a cutter is given).
+STEP, trimesh only for STL, tool paths only when a cutter is given).  Every
+writer takes the profiles as :class:`~camfab.geom2d.ArcChain` values.
 """
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Iterable
 
-import numpy as np
-
+from ..discretize import ArcDiscretisation, arcs, measure_deviation, validate_tol
+from ..geom2d import ArcChain
 from ..io import atomic_write
-from ..offset.discretize import arcs, measure_deviation, validate_tol
 from ..offset.cutter import pitch_curve, profile_curve, tool_centre_path
 from . import dxf as dxf_mod
-from .plate import BulgeLoop, PlateSpec, bore_loop
+from . import step, stl
+from .plate import PlateSpec, bore_loop
 
 __all__ = ["Artifact", "CamShapes", "cam_shapes", "build_artifacts", "write_artifacts", "FORMATS"]
 
@@ -38,45 +39,43 @@ class Artifact:
 
 @dataclass(frozen=True)
 class CamShapes:
-    """Arc-fitted loops of every profile (and pitch curve) of a cam, with their deviations."""
+    """Arc chains of every profile (and pitch curve) of a cam, each with its measured deviation (mm)."""
 
-    profiles: tuple[BulgeLoop, ...]
-    profile_deviation: tuple[float, ...]
-    pitch: tuple[BulgeLoop, ...]
+    profiles: tuple[ArcDiscretisation, ...]
+    pitch: tuple[ArcChain, ...]
     curves: tuple  # exact ParametricCurve of each profile
     tol: float
 
-
-def _loop(fit) -> BulgeLoop:
-    return BulgeLoop(np.asarray(fit.starts, dtype=float), np.asarray(fit.bulges, dtype=float))
+    @property
+    def profile_deviation(self) -> tuple[float, ...]:
+        """The measured deviation of every profile's arc chain from its exact curve (mm)."""
+        return tuple(float(p.max_deviation) for p in self.profiles)
 
 
 def cam_shapes(geometry, *, tol: float, with_pitch: bool = True) -> CamShapes:
     """Arc-fit every profile of ``geometry`` within ``tol`` (measured)."""
     tol = validate_tol(tol)
-    profiles, devs, pitch, curves = [], [], [], []
+    profiles, pitch, curves = [], [], []
     for c in geometry.profiles:
         curve = profile_curve(c)
-        fit = arcs(curve, tol=tol)
-        profiles.append(_loop(fit))
-        devs.append(float(fit.max_deviation))
+        profiles.append(arcs(curve, tol=tol))
         curves.append(curve)
         pc = pitch_curve(c) if with_pitch and c.roller_radius > 0 else None
         if pc is not None:
             pitch.append(_pitch_loop(profiles[-1], c.roller_radius, pc, tol))
-    return CamShapes(tuple(profiles), tuple(devs), tuple(pitch), tuple(curves), tol)
+    return CamShapes(tuple(profiles), tuple(pitch), tuple(curves), tol)
 
 
-def _pitch_loop(profile: BulgeLoop, roller_radius: float, pitch, tol: float) -> BulgeLoop:
+def _pitch_loop(profile: ArcChain, roller_radius: float, pitch, tol: float) -> ArcChain:
     """The pitch curve's arcs: the profile's arc chain offset by the roller radius (exact for a G1 chain:
     concentric arcs), kept when its deviation from the exact pitch curve, measured, is within ``tol``;
     otherwise (or for a chain with corners) a fit of its own."""
     loop = profile.offset_g1(roller_radius)
     if loop is not None:
-        rows = np.column_stack([loop.points, loop.bulges])
-        if float(measure_deviation(rows, pitch).max) <= tol:
-            return loop
-    return _loop(arcs(pitch, tol=tol))
+        dev = float(measure_deviation(loop, pitch).max)
+        if dev <= tol:
+            return loop.with_deviation(dev)
+    return arcs(pitch, tol=tol)
 
 
 def _plate(spec) -> PlateSpec:
@@ -113,28 +112,24 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
         say("DXF")
         out.append(_dxf(spec, geometry, shapes, plate, tol, dxf_flavour, tool_paths))
     if "stl" in formats:
-        from . import stl
-
-        for i, (loop, curve) in enumerate(zip(shapes.profiles, shapes.curves)):
+        for i, curve in enumerate(shapes.curves):
             say(f"STL{_suffix(i, n)}")
             # arcs within tol/2 of the curve, flattened within tol/2 of the arcs: within tol overall
-            fine = _loop(arcs(curve, tol=tol / 2))
+            fine = arcs(curve, tol=tol / 2)
             dev = float(measure_deviation(fine.flatten(tol / 2), curve).max)
             data = stl.dumps(fine, plate, tol=tol / 2, name=spec.name)
             out.append(Artifact(f"{spec.name}{_suffix(i, n)}.stl", data, "stl", None, dev))
     if "step" in formats:
-        from . import step
-
-        for i, (loop, dev) in enumerate(zip(shapes.profiles, shapes.profile_deviation)):
+        for i, (loop, dev) in enumerate(zip(shapes.profiles, shapes.profile_deviation, strict=True)):
             say(f"STEP{_suffix(i, n)}")
             text = step.dumps(loop, plate, name=f"{spec.name}{_suffix(i, n)}")
             out.append(Artifact(f"{spec.name}{_suffix(i, n)}.step", text.encode("utf-8"), "step",
-                                len(loop.points), dev))
+                                loop.n_entities, dev))
         if n > 1:
             say("STEP pair on the shaft")
             text = step.stack_dumps(shapes.profiles, plate, name=f"{spec.name}_pair")
             out.append(Artifact(f"{spec.name}_pair.step", text.encode("utf-8"), "step",
-                                sum(len(lp.points) for lp in shapes.profiles), max(shapes.profile_deviation),
+                                sum(lp.n_entities for lp in shapes.profiles), max(shapes.profile_deviation),
                                 "both cams positioned along the shaft"))
     return out
 
@@ -142,10 +137,10 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
 def _dxf(spec, geometry, shapes: CamShapes, plate: PlateSpec, tol: float, flavour: str,
          tool_paths: bool) -> Artifact:
     f = spec.follower
-    tools = ()
+    tools: tuple[ArcChain, ...] = ()
     tool_d = spec.manufacturing.tool_diameter_mm
     if tool_paths and tool_d:
-        tools = tuple(_loop(tool_centre_path(c, tool_d / 2, tol=tol).arcs) for c in geometry.profiles)
+        tools = tuple(tool_centre_path(c, tool_d / 2, tol=tol).arcs for c in geometry.profiles)
     rr = f.roller_radius_mm or 0.0
     content = dxf_mod.DxfContent(
         profiles=shapes.profiles, pitch_curves=shapes.pitch, base_radius=f.base_radius_mm,
@@ -153,7 +148,7 @@ def _dxf(spec, geometry, shapes: CamShapes, plate: PlateSpec, tol: float, flavou
         bore=bore_loop(plate.bore_mm, plate.keyway) if plate.bore_mm > 0 else None,
         tool_paths=tools, tol_mm=tol, deviation_mm=max(shapes.profile_deviation), name=spec.name)
     text = dxf_mod.dumps(content, flavour=flavour)
-    ents = sum(len(lp.points) for lp in shapes.profiles)
+    ents = sum(lp.n_entities for lp in shapes.profiles)
     return Artifact(f"{spec.name}.dxf", text.encode("utf-8"), "dxf", ents, max(shapes.profile_deviation),
                     f"{flavour}; {len(tools)} tool path(s)" if tools else flavour)
 

@@ -10,7 +10,8 @@ import tempfile
 from pathlib import Path
 
 from ..errors import MissingDependencyError
-from .plate import BulgeLoop, PlateSpec
+from ..geom2d import ArcChain, bulge_midpoint
+from .plate import PlateSpec
 
 __all__ = ["plate_solid", "dumps", "stack_dumps"]
 
@@ -23,17 +24,14 @@ def _cq():
     return cq
 
 
-def _wire(cq, loop: BulgeLoop, z: float = 0.0):
+def _wire(cq, loop: ArcChain, z: float = 0.0):
     wp = cq.Workplane("XY", origin=(0, 0, z)).moveTo(*loop.points[0])
     for p0, p1, b in loop.segments():
-        if abs(b) < 1e-15:
-            wp = wp.lineTo(*p1)
-        else:
-            wp = wp.threePointArc(tuple(BulgeLoop.arc_midpoint(p0, p1, b)), tuple(p1))
-    return wp.close()
+        wp = wp.lineTo(*p1) if abs(b) < 1e-15 else wp.threePointArc(tuple(bulge_midpoint(p0, p1, b)), tuple(p1))
+    return wp.close() if loop.closed else wp
 
 
-def plate_solid(outline: BulgeLoop, plate: PlateSpec):
+def plate_solid(outline: ArcChain, plate: PlateSpec):
     """The plate as a cadquery ``Workplane`` holding one valid solid (z = 0 … thickness [+ hub])."""
     cq = _cq()
     body = _wire(cq, outline).extrude(plate.thickness_mm)
@@ -48,7 +46,7 @@ def plate_solid(outline: BulgeLoop, plate: PlateSpec):
     return body
 
 
-def dumps(outline: BulgeLoop, plate: PlateSpec, *, name: str = "cam") -> str:
+def dumps(outline: ArcChain, plate: PlateSpec, *, name: str = "cam") -> str:
     """STEP (AP214) text of the plate, in millimetres, byte-identical for the same input."""
     return _export(plate_solid(outline, plate), name)
 

@@ -2,18 +2,19 @@
 from __future__ import annotations
 
 from ..errors import GeometryError, MissingDependencyError
-from .plate import BulgeLoop, PlateSpec
+from ..geom2d import ArcChain
+from .plate import PlateSpec
 
 __all__ = ["plate_mesh", "dumps"]
 
 
-def _polygon(loop: BulgeLoop, tol: float):
+def _polygon(loop: ArcChain, tol: float):
     from shapely.geometry import Polygon
 
     return Polygon(loop.flatten(tol))
 
 
-def plate_mesh(outline: BulgeLoop, plate: PlateSpec, *, tol: float):
+def plate_mesh(outline: ArcChain, plate: PlateSpec, *, tol: float):
     """A watertight ``trimesh.Trimesh`` of the plate (and hub), arcs flattened within ``tol``.
 
     The outline is flattened by chords inscribed in the exact curve, so the mesh
@@ -23,7 +24,8 @@ def plate_mesh(outline: BulgeLoop, plate: PlateSpec, *, tol: float):
     try:
         import trimesh
     except ImportError as exc:  # pragma: no cover - exercised only without the extra
-        raise MissingDependencyError("STL export needs trimesh and mapbox_earcut: pip install trimesh mapbox_earcut") from exc
+        raise MissingDependencyError("STL export needs trimesh and mapbox_earcut: "
+                                     "pip install trimesh mapbox_earcut") from exc
     if plate.hub_diameter_mm and plate.hub_length_mm:
         raise GeometryError("STL export of a plate with a hub is not supported yet; "
                             "remove manufacturing.hub_diameter_mm for the STL or use STEP")
@@ -36,7 +38,7 @@ def plate_mesh(outline: BulgeLoop, plate: PlateSpec, *, tol: float):
     return mesh
 
 
-def dumps(outline: BulgeLoop, plate: PlateSpec, *, tol: float, name: str = "cam") -> bytes:
+def dumps(outline: ArcChain, plate: PlateSpec, *, tol: float, name: str = "cam") -> bytes:
     """Binary STL bytes of the plate, deterministic for the same input."""
     mesh = plate_mesh(outline, plate, tol=tol)
     data = mesh.export(file_type="stl")

@@ -8,19 +8,18 @@ with a post-processor (``linuxcnc``, ``fanuc``, ``grbl``) -> G-code text -> :fun
 grinders.
 """
 from camfab.gcode.compensation import simulate_compensation
-from camfab.gcode.geom import ContourDistance, arc_sweep
+from camfab.gcode.contour import ContourDistance, Segment, as_contour, offset_contour, orient_contour
 from camfab.gcode.lift_table import lift_angles, lift_table_csv, write_lift_table
+from camfab.gcode.model import Arc, Comment, Coolant, CutterComp, Feed, Job, Program, Rapid, Spindle, ToolChange
 from camfab.gcode.parse import Backplot, GcodeError, Move, Samples, backplot, parse, sample
 from camfab.gcode.post import POSTS, dumps, get_post, write_gcode
-from camfab.gcode.toolpath import (Arc, Comment, Coolant, CutterComp, Feed, Job, Program, Rapid, Segment,
-                                   Spindle, ToolChange, as_contour, contour_toolpath, offset_contour,
-                                   orient_contour)
+from camfab.gcode.toolpath import contour_toolpath
 from camfab.gcode.verify import VerifyReport, verify
 
 __all__ = [
     "Arc", "Backplot", "Comment", "ContourDistance", "Coolant", "CutterComp", "Feed", "GcodeError", "Job",
     "Move", "POSTS", "Program", "Rapid", "Samples", "Segment", "Spindle", "ToolChange",
-    "VerifyReport", "arc_sweep", "as_contour", "backplot", "contour_toolpath", "dumps", "get_post",
-    "lift_angles", "lift_table_csv", "offset_contour", "orient_contour", "parse", "sample", "simulate_compensation", "verify",
+    "VerifyReport", "as_contour", "backplot", "contour_toolpath", "dumps", "get_post", "lift_angles",
+    "lift_table_csv", "offset_contour", "orient_contour", "parse", "sample", "simulate_compensation", "verify",
     "write_gcode", "write_lift_table",
 ]

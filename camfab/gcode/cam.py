@@ -1,33 +1,25 @@
 """Cam profiles → milling programs, and the exact distance functions the verifier needs.
 
 Takes geometry (a profile :class:`~camfab.design.profile.Contact`) and a
-:class:`~camfab.gcode.toolpath.Job`; never a design file.  The finishing
+:class:`~camfab.gcode.model.Job`; never a design file.  The finishing
 contour is the exact tool-centre offset arc-fitted within ``tol``; roughing
-contours are exact offsets by the allowance plus the step-over.
+contours are exact offsets by the allowance plus the step-over.  Every contour
+reaches the toolpath builder as an :class:`~camfab.geom2d.ArcChain`.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Callable
+from collections.abc import Callable
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..discretize import ParametricCurve, arcs, polyline
+from ..geom2d import ArcChain
 from ..offset.cutter import offset_curve, profile_curve, tool_centre_path
-from ..offset.discretize import ArcDiscretisation, ParametricCurve, arcs, polyline
-from .toolpath import Job, Program, Segment, contour_toolpath
+from .model import Job, Program
+from .toolpath import contour_toolpath
 
-__all__ = ["segments_from_arcs", "segments_from_polyline", "cam_program", "CamProgram", "signed_distance"]
-
-
-def segments_from_arcs(fit: ArcDiscretisation) -> list[Segment]:
-    """G-code contour segments (lines and arcs) of an arc discretisation."""
-    out = []
-    for s, e, c, sw in zip(fit.starts, fit.ends, fit.centres, fit.sweeps):
-        if sw == 0:
-            out.append(Segment(tuple(s), tuple(e)))
-        else:
-            out.append(Segment(tuple(s), tuple(e), tuple(c), bool(sw < 0)))
-    return out
+__all__ = ["FIT_SHARE", "CamProgram", "cam_program", "signed_distance"]
 
 
 @dataclass(frozen=True)
@@ -45,11 +37,6 @@ class CamProgram:
 FIT_SHARE = 0.8
 
 
-def segments_from_polyline(points: np.ndarray) -> list[Segment]:
-    """Line segments through consecutive points of a closed polyline (last point == first)."""
-    return [Segment(tuple(a), tuple(b)) for a, b in zip(points[:-1], points[1:])]
-
-
 def cam_program(contact, job: Job, *, tol: float, compensation: str | None = None,
                 arcs_allowed: bool = True) -> CamProgram:
     """The contour-milling program of one profile (periphery, outside).
@@ -60,33 +47,29 @@ def cam_program(contact, job: Job, *, tol: float, compensation: str | None = Non
     r = job.tool_radius_mm
     tol_fit = max(tol * FIT_SHARE, 1e-6)
     path = tool_centre_path(contact, r, tol=tol_fit)
-    if not arcs_allowed and not compensation:
-        line = polyline(path.curve, tol=tol_fit)
-        job = _with_deviation(job, line.max_deviation)
-        prog = contour_toolpath(segments_from_polyline(line.points), job, roughing_contours=_rough(contact, job, tol))
-        return CamProgram(prog, line.max_deviation, path.shapely_deviation, line.n_entities)
-    job = _with_deviation(job, path.max_deviation)
     if compensation:
         part = arcs(profile_curve(contact), tol=tol_fit)
-        prog = contour_toolpath(segments_from_arcs(part), job, compensation=compensation)
+        job = replace(job, achieved_deviation_mm=path.max_deviation)
+        prog = contour_toolpath(part, job, compensation=compensation)
         return CamProgram(prog, part.max_deviation, path.shapely_deviation, part.n_entities)
-    prog = contour_toolpath(segments_from_arcs(path.arcs), job, roughing_contours=_rough(contact, job, tol))
-    return CamProgram(prog, path.max_deviation, path.shapely_deviation, path.arcs.n_entities)
+    contour: ArcChain
+    if arcs_allowed:
+        contour, dev = path.arcs, path.max_deviation
+    else:
+        line = polyline(path.curve, tol=tol_fit)
+        contour, dev = line.arc_chain(), line.max_deviation
+    job = replace(job, achieved_deviation_mm=dev)
+    prog = contour_toolpath(contour, job, roughing_contours=_rough(contact, job, tol))
+    return CamProgram(prog, dev, path.shapely_deviation, contour.n_entities)
 
 
-def _rough(contact, job: Job, tol: float) -> list[list[Segment]]:
+def _rough(contact, job: Job, tol: float) -> list[ArcChain]:
     """Roughing contours, outermost first: exact offsets by tool radius + allowance + k·step-over."""
-    out = []
+    out: list[ArcChain] = []
     for k in range(job.roughing_passes, 0, -1):
         d = job.tool_radius_mm + job.roughing_allowance_mm + (k - 1) * job.stepover
-        out.append(segments_from_arcs(arcs(offset_curve(contact, d), tol=max(tol, 1e-3))))
+        out.append(arcs(offset_curve(contact, d), tol=max(tol, 1e-3)))
     return out
-
-
-def _with_deviation(job: Job, dev: float) -> Job:
-    from dataclasses import replace
-
-    return replace(job, achieved_deviation_mm=dev)
 
 
 def signed_distance(curve: ParametricCurve, *, tol: float) -> Callable[[np.ndarray], np.ndarray]:

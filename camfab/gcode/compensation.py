@@ -41,7 +41,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from camfab.gcode.geom import TWO_PI, arc_sweep
+from camfab.geom2d import TWO_PI, arc_sweep
 from camfab.gcode.parse import Move
 from camfab.results import Finding, IssueCode
 

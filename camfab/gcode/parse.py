@@ -26,7 +26,7 @@ from typing import Sequence
 import numpy as np
 
 from camfab.errors import CamfabError
-from camfab.gcode.geom import arc_sweep
+from camfab.geom2d import arc_sweep
 
 __all__ = ["GcodeError", "Move", "Backplot", "Samples", "parse", "backplot", "sample"]
 

@@ -2,7 +2,7 @@
 
 Examples
 --------
->>> from camfab.gcode.toolpath import Job, Segment, contour_toolpath
+>>> from camfab.gcode import Job, Segment, contour_toolpath
 >>> circle = [Segment((20, 0), (20, 0), center=(0, 0))]
 >>> prog = contour_toolpath(circle, Job(tool_diameter_mm=6, depth_mm=5, roughing_passes=0))
 >>> text = dumps(prog, "fanuc", arc_format="r")
@@ -13,11 +13,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from camfab.gcode.model import Program
 from camfab.gcode.posts.base import Post
 from camfab.gcode.posts.fanuc import POST as _FANUC
 from camfab.gcode.posts.grbl import POST as _GRBL
 from camfab.gcode.posts.linuxcnc import POST as _LINUXCNC
-from camfab.gcode.toolpath import Program
 from camfab.io import atomic_write
 
 __all__ = ["POSTS", "get_post", "dumps", "write_gcode"]
@@ -48,7 +48,7 @@ def dumps(program: Program, post: str | Post, **options) -> str:
     Parameters
     ----------
     program : Program
-        From :func:`camfab.gcode.toolpath.contour_toolpath`.
+        From :func:`camfab.gcode.contour_toolpath`.
     post : {"linuxcnc", "fanuc", "grbl"} or Post
     **options
         Post options: fanuc ``arc_format`` ("ij"|"r"), ``program_number``, ``line_number_step``;

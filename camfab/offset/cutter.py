@@ -17,9 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..discretize import ArcDiscretisation, ParametricCurve, arcs, measure_deviation, polyline, validate_tol
 from ..errors import GeometryError
 from ..tolerances import DEFAULT_EXPORT_TOL_MM
-from .discretize import ArcDiscretisation, ParametricCurve, arcs, measure_deviation, polyline, validate_tol
 from .outline import translating_outline
 
 __all__ = ["profile_curve", "pitch_curve", "offset_curve", "concave_limit", "ToolCentrePath",
@@ -34,8 +34,9 @@ JOIN_STYLE = "round"
 SHAPELY_CHECK_MIN_MM = 1e-4
 
 
-def _deg(contact, x):
-    return math.degrees(x) if contact.closed else x
+def _user(contact, x) -> float:
+    """A profile parameter in the user's unit: degrees of cam angle, or mm of a translating cam's travel."""
+    return float(contact.axis.to_user(x))
 
 
 def profile_curve(contact) -> ParametricCurve:
@@ -95,7 +96,7 @@ def concave_limit(contact) -> tuple[float, list[tuple[float, float]]]:
     if kmin >= 0:
         return math.inf, []
     ranges = positive_ranges(lambda t: -contact.evaluate(t).curvature, edges, closed=contact.closed)
-    return 1.0 / -kmin, [(_deg(contact, lo), _deg(contact, hi)) for lo, hi, *_ in ranges]
+    return 1.0 / -kmin, [(_user(contact, lo), _user(contact, hi)) for lo, hi, *_ in ranges]
 
 
 def _refuse_if_too_big(contact, tool_radius: float, label: str) -> None:
@@ -106,7 +107,8 @@ def _refuse_if_too_big(contact, tool_radius: float, label: str) -> None:
         return
     g = lambda t: -tool_radius * contact.evaluate(t).curvature - 1.0  # noqa: E731  > 0 where too tight
     where = positive_ranges(g, contact.breakpoints, closed=contact.closed)
-    spans = ", ".join(f"{_deg(contact, lo):.4g}°–{_deg(contact, hi):.4g}°" for lo, hi, *_ in where)
+    unit = contact.axis.x_symbol
+    spans = ", ".join(f"{_user(contact, lo):.4g}{unit}–{_user(contact, hi):.4g}{unit}" for lo, hi, *_ in where)
     raise GeometryError(
         f"{label}the cutter radius {tool_radius:g} mm is larger than the concave radius of the profile "
         f"(down to {fits:.6g} mm) in {spans}: it would gouge the part. The largest cutter that fits has "

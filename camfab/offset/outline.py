@@ -5,7 +5,7 @@ over one cam length) and whose other three sides are straight: two vertical
 ends and the bottom edge ``y = 0`` of the cam frame (see
 :class:`~camfab.design.mechanisms.TranslatingCamRoller`).  Exporters and tool
 paths need a closed curve, so this module chains the exact pieces into one
-:class:`~camfab.offset.discretize.ParametricCurve`:
+:class:`~camfab.discretize.ParametricCurve`:
 
 * traversed counter-clockwise (outward normal on the right of the direction of
   travel), starting at the middle of the bottom edge, so a lead-in lands on a
@@ -22,13 +22,13 @@ cutter rolling around the plate traces.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 
+from ..discretize import ParametricCurve
 from ..errors import GeometryError
-from .discretize import ParametricCurve
 
 __all__ = ["Piece", "line_piece", "arc_piece", "chain_curve", "translating_outline"]
 
@@ -88,7 +88,7 @@ def chain_curve(pieces) -> ParametricCurve:
         return f
 
     breaks = list(starts)
-    for s, p in zip(starts, pieces):
+    for s, p in zip(starts[:-1], pieces, strict=True):
         breaks += [s + b for b in p.breaks]
     return ParametricCurve(dispatch("point"), np.array(breaks), period, dispatch("derivative"))
 

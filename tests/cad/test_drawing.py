@@ -12,10 +12,10 @@ from camfab.cad.drawing import LAYERS, build_drawing, drawing_sheet, load_templa
 from camfab.cad.export import cam_shapes
 from camfab.design.assemble import check_design, geometry_from_spec
 from camfab.design.spec import design_from_dict
+from camfab.discretize import measure_deviation
 from camfab.errors import SpecError
 from camfab.formats import load_design
 from camfab.offset.cutter import profile_curve
-from camfab.offset.discretize import measure_deviation
 from tests.conftest import EXAMPLES, base_design
 
 ezdxf = pytest.importorskip("ezdxf")

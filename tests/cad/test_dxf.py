@@ -8,14 +8,15 @@ import numpy as np
 import pytest
 
 from camfab.cad.dxf import DxfContent, dumps
-from camfab.cad.plate import BulgeLoop, bore_loop, circle_loop
+from camfab.cad.plate import bore_loop, circle_loop
+from camfab.geom2d import ArcChain
 
 ezdxf = pytest.importorskip("ezdxf")
 
 
 def _stadium():
     pts = np.array([[-15.0, -15.0], [15.0, -15.0], [15.0, 15.0], [-15.0, 15.0]])
-    return BulgeLoop(pts, np.array([0.0, 1.0, 0.0, 1.0]))
+    return ArcChain.from_bulges(pts, np.array([0.0, 1.0, 0.0, 1.0]))
 
 
 def _content():

@@ -12,8 +12,8 @@ from camfab.cad.plate import PlateSpec, plate_volume
 from camfab.cli import main
 from camfab.design.assemble import geometry_from_spec
 from camfab.design.spec import design_from_dict
+from camfab.discretize import Chain, measure_deviation, polyline
 from camfab.offset.cutter import profile_curve
-from camfab.offset.discretize import Chain, measure_deviation, polyline
 from tests.conftest import DESIGNS, EXAMPLES, base_design
 
 ezdxf = pytest.importorskip("ezdxf")

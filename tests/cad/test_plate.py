@@ -6,26 +6,28 @@ import math
 import numpy as np
 import pytest
 
-from camfab.cad.plate import BulgeLoop, PlateSpec, bore_loop, circle_loop, keyway_size, plate_volume
+from camfab.cad.plate import PlateSpec, bore_loop, circle_loop, keyway_size, plate_volume
 from camfab.errors import GeometryError
+from camfab.geom2d import ArcChain
 
 
 def _regular_arc_loop(r=40.0, n=4):
     ang = np.linspace(0, 2 * math.pi, n, endpoint=False)
-    return BulgeLoop(r * np.column_stack([np.cos(ang), np.sin(ang)]), np.full(n, math.tan(2 * math.pi / n / 4)))
+    return ArcChain.from_bulges(r * np.column_stack([np.cos(ang), np.sin(ang)]),
+                                np.full(n, math.tan(2 * math.pi / n / 4)))
 
 
 def _stadium():
     # 60 x 30 stadium: two lines and two half circles (clockwise arcs negative bulge test below)
     pts = np.array([[-15.0, -15.0], [15.0, -15.0], [15.0, 15.0], [-15.0, 15.0]])
-    return BulgeLoop(pts, np.array([0.0, 1.0, 0.0, 1.0]))
+    return ArcChain.from_bulges(pts, np.array([0.0, 1.0, 0.0, 1.0]))
 
 
 def test_areas_are_exact():
     assert _regular_arc_loop().area() == pytest.approx(math.pi * 1600, rel=1e-14)
     assert circle_loop(7.0).area() == pytest.approx(math.pi * 49, rel=1e-14)
     assert _stadium().area() == pytest.approx(30 * 30 + math.pi * 15**2, rel=1e-14)
-    cw = BulgeLoop(_stadium().points[::-1].copy(), -np.roll(_stadium().bulges[::-1], -1))
+    cw = ArcChain.from_bulges(_stadium().points[::-1].copy(), -np.roll(_stadium().bulges[::-1], -1))
     assert cw.area() == pytest.approx(-_stadium().area(), rel=1e-14)
 
 
@@ -95,7 +97,7 @@ def test_step_solid_valid_volume_and_reimport(tmp_path):
 @pytest.mark.parametrize("d", [-5.0, 2.5])
 def test_offset_of_a_g1_loop_is_exact(reverse, d):
     st = _stadium()
-    loop = BulgeLoop(st.points[::-1].copy(), -np.roll(st.bulges[::-1], -1)) if reverse else st
+    loop = ArcChain.from_bulges(st.points[::-1].copy(), -np.roll(st.bulges[::-1], -1)) if reverse else st
     off = loop.offset_g1(d)
     # every vertex of the offset stadium lies at distance d outside the original (radius 15 + d)
     pts = off.flatten(1e-6)
@@ -109,7 +111,7 @@ def test_offset_of_a_g1_loop_is_exact(reverse, d):
 
 
 def test_offset_refuses_corners_and_vanishing_arcs():
-    square = BulgeLoop(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]), np.zeros(4))
+    square = ArcChain.from_bulges(np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]), np.zeros(4))
     assert square.offset_g1(0.1) is None  # corners need rounding arcs
     assert _stadium().offset_g1(-15.0) is None  # the half circles would shrink to radius 0
     assert _regular_arc_loop(10.0).offset_g1(-9.0).area() == pytest.approx(math.pi, rel=1e-12)

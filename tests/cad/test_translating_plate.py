@@ -16,8 +16,8 @@ from camfab.errors import GeometryError, SpecError
 from camfab.formats import load_design
 from camfab.gcode import Job, dumps, parse, verify
 from camfab.gcode.cam import cam_program, signed_distance
+from camfab.discretize import Chain, arcs, measure_deviation, polyline
 from camfab.offset.cutter import offset_curve, pitch_curve, profile_curve, tool_centre_path
-from camfab.offset.discretize import Chain, arcs, measure_deviation, polyline
 from camfab.offset.outline import translating_outline
 from tests.conftest import EXAMPLES, base_design
 
@@ -166,8 +166,9 @@ def test_tool_path_rounds_the_plate_corners():
 def test_concave_stretch_tighter_than_the_cutter_is_refused():
     spec = _wedge()
     c = geometry_from_spec(spec).profiles[0]
-    with pytest.raises(GeometryError, match="largest cutter"):
+    with pytest.raises(GeometryError, match="largest cutter") as e:
         tool_centre_path(c, 200.0, tol=1e-3)
+    assert " mm–" in str(e.value) and "°" not in str(e.value)  # the stretch is named in mm of travel
 
 
 def test_plate_without_height_and_bore_are_refused(tmp_path):

@@ -7,9 +7,8 @@ import numpy as np
 import pytest
 
 from camfab.errors import GeometryError, SpecError
-from camfab.gcode import (Arc, Comment, Feed, Job, Rapid, Segment, as_contour, contour_toolpath,
+from camfab.gcode import (Arc, Comment, Feed, Job, Rapid, Segment, ToolChange, as_contour, contour_toolpath,
                           offset_contour)
-from camfab.gcode.toolpath import ToolChange
 from tests.gcode.parts import (CENTRE_CURVE, HALF, PART, RP, R_TOOL, SAFE_Z, centre_path, circle, job,
                                stadium, stadium_distance)
 

@@ -16,9 +16,8 @@ import re
 from typing import Any
 
 from camfab.errors import ExportError
-from camfab.gcode.geom import arc_sweep
-from camfab.gcode.toolpath import (Arc, Comment, Coolant, CutterComp, Feed, Program, Rapid, Spindle,
-                                   ToolChange)
+from camfab.gcode.model import Arc, Comment, Coolant, CutterComp, Feed, Program, Rapid, Spindle, ToolChange
+from camfab.geom2d import arc_sweep
 
 __all__ = ["MM_PER_INCH", "Post", "decimals_for", "header_lines"]
 
@@ -160,7 +159,7 @@ class Post:
             The program needs something the controller lacks (e.g. G41/G42 on GRBL).
         """
         if not isinstance(program, Program):
-            raise TypeError("dumps() takes a camfab.gcode.toolpath.Program")
+            raise TypeError("dumps() takes a camfab.gcode.Program")
         opts = self.check_options(options)
         if program.compensation and not self.compensation:
             raise ExportError(f"post {self.name!r}: the controller has no cutter radius compensation "

@@ -12,9 +12,9 @@ import pytest
 
 from camfab.design.assemble import geometry_from_spec
 from camfab.design.spec import design_from_dict
+from camfab.discretize import arcs
 from camfab.formats import load_design
 from camfab.offset.cutter import pitch_curve, profile_curve
-from camfab.offset.discretize import arcs
 
 from .test_discretize import Dense, assert_chain_consistent, check_arcs, tangent_jumps
 
@@ -123,7 +123,7 @@ def test_free_spline_at_fine_tolerances(tol, bounds):
 
 def test_overshooting_span_is_refitted_alone(monkeypatch):
     """A model target above tol makes spans overshoot: only they are refitted, the result stays within tol."""
-    import camfab.offset.arcspline as d
+    import camfab.discretize.arcspline as d
 
     _, curve, dense = example("typical12")
     calls = []

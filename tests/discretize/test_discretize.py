@@ -16,17 +16,22 @@ from hypothesis import strategies as st
 from scipy.spatial import cKDTree
 
 from camfab.design.program import MotionProgram
-from camfab.offset.discretize import (
+from camfab.discretize import (
     ArcDiscretisation,
     Chain,
+    CurveError,
     Discretisation,
     ParametricCurve,
+    ToleranceError,
     arcs,
+    curvature_at,
     max_deviation,
     measure_deviation,
     polyline,
     validate_tol,
 )
+from camfab.errors import CamfabError
+from camfab.geom2d import cross, dot
 from camfab.tolerances import MAX_EXPORT_TOL_MM, MIN_EXPORT_TOL_MM
 
 TOLS = (1e-2, 1e-3, 1e-4, 1e-5)
@@ -334,6 +339,86 @@ def test_curve_validation():
         polyline(ParametricCurve(lambda t: np.column_stack([t, 0 * t]), [0.0]), tol=1e-3)
     with pytest.raises(ValueError, match=r"\(n, 2\)"):
         polyline(ParametricCurve(lambda t: np.cos(t), [0.0]), tol=1e-3)
+    # every deliberate error is a CamfabError (and still a ValueError)
+    with pytest.raises(CurveError, match="pass closed=False"):
+        arcs(ParametricCurve(lambda t: np.column_stack([t, 0 * t]), [0.0]), tol=1e-3)
+    with pytest.raises(ToleranceError, match="give a tolerance in that range"):
+        validate_tol(1.0)
+    assert issubclass(CurveError, CamfabError) and issubclass(ToleranceError, CamfabError)
+
+
+def test_curvature():
+    r = 30.0
+    np.testing.assert_allclose(curvature_at(circle(), np.linspace(0, 2 * math.pi, 9)), 1 / r, rtol=1e-7)
+    a, b = 50.0, 20.0
+    t = np.linspace(0, 2 * math.pi, 17)
+    exact = a * b / (a * a * np.sin(t) ** 2 + b * b * np.cos(t) ** 2) ** 1.5
+    np.testing.assert_allclose(curvature_at(ellipse(), t), exact, rtol=1e-6)
+    np.testing.assert_allclose(curvature_at(circle(derivative=False), np.array([0.3, 2.0])), 1 / r, rtol=1e-5)
+
+
+# ---------------------------------------------------------------------------------------
+# open curves: the ends are vertices, nothing wraps around
+# ---------------------------------------------------------------------------------------
+def half_ellipse() -> ParametricCurve:
+    a, b = 50.0, 20.0
+    return ParametricCurve(lambda t: np.column_stack([a * np.cos(t), b * np.sin(t)]), [0.0], period=math.pi,
+                           derivative=lambda t: np.column_stack([-a * np.sin(t), b * np.cos(t)]), closed=False)
+
+
+def open_kinked() -> ParametricCurve:
+    """y = 5·|sin x| on [0, 7]: kinks at π and 2π, the ends far apart."""
+    def derivative(t):
+        return np.column_stack([np.ones_like(t), 5.0 * np.cos(t) * np.sign(np.sin(t))])
+
+    return ParametricCurve(lambda t: np.column_stack([t, 5.0 * np.abs(np.sin(t))]), [math.pi, 2 * math.pi],
+                           period=7.0, closed=False, derivative=derivative)
+
+
+def open_cam() -> ParametricCurve:
+    """Three quarters of the CAM4 profile: a rise, a dwell, a return, ending before the last dwell."""
+    c = cam(CAM4)
+    return ParametricCurve(c.point, c.breakpoints[c.breakpoints <= 1.5 * math.pi], period=1.5 * math.pi,
+                           derivative=c.derivative, closed=False)
+
+
+OPEN = {"half_ellipse": half_ellipse, "open_kinked": open_kinked, "open_cam": open_cam}
+
+
+@pytest.mark.parametrize("tol", [1e-2, 1e-4])
+@pytest.mark.parametrize("name", sorted(OPEN))
+def test_open_curves_within_tol(name, tol):
+    curve = OPEN[name]()
+    dense = Dense(curve)
+    ends = curve.point(np.array([0.0, curve.period]))
+    res_l = polyline(curve, tol=tol)
+    assert not res_l.closed and res_l.max_deviation <= tol
+    assert check_polyline(res_l, dense) <= tol
+    np.testing.assert_array_equal(res_l.points[[0, -1]], ends)
+    res_a = arcs(curve, tol=tol)
+    assert not res_a.closed and res_a.max_deviation <= tol
+    assert check_arcs(res_a, dense) <= tol
+    assert res_a.max_deviation == pytest.approx(check_arcs(res_a, dense), rel=0.02, abs=2e-8)
+    np.testing.assert_array_equal(np.vstack([res_a.starts[0], res_a.ends[-1]]), ends)
+    np.testing.assert_array_equal(res_a.ends[:-1], res_a.starts[1:])  # no closing entity
+    jumps = np.abs(np.arctan2(cross(res_a.end_tangents[:-1], res_a.tangents[1:]),
+                              dot(res_a.end_tangents[:-1], res_a.tangents[1:])))
+    assert (jumps > 1e-3).sum() == (2 if name == "open_kinked" else 0)
+    assert res_a.n_entities < res_l.n_entities
+
+
+def test_measure_open_chain_sees_its_ends():
+    curve = half_ellipse()
+    res = polyline(curve, tol=1e-3)
+    assert measure_deviation(res.points, curve).max == pytest.approx(res.max_deviation, rel=1e-9)
+    # dropping the last segment leaves the curve's end uncovered: the curve-to-entities distance sees it
+    short = res.points[:-1]
+    gap = float(np.hypot(*(res.points[-1] - res.points[-2])))
+    dev = measure_deviation(short, curve)
+    assert dev.curve_to_entities == pytest.approx(gap, rel=1e-3)
+    assert dev.at_param == pytest.approx(math.pi, abs=1e-9)
+    # the chain measured as an ArcChain keeps its own closure
+    assert measure_deviation(arcs(curve, tol=1e-3), curve).max <= 1e-3
 
 
 # ---------------------------------------------------------------------------------------

@@ -1,8 +1,8 @@
 """Interpolating discretisations on adaptive node grids: chords or biarcs through exact curve points.
 
-Used by :func:`camfab.offset.discretize.polyline` (chords) and as the fallback of
-:func:`camfab.offset.discretize.arcs` (interpolating biarcs, when the free arc spline of
-:mod:`camfab.offset.arcspline` does not fit).  Every parameter interval of a node grid gets its
+Used by :func:`~camfab.discretize.fit.polyline` (chords) and as the fallback of
+:func:`~camfab.discretize.fit.arcs` (interpolating biarcs, when the free arc spline of
+:mod:`camfab.discretize.arcspline` does not fit).  Every parameter interval of a node grid gets its
 own entities (one chord, or a biarc with the exact one-sided end tangents), whose two-way deviation
 from the interval's curve is measured (samples plus a golden-section maximisation in each
 direction); intervals above the target are split, a grid equidistributing the measured errors is
@@ -11,27 +11,19 @@ tried once, and the finished result is verified globally by the caller's ``verif
 from __future__ import annotations
 
 import math
-from typing import Callable, Optional
+from collections.abc import Callable
 
 import numpy as np
 
 from ..errors import GeometryError
-from .discretize import (
-    MARGIN,
-    MAX_TURNING_RAD,
-    Chain,
-    ParametricCurve,
-    _biarc,
-    _cross,
-    _derivatives,
-    _dot,
-    _entity_distance,
-    _entity_point,
-    _piece_index,
-    _points,
-    _surrogate,
-    _unit,
-)
+from ..geom2d import cross, dot, unit
+from .chain import Chain
+from .curve import ParametricCurve, derivatives_at, piece_index, points_at
+from .entities import MAX_TURNING_RAD, biarc, entity_distance, entity_point
+from .surrogate import HermiteSurrogate, fit_surrogate
+from .tolerance import MARGIN
+
+__all__ = ["fit_grid", "biarc_chain"]
 
 
 #: interior curve samples per interval and samples per entity used while fitting
@@ -60,17 +52,14 @@ def _project(curve: ParametricCurve, x: np.ndarray, t0: np.ndarray, a: np.ndarra
     """
     t = np.clip(t0, a, b)
     for _ in range(iters):
-        r = _points(curve, t) - x
-        d = _derivatives(curve, t, lo, hi)
+        r = points_at(curve, t) - x
+        d = derivatives_at(curve, t, lo, hi)
         dd = np.einsum("...i,...i->...", d, d)
         step = np.einsum("...i,...i->...", r, d) / np.where(dd > 0, dd, 1.0)
         t = np.clip(t - step, a, b)
     return t
 
 
-# --------------------------------------------------------------------------------------
-# per-interval measurement
-# --------------------------------------------------------------------------------------
 def _golden_min(f: Callable[[np.ndarray], np.ndarray], lo: np.ndarray, hi: np.ndarray,
                 iters: int = _GOLDEN_ITERS) -> tuple[np.ndarray, np.ndarray]:
     """Vectorised golden-section search on each ``[lo, hi]``: the argument minimising ``f`` and the
@@ -106,27 +95,27 @@ def _interval_entities(curve: ParametricCurve, a, b, lo, hi, kind: str, pa=None,
     largest distance from the curve samples of the interval to the biarc).
     ``pa``, ``pb`` may pass ``P(a)``, ``P(b)`` already evaluated.
     """
-    pa = _points(curve, a) if pa is None else pa
-    pb = _points(curve, b) if pb is None else pb
+    pa = points_at(curve, a) if pa is None else pa
+    pb = points_at(curve, b) if pb is None else pb
     if kind == "line":
         w = pb - pa
         length = np.hypot(w[:, 0], w[:, 1])
-        return dict(s=pa[:, None], T=_unit(w)[:, None], k=np.zeros((a.size, 1)),
+        return dict(s=pa[:, None], T=unit(w)[:, None], k=np.zeros((a.size, 1)),
                     ell=length[:, None], e=pb[:, None], valid=length > 0)
-    ta = _unit(_derivatives(curve, a, lo, hi))
-    tb = _unit(_derivatives(curve, b, lo, hi))
+    ta = unit(derivatives_at(curve, a, lo, hi))
+    tb = unit(derivatives_at(curve, b, lo, hi))
     frac = np.arange(1, _CURVE_SAMPLES + 1) / (_CURVE_SAMPLES + 1)
-    q = _points(curve, a[:, None] + (b - a)[:, None] * frac)
+    q = points_at(curve, a[:, None] + (b - a)[:, None] * frac)
 
     def proxy(log_r):
-        ent = _biarc(pa, ta, pb, tb, np.exp(log_r))
-        d = _entity_distance(q[:, :, None], *(ent[key][:, None] for key in ("s", "T", "k", "ell", "e")))
+        ent = biarc(pa, ta, pb, tb, np.exp(log_r))
+        d = entity_distance(q[:, :, None], *(ent[key][:, None] for key in ("s", "T", "k", "ell", "e")))
         return np.where(ent["valid"], d.min(axis=-1).max(axis=-1), np.inf)
 
     bound = np.full(a.size, _LOG_RATIO_BOUND)
     log_r = _golden_min(proxy, -bound, bound)[0]
     log_r = np.where(proxy(log_r) < proxy(np.zeros(a.size)), log_r, 0.0)
-    return _biarc(pa, ta, pb, tb, np.exp(log_r))
+    return biarc(pa, ta, pb, tb, np.exp(log_r))
 
 
 def _measure_block(curve: ParametricCurve, a, b, lo, hi, ent: dict) -> np.ndarray:
@@ -145,26 +134,26 @@ def _measure_block(curve: ParametricCurve, a, b, lo, hi, ent: dict) -> np.ndarra
     m = _CURVE_SAMPLES
     frac = np.arange(1, m + 1) / (m + 1)
     tfull = np.concatenate([a[:, None], a[:, None] + (b - a)[:, None] * frac, b[:, None]], axis=1)
-    qfull = _points(curve, tfull)
-    d_a = _entity_distance(qfull[:, 1:-1, None], s[:, None], T[:, None], k[:, None],
+    qfull = points_at(curve, tfull)
+    d_a = entity_distance(qfull[:, 1:-1, None], s[:, None], T[:, None], k[:, None],
                            ell[:, None], e[:, None]).min(axis=-1)
     j = d_a.argmax(axis=1)
 
     def g_a(t):
-        return _entity_distance(_points(curve, t)[:, None], s, T, k, ell, e).min(axis=-1)
+        return entity_distance(points_at(curve, t)[:, None], s, T, k, ell, e).min(axis=-1)
 
     worst_a = np.maximum(d_a.max(axis=1), _golden_max(g_a, tfull[rows, j], tfull[rows, j + 2]))
 
     n_ent = k.shape[1]
     me = _ENTITY_SAMPLES
     uf = np.linspace(0.0, 1.0, me)
-    x = _entity_point(s[:, :, None], T[:, :, None], k[:, :, None], ell[:, :, None] * uf)
+    x = entity_point(s[:, :, None], T[:, :, None], k[:, :, None], ell[:, :, None] * uf)
     x = x.reshape(n, n_ent * me, 2)
     d2 = ((x[:, :, None, :] - qfull[:, None, :, :]) ** 2).sum(axis=-1)
     t0 = np.take_along_axis(tfull, d2.argmin(axis=-1), axis=1)
     bb = lambda z: np.broadcast_to(z[:, None], t0.shape)  # noqa: E731
     tp = _project(curve, x, t0, bb(a), bb(b), bb(lo), bb(hi))
-    diff = x - _points(curve, tp)
+    diff = x - points_at(curve, tp)
     d_b = np.hypot(diff[..., 0], diff[..., 1])
     jb = d_b.argmax(axis=1)
     ei, ui = jb // me, jb % me
@@ -172,9 +161,9 @@ def _measure_block(curve: ParametricCurve, a, b, lo, hi, ent: dict) -> np.ndarra
     s_i, T_i, k_i, l_i = s[rows, ei], T[rows, ei], k[rows, ei], ell[rows, ei]
 
     def g_b(u):
-        pts = _entity_point(s_i, T_i, k_i, u)
+        pts = entity_point(s_i, T_i, k_i, u)
         tt = _project(curve, pts, t_best, a, b, lo, hi, iters=3)
-        dd = pts - _points(curve, tt)
+        dd = pts - points_at(curve, tt)
         return np.hypot(dd[:, 0], dd[:, 1])
 
     u_lo = l_i * uf[np.maximum(ui - 1, 0)]
@@ -187,7 +176,7 @@ def _measure_block(curve: ParametricCurve, a, b, lo, hi, ent: dict) -> np.ndarra
 def _measure_intervals(curve: ParametricCurve, a: np.ndarray, b: np.ndarray, kind: str) -> np.ndarray:
     """Measured deviation of every interval ``[a_i, b_i]`` (vectorised in blocks)."""
     out = np.empty(a.size)
-    pieces = _piece_index(curve, 0.5 * (a + b))
+    pieces = piece_index(curve, 0.5 * (a + b))
     lo_all, hi_all = curve.breakpoints[pieces], curve.breakpoints[pieces + 1]
     for c in range(0, a.size, _BLOCK):
         sl = slice(c, c + _BLOCK)
@@ -197,12 +186,9 @@ def _measure_intervals(curve: ParametricCurve, a: np.ndarray, b: np.ndarray, kin
     return out
 
 
-# --------------------------------------------------------------------------------------
-# grids and refinement
-# --------------------------------------------------------------------------------------
 def _piece_samples(curve: ParametricCurve, lo: float, hi: float, m: int = 129):
     t = np.linspace(lo, hi, m)
-    return t, _points(curve, t)
+    return t, points_at(curve, t)
 
 
 def _turning(p: np.ndarray) -> float:
@@ -211,7 +197,7 @@ def _turning(p: np.ndarray) -> float:
     w = w[np.hypot(w[:, 0], w[:, 1]) > 0]
     if w.shape[0] < 2:
         return 0.0
-    return float(np.abs(np.arctan2(_cross(w[:-1], w[1:]), _dot(w[:-1], w[1:]))).sum())
+    return float(np.abs(np.arctan2(cross(w[:-1], w[1:]), dot(w[:-1], w[1:]))).sum())
 
 
 def _place(lo: float, hi: float, t: np.ndarray, density: np.ndarray, n: int) -> np.ndarray:
@@ -232,14 +218,14 @@ def _initial_grid(curve: ParametricCurve, target: float, kind: str) -> np.ndarra
     steps turning at most :data:`MAX_TURNING_RAD`.  Both keep at least that
     turning bound.
     """
-    grids = []
-    for lo, hi in zip(*curve.pieces):
+    grids: list[np.ndarray] = []
+    for lo, hi in zip(*curve.pieces, strict=True):
         t, p = _piece_samples(curve, float(lo), float(hi))
         n_min = max(1, math.ceil(_turning(p) / MAX_TURNING_RAD))
         if kind == "line":
             w = np.diff(p, axis=0)
             seg = np.hypot(w[:, 0], w[:, 1])
-            turn = np.abs(np.arctan2(_cross(w[:-1], w[1:]), _dot(w[:-1], w[1:])))
+            turn = np.abs(np.arctan2(cross(w[:-1], w[1:]), dot(w[:-1], w[1:])))
             kappa = turn / np.maximum(0.5 * (seg[:-1] + seg[1:]), 1e-300)
             kappa = np.concatenate([[kappa[0]], np.maximum(kappa[:-1], kappa[1:]), [kappa[-1]]])
             speed = seg / np.diff(t)
@@ -248,12 +234,12 @@ def _initial_grid(curve: ParametricCurve, target: float, kind: str) -> np.ndarra
             grids.append(_place(float(lo), float(hi), t, density, n)[:-1])
         else:
             grids.append(np.linspace(float(lo), float(hi), n_min + 1)[:-1])
-    grids.append([curve.period])
+    grids.append(np.array([curve.period]))
     return np.concatenate(grids)
 
 
 def _refine(curve: ParametricCurve, nodes: np.ndarray, target: float, kind: str,
-            dev: Optional[np.ndarray] = None) -> tuple[np.ndarray, np.ndarray]:
+            dev: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Split intervals whose measured deviation exceeds ``target`` until none does.
 
     An interval is bisected, or cut into ``k`` equal parts when its measured
@@ -295,26 +281,27 @@ def _equidistribute(curve: ParametricCurve, nodes: np.ndarray, dev: np.ndarray, 
     """
     power = 2.0 if kind == "line" else 3.0
     share = np.maximum((np.maximum(dev, 0.0) / (fill * target)) ** (1.0 / power), 1e-6)
-    grids = []
-    for lo, hi in zip(*curve.pieces):
+    grids: list[np.ndarray] = []
+    for lo, hi in zip(*curve.pieces, strict=True):
         sel = (nodes[:-1] >= lo) & (nodes[:-1] < hi)
         t = np.append(nodes[:-1][sel], hi)
         _, p = _piece_samples(curve, float(lo), float(hi))
         n_min = max(1, math.ceil(_turning(p) / MAX_TURNING_RAD))
         n = max(n_min, math.ceil(float(share[sel].sum())))
         grids.append(_place(float(lo), float(hi), t, share[sel] / np.diff(t), n)[:-1])
-    grids.append([curve.period])
+    grids.append(np.array([curve.period]))
     return np.concatenate(grids)
 
 
-def _fit(curve: ParametricCurve, tol: float, kind: str, verify: Callable[[np.ndarray], float],
-         sur: Optional[tuple] = None):
+def fit_grid(curve: ParametricCurve, tol: float, kind: str, verify: Callable[[np.ndarray], float],
+             surrogate: tuple[HermiteSurrogate, float] | None = None) -> tuple[np.ndarray, float]:
     """Adaptive grid for ``kind`` within ``tol``: initial grid, refinement, one re-spread.
 
     ``verify(nodes)`` measures the finished result globally; should it exceed
-    ``tol`` the target is tightened and refinement resumes.
+    ``tol`` the target is tightened and refinement resumes.  Returns the nodes and the measured
+    deviation.  ``surrogate``: the curve's Hermite stand-in and its error, when already built.
     """
-    sur, sur_err = sur or _surrogate(curve, tol)
+    sur, sur_err = surrogate or fit_surrogate(curve, tol)
     curve = sur.as_curve()  # fitting never calls the exact curve; verify() measures on it
     target = tol * (1.0 - MARGIN) - sur_err
     nodes, dev = _refine(curve, _initial_grid(curve, target, kind), target, kind)
@@ -333,18 +320,19 @@ def _fit(curve: ParametricCurve, tol: float, kind: str, verify: Callable[[np.nda
                         "may have a cusp or cross itself (an undercut profile cannot be exported)")
 
 
-def _arc_chain(curve: ParametricCurve, nodes: np.ndarray, fit_curve: ParametricCurve = None
-               ) -> tuple[Chain, np.ndarray]:
+def biarc_chain(curve: ParametricCurve, nodes: np.ndarray, fit_curve: ParametricCurve | None = None
+                ) -> tuple[Chain, np.ndarray]:
     """The biarc chain of a node grid and the piece index of every entity.
 
     The nodes are exact points of ``curve``; tangents and biarc ratios may be
     taken from ``fit_curve`` (a surrogate of it).
     """
     a, b = nodes[:-1], nodes[1:]
-    pieces = _piece_index(curve, 0.5 * (a + b))
+    pieces = piece_index(curve, 0.5 * (a + b))
     bp = curve.breakpoints
-    pts = _points(curve, nodes)
-    pts[-1] = pts[0]  # one evaluation per node: ends[i] == starts[i + 1] bit for bit
+    pts = points_at(curve, nodes)
+    if curve.closed:
+        pts[-1] = pts[0]  # one evaluation per node: ends[i] == starts[i + 1] bit for bit
     ent = _interval_entities(fit_curve or curve, a, b, bp[pieces], bp[pieces + 1], "biarc", pts[:-1], pts[1:])
     start = ent["s"].reshape(-1, 2)
     end = ent["e"].reshape(-1, 2)

@@ -1,0 +1,335 @@
+"""G1 arc splines fitted to a curve's cubic stand-in: knots and curvatures optimised per span.
+
+The *free* (non-interpolating) arc spline that :func:`~camfab.discretize.fit.arcs` tries first.
+The curve is cut into spans (:mod:`camfab.discretize.spans`); each span is clamped to the curve's
+point and tangent at both ends and fitted on the Hermite surrogate
+(:class:`~camfab.discretize.surrogate.HermiteSurrogate`): a linear model of the normal deviation
+(:mod:`camfab.discretize.spanmodel`) gives the curvatures of given knots by a minimax (Lawson) fit,
+then knots and curvatures are optimised together until the errors equioscillate, and the fewest
+arcs that fit are kept.  The exact arcs are then laid out (two of them the biarc closing the span),
+the chain is measured on the exact curve, and only the spans that exceed ``tol`` are refitted.
+:func:`fit_spline` is the entry point.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..geom2d import cross, dot, rotate
+from .chain import Chain, merge_cocircular
+from .curve import ParametricCurve, points_at
+from .entities import LINE_SWEEP_RAD, MAX_TURNING_RAD, arc_from, biarc, entity_point
+from .measure import measure_deviation
+from .spanmodel import SpanModel, cumtrapz, equioscillate
+from .spans import Span, cut_spans, span_density, span_ends
+from .surrogate import HermiteSurrogate
+
+__all__ = ["fit_spline"]
+
+
+#: model samples per arc of the free arc spline
+_SPLINE_SAMPLES = 16
+#: the free spline's model deviation aims at this fraction of tol (less the surrogate error)
+_SPLINE_FILL = 0.97
+#: fewest model samples of one span
+_SPLINE_MIN_GRID = 129
+#: the first arc count tried is this multiple of the asymptotic estimate
+_EST_FACTOR = 1.0
+#: one arc fewer is tried while the predicted error (∝ 1/m³) stays below this multiple of the target
+_DOWN_SLACK = 1.2
+#: a span is only fitted up to this many arcs (else interpolating biarcs are used)
+_SPAN_MAX_ARCS = 64
+#: relative lengths of the two end arcs at each clamped end of a piece (an LP over C¹ patterns:
+#: a clamped end then costs about half an arc instead of tripling the error of uniform arcs)
+_END_ARCS = (0.6, 1.0)
+#: further end-arc ratios tried at the smallest failing arc count (the optimum is not monotone in it)
+_END_ARCS_ALT = ((0.7, 1.1),)
+#: refits of the spans where the measured chain exceeds tol
+_SPAN_REFITS = 4
+#: relative lengths of the two end arcs at an end whose arc curvature is fixed (next to a dwell: the
+#: arc matches the curve to second order there, so it is kept shorter)
+_FIXED_END_ARCS = (0.35, 0.9)
+#: further fixed-end ratios tried at the smallest failing count (none: they rarely paid for their time)
+_FIXED_END_ARCS_ALT: tuple = ()
+
+
+def _place_knots(s, density, m, ends=_END_ARCS, ends_hi=None):
+    """``m`` arcs equidistributing ``density``, the two end arcs at each end scaled (``ends``, ``ends_hi``)."""
+    ends_hi = ends if ends_hi is None else ends_hi
+    w = np.ones(m)
+    if m >= 4:
+        w[0], w[1] = ends[0], ends[1]
+        w[-1], w[-2] = ends_hi[0], ends_hi[1]
+    elif m == 3:
+        w[0], w[-1] = ends[0], ends_hi[0]
+    q = np.concatenate([[0.0], np.cumsum(w)]) / w.sum()
+    cum = cumtrapz(density, s)
+    knots = np.interp(q * cum[-1], cum, s) if cum[-1] > 0 else q * s[-1]
+    knots[0], knots[-1] = 0.0, s[-1]
+    return knots
+
+
+class _SpanFit:
+    """The arc-count search of one clamped span: a model per arc count, the errors of the counts tried."""
+
+    def __init__(self, sur: HermiteSurrogate, span: Span, target: float):
+        self.sur, self.span, self.target = sur, span, target
+        _, self.s0, self.density, _ = span_density(sur, span.segs, target)
+        self.est = float(cumtrapz(self.density, self.s0)[-1])
+        self.n_fixed = sum(f is not None for f in span.fixed)
+        self.m_min = 2 + self.n_fixed
+        self.tried: dict = {}
+        self.models: dict = {}
+
+    def attempt(self, m: int, ends=_END_ARCS, knots=None, fixed_ends=_FIXED_END_ARCS):
+        """``(error, fits, (knots, k, error))`` of ``m`` arcs optimised from ``knots`` (default: placed)."""
+        span = self.span
+        if m not in self.models:
+            self.models[m] = SpanModel(self.sur, span.segs, max(_SPLINE_MIN_GRID, _SPLINE_SAMPLES * m + 1),
+                                       span.fixed)
+        model = self.models[m]
+        if knots is None:
+            knots = _place_knots(model.s, np.interp(model.s, self.s0, self.density), m,
+                                 fixed_ends if span.fixed[0] is not None else ends,
+                                 fixed_ends if span.fixed[1] is not None else ends)
+        err, knots, k = equioscillate(model, knots)
+        free = np.ones(m, bool)
+        free[0] = span.fixed[0] is None
+        free[-1] = span.fixed[1] is None
+        ok = err <= self.target and np.all(np.abs(k * np.diff(knots))[free] < MAX_TURNING_RAD * 1.5)
+        return err, ok, (knots, k, err)
+
+    def search(self):
+        """The fewest arcs that fit from the count search, or None (no fit, or more than the span allows)."""
+        m = max(self.m_min, math.ceil(_EST_FACTOR * self.est))
+        best = None
+        for _ in range(12):
+            if m in self.tried:
+                break
+            if m > _SPAN_MAX_ARCS:
+                return None
+            err, ok, fit = self.attempt(m)
+            self.tried[m] = err
+            if ok and (best is None or m < best[0].size - 1):
+                best = fit
+            nxt = self._next_count(m, err, ok, best)
+            if nxt is None:
+                break
+            m = nxt
+        return best
+
+    def _next_count(self, m: int, err: float, ok: bool, best) -> int | None:
+        """The next arc count to try after ``m`` arcs (error ``err``), or None to stop."""
+        if ok:
+            # one arc fewer raises the error by about (m / (m - 1))³: not worth trying beyond the target
+            if (m - 1) in self.tried or m <= self.m_min or err * (m / (m - 1)) ** 3 > _DOWN_SLACK * self.target:
+                return None
+            return m - 1
+        if best is not None and best[0].size - 1 == m + 1:
+            return None
+        jump = math.ceil(m * (err / self.target) ** (1.0 / 3.0)) - m  # (a single count may fail badly)
+        return m + 1 if err < 1.6 * self.target else m + max(1, min(jump, math.ceil(0.1 * m) + 1))
+
+    def retry_one_fewer(self, best):
+        """``best``, or a fit with one arc fewer when that count failed narrowly: a warm start from the
+        optimised knots of ``best`` less the joint of the smallest curvature jump (not an end arc), then
+        other end-arc ratios."""
+        m = best[0].size - 2
+        if not (m >= max(4, self.m_min) and m in self.tried and self.tried[m] <= 1.3 * self.target):
+            return best
+        kb, kk = best[0], best[1]
+        jump = np.abs(np.diff(kk))[1:-1]
+        if jump.size:
+            j = 2 + int(np.argmin(jump))
+            _, ok, fit = self.attempt(m, knots=np.delete(kb, j))
+            if ok:
+                return fit
+        alts = [(ends, _FIXED_END_ARCS) for ends in _END_ARCS_ALT] if self.n_fixed < 2 else []
+        alts += [(_END_ARCS, fe) for fe in _FIXED_END_ARCS_ALT] if self.n_fixed else []
+        for ends, fixed_ends in alts:
+            _, ok, fit = self.attempt(m, ends, fixed_ends=fixed_ends)
+            if ok:
+                return fit
+        return best
+
+
+def _fit_span(sur: HermiteSurrogate, span: Span, target: float):
+    """Fewest arcs (model) for a clamped span: ``(knots, k, error)`` or None.
+
+    The arc count starts from the asymptotic estimate ``∫ (|κ'| / (124.7·target))^(1/3) ds``;
+    every count gets knots equidistributing that density (end arcs shortened at clamped ends),
+    then knots and curvatures are optimised together (:func:`equioscillate`);
+    the count goes down while the span still fits ``target`` and up until it does.
+    The optimum is not monotone in the count: at the smallest failing count a warm start
+    and other end-arc ratios (:data:`_END_ARCS_ALT`) are tried when it failed narrowly.
+    """
+    fit = _SpanFit(sur, span, target)
+    best = fit.search()
+    return None if best is None else fit.retry_one_fewer(best)
+
+
+def _tanlen(kk, ll):
+    x = 0.5 * kk * ll
+    return ll / 2 if abs(x) < 1e-12 else math.tan(x) / kk
+
+
+def _lay_backward(p1, t1, k, ell, j: int):
+    """Arcs ``j + 2 … m - 1`` laid backward from ``p1`` (tangent ``t1``): their starts and start tangents,
+    and the point and tangent angle where the closing biarc must end."""
+    b_starts: list[np.ndarray] = []
+    b_tans: list[np.ndarray] = []
+    end_p, end_ang = p1, math.atan2(t1[1], t1[0])
+    for i in range(ell.size - 1, j + 1, -1):
+        ang_s = end_ang - k[i] * ell[i]
+        tb = np.array([math.cos(end_ang), math.sin(end_ang)])
+        sp = entity_point(end_p, -tb, -k[i], ell[i])
+        b_starts.insert(0, sp)
+        b_tans.insert(0, np.array([math.cos(ang_s), math.sin(ang_s)]))
+        end_p, end_ang = sp, ang_s
+    return b_starts, b_tans, end_p, end_ang
+
+
+def _cut_long_arcs(S, TT, K, L):
+    """Starts and tangents of the arcs ``(S, TT, K, L)`` with every arc turning more than π/2 cut into
+    equal parts (fixed dwell arcs)."""
+    parts = np.maximum(1, np.ceil(np.abs(K * L) / (0.5 * math.pi))).astype(int)
+    if parts.max() == 1:
+        return S, TT
+    idx = np.repeat(np.arange(K.size), parts)
+    sub = np.arange(idx.size) - np.repeat(np.cumsum(parts) - parts, parts)
+    u = L[idx] * sub / parts[idx]
+    return entity_point(S[idx], TT[idx], K[idx], u), rotate(TT[idx], K[idx] * u)
+
+
+def _span_chain(p0, t0, p1, t1, knots, k, fixed=(None, None)):
+    """Exact G1 arcs of a span from ``(p0, t0)`` to ``(p1, t1)``: the planned arcs, closed by a biarc.
+
+    The arcs before the closing biarc are laid forward from ``p0``; with a fixed last curvature the
+    last arc is laid backward from ``p1`` (the biarc closes the arcs before it).  Arcs turning more
+    than π/2 are cut into equal parts (co-circular parts merge again later)."""
+    ell = np.diff(knots)
+    k = np.array(k, dtype=float)
+    if fixed[0] is not None:
+        k[0] = fixed[0]
+    if fixed[1] is not None:
+        k[-1] = fixed[1]
+    m = ell.size
+    j = m - 3 if fixed[1] is not None else m - 2  # the closing biarc is arcs j, j + 1
+    if j < (1 if fixed[0] is not None else 0):
+        return None
+    starts, tans, ks, ls = [p0], [t0], [], []
+    base = math.atan2(t0[1], t0[0])
+    ang = base + np.concatenate([[0.0], np.cumsum(k * ell)])
+    for i in range(j):
+        e = entity_point(starts[-1], tans[-1], k[i], ell[i])
+        ks.append(k[i])
+        ls.append(ell[i])
+        starts.append(e)
+        tans.append(np.array([math.cos(ang[i + 1]), math.sin(ang[i + 1])]))
+    b_starts, b_tans, end_p, end_ang = _lay_backward(p1, t1, k, ell, j)
+    d1, d2 = _tanlen(k[j], ell[j]), _tanlen(k[j + 1], ell[j + 1])
+    ratio = d1 / d2 if d1 > 0 and d2 > 0 else 1.0
+    tgt_t = np.array([math.cos(end_ang), math.sin(end_ang)])
+    bi = biarc(starts[-1][None], tans[-1][None], end_p[None], tgt_t[None], np.array([ratio]))
+    if not bi["valid"][0]:
+        bi = biarc(starts[-1][None], tans[-1][None], end_p[None], tgt_t[None], np.array([1.0]))
+        if not bi["valid"][0]:
+            return None
+    S = np.concatenate([np.array(starts[:j]).reshape(-1, 2), bi["s"][0], np.array(b_starts).reshape(-1, 2)])
+    TT = np.concatenate([np.array(tans[:j]).reshape(-1, 2), bi["T"][0], np.array(b_tans).reshape(-1, 2)])
+    K = np.concatenate([np.array(ks), bi["k"][0], k[j + 2:]])
+    L = np.concatenate([np.array(ls), bi["ell"][0], ell[j + 2:]])
+    S, TT = _cut_long_arcs(S, TT, K, L)
+    # make every arc consistent with both its end points (ends[i] == starts[i + 1] exactly)
+    S_next = np.concatenate([S[1:], [p1]])
+    TT2, K2, L2, ok = arc_from(S, TT, S_next)
+    if not ok.all():
+        return None
+    return S, TT2, K2, L2, S_next
+
+
+def _fit_span_chain(curve: ParametricCurve, sur: HermiteSurrogate, span: Span, target: float):
+    """The exact G1 arcs of one span fitted to ``target`` and the model error, or None."""
+    if span.exact is not None:
+        return span.exact, 0.0
+    fit = _fit_span(sur, span, target)
+    if fit is None:
+        return None
+    knots, k, err = fit
+    p0, t0, p1, t1 = span_ends(sur, span)
+    chain = _span_chain(p0, t0, p1, t1, knots, k, span.fixed)
+    return None if chain is None else (chain, err)
+
+
+def _merge_wrap(chain: Chain, labels: np.ndarray) -> tuple[Chain, np.ndarray]:
+    """Roll the chain by one entity when its last and first entities lie on one circle (G1 joint)."""
+    if chain.n < 2 or labels[0] != labels[-1]:
+        return chain, labels
+    k, ell = chain.curvature, chain.length
+    tj = chain.end_tangent[-1]
+    g1 = abs(math.atan2(cross(tj, chain.tangent[0]), dot(tj, chain.tangent[0]))) < 1e-12
+    if not (g1 and abs(k[0] - k[-1]) * (ell[0] + ell[-1]) <= LINE_SWEEP_RAD):
+        return chain, labels
+    roll = lambda a: np.roll(a, 1, axis=0)  # noqa: E731
+    return Chain(*(roll(a) for a in (chain.start, chain.tangent, chain.curvature, chain.length, chain.end))), \
+        roll(labels)
+
+
+def _span_deviations(curve: ParametricCurve, spans: list, parts: list, merged: Chain, dev) -> np.ndarray:
+    """The measured deviation of every span: the largest distance from its exact curve samples (16 per
+    arc) to the chain, and the measured maximum ``dev`` for the span holding it."""
+    counts = [c[0].shape[0] for c in parts]
+    t = [sp.sample(16 * n) for sp, n in zip(spans, counts, strict=True)]
+    d, _ = merged.distance(points_at(curve, np.concatenate(t)))
+    worst = np.maximum.reduceat(d, np.concatenate([[0], np.cumsum([x.size for x in t])[:-1]]))
+    at = float(dev.at_param)
+    j = next((i for i, sp in enumerate(spans) if sp.contains(at)), None)
+    if j is not None:
+        worst[j] = max(worst[j], dev.max)
+    return worst
+
+
+def fit_spline(curve: ParametricCurve, surrogate: tuple[HermiteSurrogate, float], tol: float,
+               anchored: bool = True) -> tuple[Chain, float, np.ndarray] | None:
+    """The free arc spline within ``tol`` (measured on the exact curve) and its span-end parameters, or None.
+
+    Spans are independent (their ends are fixed points with fixed tangents), so
+    when the measured chain exceeds ``tol`` only the offending spans are refitted (the one holding
+    the worst deviation and every span whose exact curve samples lie farther than ``tol`` from the
+    chain), each to a target lowered by its measured / model error ratio.
+    """
+    sur, sur_err = surrogate
+    target = _SPLINE_FILL * tol - sur_err
+    if not (target > 0):
+        return None
+    spans = cut_spans(curve, sur, target, tol, anchored)
+    targets = [target] * len(spans)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        fits = [_fit_span_chain(curve, sur, sp, target) for sp in spans]
+    if any(f is None for f in fits):
+        return None
+    parts, errs = [f[0] for f in fits], [f[1] for f in fits]
+    params = np.unique(np.append([sp.segs[0][1] for sp in spans], curve.period))
+    for _ in range(_SPAN_REFITS + 1):
+        cat = [np.concatenate([c[i] for c in parts]) for i in range(5)]
+        labels = np.concatenate([np.full(c[0].shape[0], spans[j].label) for j, c in enumerate(parts)])
+        chain = Chain(*cat)
+        if curve.closed:
+            chain, labels = _merge_wrap(chain, labels)
+        merged = merge_cocircular(chain, labels)
+        dev = measure_deviation(merged, curve)
+        if dev.max <= tol:
+            return merged, dev.max, params
+        worst = _span_deviations(curve, spans, parts, merged, dev)
+        for j in np.flatnonzero(worst > 0.99 * tol):
+            if spans[j].exact is not None:
+                return None
+            # the measured / model ratio of this span scales its next target
+            targets[j] = min(0.98 * targets[j], 0.97 * tol * errs[j] / worst[j])
+            with np.errstate(invalid="ignore", divide="ignore"):
+                fit = _fit_span_chain(curve, sur, spans[j], targets[j])
+            if fit is None:
+                return None
+            parts[j], errs[j] = fit
+    return None

@@ -1,0 +1,215 @@
+"""The two-way maximum distance between lines/arcs and an exact curve, measured (never assumed).
+
+Curve to entities: exact point-to-line / point-to-arc distances of exact curve samples to the chain.
+Entities to curve: every entity sample is projected onto the curve (Newton on a Hermite interpolant of
+the exact samples and derivatives, on both sample intervals touching the nearest curve sample, never
+across a breakpoint) and its distance taken to the exact curve point at the foot, an upper bound.  The
+worst local maxima of each direction are then refined by two nested grids around them.  The exact
+curve is called a fixed, small number of times (batched).
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from ..errors import GeometryError
+from ..geom2d import ArcChain, dot
+from .chain import Chain
+from .curve import ParametricCurve, points_at
+from .entities import entity_point
+from .results import ArcDiscretisation, Deviation, Discretisation
+from .surrogate import HermiteSurrogate
+
+__all__ = ["as_chain", "measure_deviation", "max_deviation"]
+
+
+def as_chain(entities, closed: bool = True) -> Chain:
+    """Any entities :func:`measure_deviation` accepts as a :class:`Chain`; arrays of vertex rows are
+    closed or open as ``closed`` says (an arc chain or discretisation knows).
+
+    Raises
+    ------
+    GeometryError
+        For anything else (the accepted forms are named).
+    """
+    if isinstance(entities, Chain):
+        return entities
+    if isinstance(entities, (Discretisation, ArcDiscretisation)):
+        return entities.chain()
+    if isinstance(entities, ArcChain):
+        entities, closed = entities.lwpolyline, entities.closed
+    arr = np.asarray(entities, dtype=float)
+    if arr.ndim == 2 and arr.shape[1] == 2:
+        return Chain.from_polyline(arr, closed)
+    if arr.ndim == 2 and arr.shape[1] == 3:
+        return Chain.from_bulges(arr, closed)
+    raise GeometryError("entities must be a Chain, an ArcChain, a discretisation, an (n, 2) polyline or "
+                        f"(n, 3) (x, y, bulge) rows; got shape {arr.shape}")
+
+
+def _local_maxima(values: np.ndarray, cyclic: bool, top: int) -> np.ndarray:
+    """Indices of the ``top`` largest local maxima of ``values`` (largest first)."""
+    left = np.roll(values, 1) if cyclic else np.concatenate([[-np.inf], values[:-1]])
+    right = np.roll(values, -1) if cyclic else np.concatenate([values[1:], [-np.inf]])
+    cand = np.flatnonzero((values >= left) & (values >= right))
+    return cand[np.argsort(-values[cand], kind="stable")[:top]]
+
+
+class _CurveProjector:
+    """Closest-point queries on the exact curve.
+
+    The foot of every query point is found by Newton iterations on a cubic
+    Hermite surrogate of the dense exact samples (on both sample intervals
+    touching the nearest sample, never across a breakpoint); the distance is
+    then taken to the *exact* curve point at that foot, one batched call, so
+    it is always an upper bound of the true distance.
+    """
+
+    def __init__(self, sur: HermiteSurrogate):
+        self.sur = sur
+        self.curve = sur.curve
+        self.x = sur.x
+        self.n = sur.x.size - 1
+        self.tree = cKDTree(sur.points[:-1] if self.curve.closed else sur.points)
+
+    def __call__(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Distance from each ``x`` ``(N, 2)`` to the curve and the foot parameter."""
+        _, j = self.tree.query(x)
+        if self.curve.closed:
+            iv = np.stack([(j - 1) % self.n, j], axis=1)  # (N, 2)
+        else:
+            iv = np.stack([np.maximum(j - 1, 0), np.minimum(j, self.n - 1)], axis=1)
+        a, h = self.x[iv], self.x[iv + 1] - self.x[iv]
+        c = self.sur.coef[:, iv]
+        xx = x[:, None, :]
+        u = 0.5 * h
+        for _ in range(6):
+            uu = u[..., None]
+            p = c[0] + uu * (c[1] + uu * (c[2] + uu * c[3]))
+            d = c[1] + uu * (2 * c[2] + 3 * uu * c[3])
+            dd = 2 * c[2] + 6 * uu * c[3]
+            r = p - xx
+            g = dot(r, d)
+            hess = dot(d, d) + dot(r, dd)
+            step = g / np.where(hess > 0, hess, np.maximum(dot(d, d), 1e-300))
+            u = np.clip(u - step, 0.0, h)
+        t = a + u
+        diff = xx - points_at(self.curve, t)
+        dist = np.hypot(diff[..., 0], diff[..., 1])
+        best = dist.argmin(axis=1)
+        rows = np.arange(x.shape[0])
+        return dist[rows, best], t[rows, best]
+
+
+def _zoom_max(f: Callable[[np.ndarray], np.ndarray], lo: np.ndarray, hi: np.ndarray,
+              levels: int = 2, m: int = 33) -> np.ndarray:
+    """Maximum of ``f`` on each ``[lo, hi]`` by nested sample grids (one batched call of ``f`` per level)."""
+    best = np.full(lo.size, -np.inf)
+    grid = np.linspace(0.0, 1.0, m)
+    rows = np.arange(lo.size)
+    for _ in range(levels):
+        u = lo[:, None] + (hi - lo)[:, None] * grid
+        v = f(u)
+        j = v.argmax(axis=1)
+        best = np.maximum(best, v[rows, j])
+        lo, hi = u[rows, np.maximum(j - 1, 0)], u[rows, np.minimum(j + 1, m - 1)]
+    return best
+
+
+def _curve_to_chain(chain: Chain, curve: ParametricCurve, sur: HermiteSurrogate,
+                    refine_top: int) -> tuple[float, float]:
+    """Largest distance from the exact curve to the chain and its parameter: exact distances of the
+    surrogate's exact samples, the worst local maxima refined by nested grids of exact points."""
+    ts = sur.x
+    n_t = ts.size - 1
+    d_a, _ = chain.distance(sur.points[:-1] if curve.closed else sur.points)
+
+    def g_a(t):
+        return chain.distance(points_at(curve, t.ravel()))[0].reshape(t.shape)
+
+    top = _local_maxima(d_a, curve.closed, refine_top)
+    if curve.closed:
+        lo_t = np.where(top > 0, ts[top - 1], ts[n_t - 1] - curve.period)
+        hi_t = ts[top + 1]
+    else:
+        lo_t, hi_t = ts[np.maximum(top - 1, 0)], ts[np.minimum(top + 1, n_t)]
+    best_a = _zoom_max(g_a, lo_t, hi_t) if top.size else np.zeros(0)
+    i_a = int(np.argmax(d_a))
+    worst_a, at_a = float(d_a[i_a]), float(ts[i_a])
+    if best_a.size and best_a.max() > worst_a:
+        worst_a = float(best_a.max())
+        at_a = float(np.mod(0.5 * (lo_t + hi_t)[best_a.argmax()], curve.period))
+    return worst_a, at_a
+
+
+def _chain_to_curve(chain: Chain, sur: HermiteSurrogate, per_entity: int,
+                    refine_top: int) -> tuple[float, float]:
+    """Largest distance from the chain to the exact curve and the parameter of its foot: entity samples
+    projected onto the curve, the worst local maxima refined by nested grids along their entities."""
+    proj = _CurveProjector(sur)
+    x, u = chain.sample(per_entity)
+    d_b, t_b = proj(x.reshape(-1, 2))
+    i_b = int(np.argmax(d_b))
+    worst_b, at_b = float(d_b[i_b]), float(t_b[i_b])
+    flat = _local_maxima(d_b, False, refine_top)
+    if flat.size:
+        ent, ui = flat // per_entity, flat % per_entity
+        u_lo = u[ent, np.maximum(ui - 1, 0)]
+        u_hi = u[ent, np.minimum(ui + 1, per_entity - 1)]
+
+        def g_b(uu):
+            pts = entity_point(chain.start[ent, None], chain.tangent[ent, None], chain.curvature[ent, None], uu)
+            return proj(pts.reshape(-1, 2))[0].reshape(uu.shape)
+
+        best_b = _zoom_max(g_b, u_lo, u_hi)
+        if best_b.max() > worst_b:
+            worst_b = float(best_b.max())
+            at_b = float(t_b.reshape(chain.n, per_entity)[ent[best_b.argmax()], ui[best_b.argmax()]])
+    return worst_b, at_b
+
+
+def measure_deviation(entities, curve: ParametricCurve, *, samples: int = 20000,
+                      per_entity: int = 17, refine_top: int = 32) -> Deviation:
+    """Two-way maximum distance between entities and the exact curve (see the module notes).
+
+    Parameters
+    ----------
+    entities : Chain, ArcChain, Discretisation or array_like
+        An arc chain or discretisation, ``(n, 2)`` polyline vertices or ``(n, 3)`` rows
+        ``(x, y, bulge)`` of an LWPOLYLINE, e.g. read back from a file (closed implicitly when the
+        curve is closed).
+    curve : ParametricCurve
+        The exact curve.
+    samples : int, optional
+        Curve samples (at least 8 per entity and per piece are used).
+    per_entity : int, optional
+        Samples per entity, ends included.
+    refine_top : int, optional
+        How many of the worst local maxima of each direction are refined by
+        nested sample grids.
+
+    Returns
+    -------
+    Deviation
+        ``max``, both one-way maxima (mm) and where the maximum occurs.
+    """
+    chain = as_chain(entities, curve.closed)
+    if chain.n == 0:
+        raise GeometryError("no entities to measure: give at least one line or arc")
+    sur = HermiteSurrogate(curve, max(int(samples), 8 * chain.n), min_count=8)
+    worst_a, at_a = _curve_to_chain(chain, curve, sur, refine_top)
+    worst_b, at_b = _chain_to_curve(chain, sur, per_entity, refine_top)
+    at = at_a if worst_a >= worst_b else at_b
+    return Deviation(max=max(worst_a, worst_b), curve_to_entities=worst_a,
+                     entities_to_curve=worst_b, at_param=at, at_point=points_at(curve, np.array([at]))[0])
+
+
+def max_deviation(entities, curve: ParametricCurve, **kwargs) -> float:
+    """Two-way maximum distance (mm) between entities and the exact curve.
+
+    A shorthand for ``measure_deviation(entities, curve, **kwargs).max``; see
+    :func:`measure_deviation` for the accepted ``entities``.
+    """
+    return measure_deviation(entities, curve, **kwargs).max

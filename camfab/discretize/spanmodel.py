@@ -1,0 +1,274 @@
+"""The linear model of a G1 arc spline's normal deviation from one span of a curve, and its minimax fit.
+
+On a span (consecutive smooth pieces joined G1, parametrised by arc length) the arcs are given by
+their knots and curvatures; to first order the normal deviation is linear in the curvatures, with
+prefix integrals exact for the cubic Hermite data of the surrogate.  :func:`equioscillate` optimises
+knots and curvatures together until the local extrema of the deviation share one level.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..geom2d import TWO_PI, cross, dot
+from .surrogate import HermiteSurrogate
+
+__all__ = ["span_model", "cumtrapz", "SpanModel", "equioscillate"]
+
+
+#: Lawson (minimax) reweighting iterations of the curvatures of given knots
+_LAWSON_ITERS = 8
+#: Gauss-Newton rounds equalising the arc errors (knots and curvatures together)
+_EQUI_ITERS = 8
+
+
+def span_model(sur: HermiteSurrogate, segs, n_grid: int, curvature: bool = False):
+    """Arc length, tangent angle (and curvature) of the surrogate along a span.
+
+    ``segs`` lists ``(piece, lo, hi)`` parameter ranges of consecutive smooth pieces joined G1; the
+    grid points are shared out by parameter length, every junction appearing twice (its one-sided
+    values: the curvature may jump there)."""
+    total = sum(hi - lo for _, lo, hi in segs)
+    ts, ss, ths, ks = [], [], [], []
+    s_off, th_off = 0.0, None
+    for piece, lo, hi in segs:
+        n = max(5, int(round(n_grid * (hi - lo) / total)) + 1) if len(segs) > 1 else n_grid
+        t = np.linspace(lo, hi, n)
+        tm = 0.5 * (t[:-1] + t[1:])
+        d = sur.derivative(t, piece)
+        dm = sur.derivative(tm, piece)
+        sp, spm = np.hypot(d[:, 0], d[:, 1]), np.hypot(dm[:, 0], dm[:, 1])
+        sv = s_off + np.concatenate([[0.0], np.cumsum(np.diff(t) / 6.0 * (sp[:-1] + 4 * spm + sp[1:]))])
+        theta = np.unwrap(np.arctan2(d[:, 1], d[:, 0]))
+        if th_off is not None:
+            theta = theta + TWO_PI * round((th_off - theta[0]) / TWO_PI)
+        ts.append(t)
+        ss.append(sv)
+        ths.append(theta)
+        if curvature:
+            ks.append(cross(d, sur.second_derivative(t, piece)) / np.maximum(sp, 1e-300) ** 3)
+        s_off, th_off = float(sv[-1]), float(theta[-1])
+    out = (np.concatenate(ts), np.concatenate(ss), np.concatenate(ths))
+    return out + (np.concatenate(ks),) if curvature else out
+
+
+def cumtrapz(f: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Cumulative trapezoid integral of ``f`` ``(n, ...)`` over the grid ``s`` ``(n,)``, 0 first."""
+    ds = np.diff(s).reshape((-1,) + (1,) * (f.ndim - 1))
+    return np.concatenate([np.zeros((1,) + f.shape[1:]), np.cumsum(0.5 * ds * (f[1:] + f[:-1]), axis=0)])
+
+
+def _cumhermite(f: np.ndarray, fp: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Cumulative integral of ``f`` (derivative ``fp``) on the grid ``s``: exact for piecewise cubics."""
+    ds = np.diff(s).reshape((-1,) + (1,) * (f.ndim - 1))
+    inc = 0.5 * ds * (f[1:] + f[:-1]) + ds * ds / 12.0 * (fp[:-1] - fp[1:])
+    return np.concatenate([np.zeros((1,) + f.shape[1:]), np.cumsum(inc, axis=0)])
+
+
+def _hermite_at(x: np.ndarray, s: np.ndarray, F: np.ndarray, f: np.ndarray, fp: np.ndarray) -> np.ndarray:
+    """``F(x) = ∫₀ˣ f`` between grid points: integral of the cubic Hermite interpolant of ``f``."""
+    i = np.clip(np.searchsorted(s, x, side="right") - 1, 0, s.size - 2)
+    h = s[i + 1] - s[i]
+    tau = np.clip((x - s[i]) / np.where(h > 0, h, 1.0), 0.0, 1.0)
+    t2, t3, t4 = tau * tau, tau ** 3, tau ** 4
+    w = (h * (tau - t3 + 0.5 * t4), h * h * (0.25 * t4 - 2.0 * t3 / 3.0 + 0.5 * t2),
+         h * (t3 - 0.5 * t4), h * h * (0.25 * t4 - t3 / 3.0))
+    return (F[i] + w[0][:, None] * f[i] + w[1][:, None] * fp[i] + w[2][:, None] * f[i + 1]
+            + w[3][:, None] * fp[i + 1])
+
+
+def _lawson(A: np.ndarray, b: np.ndarray, C: np.ndarray, dvec: np.ndarray, iters: int = _LAWSON_ITERS):
+    """Approximately minimise ``max |A k + b|`` subject to ``C k = d`` (Lawson's reweighting)."""
+    kp, *_ = np.linalg.lstsq(C, dvec, rcond=None)
+    _, sv, vt = np.linalg.svd(C)
+    rank = int((sv > sv[0] * 1e-12).sum()) if sv.size else 0
+    Z = vt[rank:].T
+    if Z.shape[1] == 0:
+        return kp, A @ kp + b
+    AZ = A @ Z
+    r0 = A @ kp + b
+    w = np.full(A.shape[0], 1.0 / A.shape[0])
+    best_k, best_e = None, np.inf
+    for _ in range(iters):
+        M = AZ * w[:, None]
+        H = AZ.T @ M
+        H[np.diag_indices_from(H)] += 1e-14 * np.trace(H) + 1e-300
+        y = np.linalg.solve(H, -(M.T @ r0))
+        k = kp + Z @ y
+        e = r0 + AZ @ y
+        emax = np.abs(e).max()
+        if emax < best_e:
+            best_k, best_e, best_res = k, emax, e
+        w = w * np.abs(e)
+        total = w.sum()
+        if not (total > 0):
+            break
+        w = np.maximum(w / total, 1e-12)
+    return best_k, best_res
+
+
+class SpanModel:
+    """Linear model of the normal deviation of a G1 arc spline from one smooth piece.
+
+    The arcs are parametrised by the arc length ``s`` of the piece: with knots
+    ``x`` (arc ends) and curvatures ``k`` the spline's tangent angle is
+    ``φ(s) = θ(0) + Σ k_j·clip(s - x_j, 0, ℓ_j)``; to first order its point at
+    ``s`` is ``P(s) + V(s)`` with ``V(s) = ∫₀ˢ (φ - θ)·n ds'``, and the normal
+    deviation is ``e(s) = n(s)·V(s) = A k + b``.  The spline starts at the
+    piece's first point with its tangent; ``C k = d`` closes it on the last
+    point with its tangent (first order; the last two arcs are re-fitted exactly).
+    """
+
+    def __init__(self, sur: HermiteSurrogate, segs, n_grid: int, fixed=(None, None)):
+        _, s, theta, kappa = span_model(sur, segs, n_grid, curvature=True)
+        self.fixed = fixed  # curvatures imposed on the first / last arc (None: free)
+        self.s, self.theta, self.L = s, theta, float(s[-1])
+        # every prefix integral is the exact integral of the cubic Hermite interpolant of its
+        # integrand (values and derivatives at the grid): knots fall between grid points, and
+        # linear interpolation there would cost O(h²·κ) -- of the order of tol at fine tolerances
+        tng = np.stack([np.cos(theta), np.sin(theta)], axis=-1)
+        nrm = np.stack([-np.sin(theta), np.cos(theta)], axis=-1)
+        dn = -kappa[:, None] * tng                                       # d n / ds
+        dth = (theta[0] - theta)[:, None]
+        self.nrm = nrm
+        self.n_fp = (nrm, dn)
+        self.m_fp = (s[:, None] * nrm, nrm + s[:, None] * dn)
+        self.N = _cumhermite(nrm, dn, s)                                 # ∫ n ds
+        self.Dt = _cumhermite(dth * nrm, -kappa[:, None] * nrm + dth * dn, s)
+        self.b = dot(self.Dt, nrm)
+        self.M = _cumhermite(*self.m_fp, s)                              # ∫ s·n ds
+        self.nN, self.nM = dot(nrm, self.N), dot(nrm, self.M)
+        self._nm = (np.hstack([self.N, self.M]), np.hstack([nrm, self.m_fp[0]]), np.hstack([dn, self.m_fp[1]]))
+        self._last_key: bytes | None = None
+        self._last_nm: tuple[np.ndarray, np.ndarray] = (np.empty((0, 2)), np.empty((0, 2)))
+
+    def NM_at(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(N(x), M(x))`` between grid points (the last query is cached)."""
+        key = x.tobytes()
+        if self._last_key != key:
+            v = _hermite_at(x, self.s, *self._nm)
+            self._last_key, self._last_nm = key, (v[:, :2], v[:, 2:])
+        return self._last_nm
+
+    def system(self, knots: np.ndarray):
+        """``(A, C, d)`` of the knots: ``e = A k + b`` on the grid, ``C k = d`` closes the span."""
+        ell = np.diff(knots)
+        s, nrm = self.s, self.nrm
+        # V_j(s) = ∫ clip(s' - x_j, 0, ℓ_j)·n ds' from the prefix integrals N = ∫ n, M = ∫ s'·n:
+        # after arc j (s > x_{j+1}) n·V_j = n·W_j + ℓ_j·n·N(s), W_j = [M - x·N] from x_j to x_{j+1};
+        # inside it n·V_j = n·M(s) - x_j·n·N(s) - n·(M(x_j) - x_j·N(x_j)); before it 0
+        Nx, Mx = self.NM_at(knots)
+        G = Mx - knots[:, None] * Nx                                        # (m + 1, 2)
+        m = ell.size
+        A = nrm @ (G[1:] - G[:-1]).T + self.nN[:, None] * ell[None, :]
+        jj = np.clip(np.searchsorted(knots, s, side="right") - 1, 0, m - 1)
+        A[np.arange(m)[None, :] >= jj[:, None]] = 0.0
+        A[np.arange(s.size), jj] = self.nM - knots[jj] * self.nN - dot(nrm, G[jj])
+        Dk_end = (Mx[1:] - Mx[:-1]) - knots[:-1, None] * (Nx[1:] - Nx[:-1]) + ell[:, None] * (self.N[-1] - Nx[1:])
+        scale = self.L / ell.size
+        C = np.vstack([ell * scale, Dk_end.T])
+        d = np.concatenate([[(self.theta[-1] - self.theta[0]) * scale], -self.Dt[-1]])
+        rows, vals = self._fixed_rows(m)
+        if rows.shape[0]:
+            C, d = np.vstack([C, rows]), np.concatenate([d, vals])
+        return A, C, d
+
+    def _fixed_rows(self, m: int):
+        rows, vals = [], []
+        for j, kf in ((0, self.fixed[0]), (m - 1, self.fixed[1])):
+            if kf is not None:
+                r = np.zeros(m)
+                r[j] = self.L
+                rows.append(r)
+                vals.append(kf * self.L)
+        return np.array(rows).reshape(-1, m), np.array(vals)
+
+    def knot_jacobian(self, knots: np.ndarray, k: np.ndarray):
+        """Derivatives of ``e`` (grid) and of ``C k - d`` with respect to the interior knots.
+
+        Moving knot ``x_j`` by ``δ`` turns every later tangent by ``(k_{j-1} - k_j)·δ``.
+        """
+        xi = knots[1:-1]
+        Nx = self.NM_at(knots)[0][1:-1]
+        jump = k[:-1] - k[1:]
+        B = (self.nN[:, None] - self.nrm @ Nx.T) * jump
+        B[self.s[:, None] <= xi[None, :]] = 0.0
+        Bc = np.vstack([jump * (self.L / k.size), ((self.N[-1][None] - Nx) * jump[:, None]).T])
+        n_fixed = self._fixed_rows(k.size)[0].shape[0]
+        if n_fixed:
+            Bc = np.vstack([Bc, np.zeros((n_fixed, xi.size))])
+        return B, Bc
+
+
+def _local_extrema(e: np.ndarray) -> np.ndarray:
+    """Grid indices where ``|e|`` has a local maximum."""
+    ae = np.abs(e)
+    left = np.concatenate([[-np.inf], ae[:-1]])
+    right = np.concatenate([ae[1:], [-np.inf]])
+    return np.flatnonzero((ae >= left) & (ae >= right) & (ae > 0))
+
+
+def equioscillate(model: SpanModel, knots: np.ndarray, iters: int = _EQUI_ITERS):
+    """Jointly optimise knots and curvatures of a clamped span: ``(max |e|, knots, k)``.
+
+    Starts from the (approximate) minimax curvatures of the given knots, then
+    Gauss-Newton steps on knots and curvatures together drive every local
+    extremum of the deviation to one common level (a Remez-like exchange: the
+    extrema are re-located after every step), the knot moves damped
+    (Levenberg) and each step accepted only if the largest deviation drops.
+    """
+    A, C, d = model.system(knots)
+    k, e = _lawson(A, model.b, C, d, iters=4)
+    best = (float(np.abs(e).max()), knots, k, e)
+    m = k.size
+    if m < 3:
+        return _peak(e), knots, k
+    lam = 1e-2
+    hmean = model.L / m
+    for _ in range(iters):
+        emax, knots, k, e = best
+        p = _local_extrema(e)
+        B, Bc = model.knot_jacobian(knots, k)
+        J = np.hstack([A[p], B[p], -np.sign(e[p])[:, None]])
+        Cj = np.hstack([C, Bc, np.zeros((C.shape[0], 1))])
+        wc = 1e3 / max(float(np.abs(Cj).max()), 1e-300)
+        damp = np.zeros((m - 1, 2 * m))
+        damp[:, m:2 * m - 1] = np.eye(m - 1) * (lam * emax / hmean)
+        y, *_ = np.linalg.lstsq(np.vstack([J, wc * Cj, damp]),
+                                np.concatenate([-e[p], wc * (d - C @ k), np.zeros(m - 1)]), rcond=None)
+        dk, dx = y[:m], y[m:2 * m - 1]
+        improved = False
+        for alpha in (1.0, 0.5, 0.25):
+            xn = knots.copy()
+            xn[1:-1] += alpha * dx
+            if not np.all(np.diff(xn) >= 0.3 * np.diff(knots)):
+                continue
+            A2, C2, d2 = model.system(xn)
+            k2 = k + alpha * dk
+            try:  # restore the closure exactly (least-norm change of the curvatures)
+                k2 = k2 + C2.T @ np.linalg.solve(C2 @ C2.T, d2 - C2 @ k2)
+            except np.linalg.LinAlgError:
+                continue
+            e2 = A2 @ k2 + model.b
+            emax2 = float(np.abs(e2).max())
+            if emax2 < best[0]:
+                best = (emax2, xn, k2, e2)
+                A, C, d = A2, C2, d2
+                improved = True
+                break
+        if not improved:
+            lam *= 4.0
+            if lam > 10.0:
+                break
+        elif emax - best[0] < 1e-3 * emax:
+            break
+    return _peak(best[3]), best[1], best[2]
+
+
+def _peak(e: np.ndarray) -> float:
+    """Largest ``|e|`` with every interior local extremum refined by a parabola through its neighbours."""
+    ae = np.abs(e)
+    j = np.clip(_local_extrema(e), 1, e.size - 2)
+    a, b, c = ae[j - 1], ae[j], ae[j + 1]
+    curv = a - 2 * b + c
+    lift = np.where(curv < 0, -(c - a) ** 2 / (8 * np.where(curv < 0, curv, -1.0)), 0.0)
+    return float(max(ae.max(), (b + np.minimum(lift, b)).max() if j.size else 0.0))

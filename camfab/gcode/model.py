@@ -1,0 +1,304 @@
+"""The common toolpath model: program items (moves, comments, tool, spindle, coolant, compensation),
+the milling :class:`Job` and the :class:`Program` a post-processor writes.
+
+All coordinates, lengths and feeds are millimetres (feeds mm/min), whatever units the program is
+finally written in: the post-processor converts (``Job.units``).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from camfab.errors import Problem, SpecError
+from camfab.tolerances import MAX_EXPORT_TOL_MM, MIN_EXPORT_TOL_MM
+
+__all__ = ["Rapid", "Feed", "Arc", "Comment", "ToolChange", "Spindle", "Coolant", "CutterComp", "Item", "Job",
+           "Program"]
+
+
+@dataclass(frozen=True)
+class Rapid:
+    """Rapid move (G0) to absolute ``(x, y, z)`` in mm; ``None`` leaves an axis where it is."""
+
+    x: float | None
+    y: float | None
+    z: float | None
+
+    def __post_init__(self):
+        for k in ("x", "y", "z"):
+            v = getattr(self, k)
+            object.__setattr__(self, k, None if v is None else float(v))
+
+
+@dataclass(frozen=True)
+class Feed:
+    """Straight cutting move (G1) to ``(x, y, z)`` mm at ``feed`` mm/min."""
+
+    x: float
+    y: float
+    z: float
+    feed: float
+
+    def __post_init__(self):
+        for k in ("x", "y", "z", "feed"):
+            object.__setattr__(self, k, float(getattr(self, k)))
+
+
+@dataclass(frozen=True)
+class Arc:
+    """Circular cutting move (G2 clockwise / G3) in the XY plane.
+
+    The arc starts where the previous move ended and ends at ``(x, y)``; ``(cx, cy)`` is the absolute
+    centre in mm, ``z`` the end height (equal to the start height except for helices) and ``feed`` mm/min.
+    """
+
+    x: float
+    y: float
+    cx: float
+    cy: float
+    clockwise: bool
+    z: float
+    feed: float
+
+    def __post_init__(self):
+        for k in ("x", "y", "cx", "cy", "z", "feed"):
+            object.__setattr__(self, k, float(getattr(self, k)))
+        object.__setattr__(self, "clockwise", bool(self.clockwise))
+
+
+@dataclass(frozen=True)
+class Comment:
+    """A comment line; the post sanitises it for its controller."""
+
+    text: str
+
+
+@dataclass(frozen=True)
+class ToolChange:
+    """Load tool ``tool`` (diameter in mm); posts without a tool changer write a comment."""
+
+    tool: int
+    diameter_mm: float
+
+
+@dataclass(frozen=True)
+class Spindle:
+    """Spindle on at ``rpm`` (clockwise, M3), or off (M5) when ``rpm == 0``."""
+
+    rpm: float
+
+
+@dataclass(frozen=True)
+class Coolant:
+    """Coolant ``"flood"`` (M8), ``"mist"`` (M7) or ``"off"`` (M9)."""
+
+    mode: str
+
+
+@dataclass(frozen=True)
+class CutterComp:
+    """Cutter radius compensation ``"G41"``, ``"G42"`` (with D ``register``) or ``"G40"`` (off).
+
+    Posts put it on the next motion block, which must be a straight line.
+    """
+
+    mode: str
+    register: int = 0
+
+
+Item = Rapid | Feed | Arc | Comment | ToolChange | Spindle | Coolant | CutterComp
+
+_DIRECTIONS = ("climb", "conventional")
+_COOLANTS = ("flood", "mist", "off")
+_UNITS = ("mm", "inch")
+
+
+@dataclass(frozen=True)
+class Job:
+    """Everything a milling program needs besides the contour.  Lengths mm, feeds mm/min.
+
+    Parameters
+    ----------
+    tool_diameter_mm : float
+        Flat end mill diameter.
+    depth_mm : float
+        Plate thickness: the final cutting depth below the stock top (``Z = -depth_mm``).
+    tool_number : int
+        T word and length-offset register H (and D register for G41/G42).
+    spindle_rpm : float
+        Spindle speed (M3, clockwise).
+    feed_mm_min, plunge_feed_mm_min : float
+        Cutting feed and the vertical plunge feed.
+    step_down_mm : float
+        Largest depth per level; levels are equal, ``ceil(depth / step_down)`` of them.
+    safe_z_mm : float
+        Safe height: every horizontal rapid runs at this Z.
+    clearance_mm : float
+        Height above the stock top where the rapid descent stops and the plunge feed begins.
+    roughing_allowance_mm : float
+        Radial stock left by the roughing passes for the finishing pass.
+    roughing_passes : int
+        Number of roughing passes per level (0 = finishing pass only, cut in step-downs).
+    roughing_stepover_mm : float or None
+        Radial distance between roughing passes; default half the tool diameter.
+    direction : {"climb", "conventional"}
+        Milling direction (with M3: climb = clockwise around the part).
+    coolant : {"flood", "mist", "off"}
+    units : {"mm", "inch"}
+        Units of the written program (G21 / G20).  The model itself is always mm.
+    tolerance_mm : float
+        Discretisation tolerance the contour was built to (stated in the header, sets the output
+        resolution).
+    design_name : str
+    achieved_deviation_mm : float or None
+        Worst deviation of the contour from the exact curve, as reported by the offset module.
+    lead_radius_mm : float or None
+        Radius of the tangent lead-in/lead-out arcs; default the tool diameter.
+    finish_full_depth : bool
+        With roughing passes, cut the finishing pass at full depth in one level (default) instead of in
+        step-downs.
+    """
+
+    tool_diameter_mm: float
+    depth_mm: float
+    tool_number: int = 1
+    spindle_rpm: float = 3000.0
+    feed_mm_min: float = 600.0
+    plunge_feed_mm_min: float = 200.0
+    step_down_mm: float = 3.0
+    safe_z_mm: float = 25.0
+    clearance_mm: float = 2.0
+    roughing_allowance_mm: float = 0.2
+    roughing_passes: int = 1
+    roughing_stepover_mm: float | None = None
+    direction: str = "climb"
+    coolant: str = "flood"
+    units: str = "mm"
+    tolerance_mm: float = 0.001
+    design_name: str = "cam"
+    achieved_deviation_mm: float | None = None
+    lead_radius_mm: float | None = None
+    finish_full_depth: bool = True
+
+    def __post_init__(self):
+        problems = self._problems()
+        if problems:
+            raise SpecError(problems, source="job")
+
+    def _problems(self) -> list[Problem]:
+        P: list[Problem] = []
+
+        def num(name, positive=True, allow_none=False):
+            v = getattr(self, name)
+            if v is None and allow_none:
+                return None
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                P.append(Problem(f"job.{name}", v, "must be a finite number", "give a number in mm"))
+                return None
+            if positive and v <= 0:
+                P.append(Problem(f"job.{name}", v, "must be > 0", "give a positive value"))
+                return None
+            return float(v)
+
+        def integer(name, minimum):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, int) or v < minimum:
+                P.append(Problem(f"job.{name}", v, f"must be an integer >= {minimum}",
+                                 f"give a whole number >= {minimum}"))
+
+        D = num("tool_diameter_mm")
+        num("depth_mm")
+        integer("tool_number", 1)
+        if isinstance(self.tool_number, int) and self.tool_number > 99:
+            P.append(Problem("job.tool_number", self.tool_number, "must be <= 99", "use a tool pocket 1..99"))
+        num("spindle_rpm")
+        num("feed_mm_min")
+        num("plunge_feed_mm_min")
+        num("step_down_mm")
+        safe = num("safe_z_mm")
+        clear = num("clearance_mm")
+        if safe is not None and clear is not None and clear >= safe:
+            P.append(Problem("job.clearance_mm", self.clearance_mm,
+                             f"must be below the safe height ({self.safe_z_mm} mm)",
+                             "raise safe_z_mm or lower clearance_mm"))
+        allow = num("roughing_allowance_mm", positive=False)
+        if allow is not None and allow < 0:
+            P.append(Problem("job.roughing_allowance_mm", allow, "must be >= 0", "give 0 or more"))
+        integer("roughing_passes", 0)
+        if (isinstance(self.roughing_passes, int) and not isinstance(self.roughing_passes, bool)
+                and self.roughing_passes > 0 and allow is not None and allow <= 0):
+            P.append(Problem("job.roughing_allowance_mm", self.roughing_allowance_mm,
+                             "must be > 0 when there are roughing passes",
+                             "leave a finishing allowance (e.g. 0.2 mm) or set roughing_passes = 0"))
+        num("roughing_stepover_mm", allow_none=True)
+        if D is not None and self.roughing_stepover_mm is not None and isinstance(
+                self.roughing_stepover_mm, (int, float)) and self.roughing_stepover_mm > D:
+            P.append(Problem("job.roughing_stepover_mm", self.roughing_stepover_mm,
+                             f"must not exceed the tool diameter ({D} mm)", "use at most the tool diameter"))
+        if self.direction not in _DIRECTIONS:
+            P.append(Problem("job.direction", self.direction, f"must be one of {', '.join(_DIRECTIONS)}",
+                             "climb is the usual choice"))
+        if self.coolant not in _COOLANTS:
+            P.append(Problem("job.coolant", self.coolant, f"must be one of {', '.join(_COOLANTS)}", ""))
+        if self.units not in _UNITS:
+            P.append(Problem("job.units", self.units, f"must be one of {', '.join(_UNITS)}", ""))
+        tol = num("tolerance_mm")
+        if tol is not None and not (MIN_EXPORT_TOL_MM <= tol <= MAX_EXPORT_TOL_MM):
+            P.append(Problem("job.tolerance_mm", tol,
+                             f"must lie in [{MIN_EXPORT_TOL_MM:g}, {MAX_EXPORT_TOL_MM:g}] mm", ""))
+        if not isinstance(self.design_name, str) or not self.design_name.strip():
+            P.append(Problem("job.design_name", self.design_name, "must be a non-empty string", ""))
+        dev = num("achieved_deviation_mm", positive=False, allow_none=True)
+        if dev is not None and dev < 0:
+            P.append(Problem("job.achieved_deviation_mm", dev, "must be >= 0", ""))
+        num("lead_radius_mm", allow_none=True)
+        if not isinstance(self.finish_full_depth, bool):
+            P.append(Problem("job.finish_full_depth", self.finish_full_depth, "must be true or false", ""))
+        return P
+
+    @property
+    def tool_radius_mm(self) -> float:
+        """Half the tool diameter."""
+        return 0.5 * self.tool_diameter_mm
+
+    @property
+    def lead_radius(self) -> float:
+        """Lead-in/out arc radius in mm (``lead_radius_mm`` or the tool diameter)."""
+        return float(self.lead_radius_mm) if self.lead_radius_mm is not None else float(self.tool_diameter_mm)
+
+    @property
+    def stepover(self) -> float:
+        """Radial step between roughing passes in mm."""
+        if self.roughing_stepover_mm is not None:
+            return float(self.roughing_stepover_mm)
+        return 0.5 * self.tool_diameter_mm
+
+    @property
+    def levels(self) -> tuple[float, ...]:
+        """Z of each depth level, top down, equal steps no larger than ``step_down_mm``."""
+        n = max(1, math.ceil(self.depth_mm / self.step_down_mm - 1e-9))
+        return tuple(-self.depth_mm * k / n for k in range(1, n + 1))
+
+
+@dataclass(frozen=True)
+class Program:
+    """A complete milling program in the common model, ready for a post-processor.
+
+    Attributes
+    ----------
+    job : Job
+    items : tuple of Item
+        The blocks in order (mm, absolute).
+    compensation : {None, "G41", "G42"}
+        ``None``: coordinates are tool-centre; otherwise the part contour with cutter compensation.
+    contour : tuple of Segment
+        The finishing contour as traversed (tool-centre path, or the part profile when compensated).
+    roughing : tuple of tuple of Segment
+        The roughing contours, outermost first.
+    """
+
+    job: Job
+    items: tuple
+    compensation: str | None = None
+    contour: tuple = ()
+    roughing: tuple = field(default=())
