@@ -1,26 +1,37 @@
 """camfab: cam mechanisms from design data to exact profiles, checks and shop-ready files.
 
-Public names are re-exported here; import submodules only for what this façade
-does not offer.  Heavy optional dependencies (cadquery) are never imported by
-``import camfab``.
+The public API, in the style of ezdxf and trimesh: :func:`load` a design (a file or a built-in example's
+name) into a :class:`Cam`, then ask it for what you need — its check report, its exact profile at any
+angle, its files::
+
+    >>> import camfab
+    >>> cam = camfab.load("ejemplo9rt")
+    >>> cam.check().verdict
+    <Verdict.NOT_FOR_HIGH_SPEED: 'not_for_high_speed'>
+    >>> "ejemplo9rt" in camfab.examples()
+    True
+
+Import submodules only for what this façade does not offer.  ``import camfab`` stays light: the pipeline
+(and with it the exporters) is imported on first use of :func:`load`, :class:`Cam` or :func:`examples`, and
+heavy optional dependencies (cadquery, matplotlib) only by the artifacts that need them.
 """
 from __future__ import annotations
 
-__version__ = "0.1.0"
+from typing import TYPE_CHECKING, Any
 
+from .design import LAWS, DesignSpec, MotionProgram, analyse_motion, build_program, design_from_dict
 from .errors import CamfabError, ExportError, GeometryError, MissingDependencyError, Problem, SpecError
-from .design import (
-    LAWS,
-    DesignSpec,
-    MotionProgram,
-    analyse_motion,
-    build_program,
-    design_from_dict,
-)
 from .formats import load_design
+from .version import __version__
+
+if TYPE_CHECKING:
+    from .pipeline import Cam, examples, load
 
 __all__ = [
     "__version__",
+    "load",
+    "examples",
+    "Cam",
     "CamfabError",
     "SpecError",
     "GeometryError",
@@ -35,3 +46,14 @@ __all__ = [
     "design_from_dict",
     "analyse_motion",
 ]
+
+_LAZY = ("load", "examples", "Cam")
+
+
+def __getattr__(name: str) -> Any:
+    """:func:`load`, :func:`examples` and :class:`Cam` come from :mod:`camfab.pipeline`, imported on first use."""
+    if name in _LAZY:
+        from . import pipeline
+
+        return getattr(pipeline, name)
+    raise AttributeError(f"module 'camfab' has no attribute {name!r}")

@@ -1,7 +1,7 @@
 """Drawing packages: many designs in parallel, a manifest, an index, incremental rebuilds.
 
 ``package(paths, out)`` finds the designs (``*.toml`` and ``*.xlsx`` files, folders
-searched recursively), runs each design's job (:mod:`camfab.jobs`) in its own
+searched recursively), runs each design through :mod:`camfab.pipeline` in its own
 folder ``out/<name>/`` on a process pool, and writes ``out/manifest.json`` (each
 file's sha256 and size, measured deviation, tolerance, verdict, stage timings)
 and ``out/index.html``.
@@ -25,12 +25,12 @@ from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-from . import __version__
 from .design.spec import DesignSpec
 from .formats import load_design
 from .io import atomic_write
-from .jobs import JobRequest
+from .pipeline import Cam, Request, run
 from .results import Verdict
+from .version import __version__
 
 __all__ = ["discover", "input_key", "package", "exit_status", "MANIFEST", "INDEX"]
 
@@ -106,9 +106,8 @@ def _read(path: Path) -> tuple[DesignSpec | None, tuple[str | Path, ...]]:
 
 def _build(args: tuple) -> dict:
     """Worker: build one design into its folder; never raises (errors go into the entry)."""
-    path, out, overrides, key, spec = args
+    path, out, options, key, spec = args
     from .errors import CamfabError
-    from .jobs import request_from_outputs, run_design
 
     t0 = time.perf_counter()
     entry = {"source": str(path), "key": key, "rebuilt": True}
@@ -116,8 +115,10 @@ def _build(args: tuple) -> dict:
         spec = spec if spec is not None else load_design(Path(path))
         entry["name"] = spec.name
         folder = Path(out) / _folder_name(spec.name)
-        req = request_from_outputs(spec, **overrides)
-        res = run_design(spec, folder, req)
+        outputs = options.get("outputs")
+        req = Request.from_design(spec, outputs, force=options.get("force") or None,
+                                  post="linuxcnc" if outputs is not None else None)
+        res = run(Cam(spec), folder, req)
         entry.update(status="unacceptable" if res.verdict == Verdict.UNACCEPTABLE else "ok", verdict=str(res.verdict),
                      tolerance_mm=res.tol, withheld=res.withheld, timings=res.timings,
                      folder=str(folder.relative_to(out)),
@@ -155,17 +156,20 @@ def _still_valid(entry: dict, out: Path) -> bool:
     return True
 
 
-def package(paths: Iterable[str | Path], out: str | Path, *, jobs: int = 1, overrides: dict | None = None,
-            progress: Callable[[str], None] | None = None) -> dict:
-    """Build every design; returns the manifest (also written to ``out/manifest.json``)."""
+def package(paths: Iterable[str | Path], out: str | Path, *, jobs: int = 1, outputs: Sequence[str] | None = None,
+            force: bool = False, progress: Callable[[str], None] | None = None) -> dict:
+    """Build every design; returns the manifest (also written to ``out/manifest.json``).
+
+    ``outputs`` replaces every design's ``[outputs]`` (None: each design's own); ``force`` writes the shop
+    outputs of unacceptable designs too."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     say = progress or (lambda m: None)
-    overrides = overrides or {}
+    options = {"outputs": sorted(outputs) if outputs is not None else None, "force": force}
     designs = discover(paths)
     old = _old_entries(out)
     templates = _templates_hash()
-    opts = JobRequest(**{k: v for k, v in overrides.items()}).key() if overrides else {}
+    opts = options if (outputs is not None or force) else {}
     todo, entries = [], {}
     for p in designs:
         spec, sources = _read(p)
@@ -175,7 +179,7 @@ def package(paths: Iterable[str | Path], out: str | Path, *, jobs: int = 1, over
             entries[str(p)] = {**prev, "rebuilt": False}
             say(f"[up to date] {prev.get('name', p.stem)}")
         else:
-            todo.append((str(p), str(out), overrides, key, spec))
+            todo.append((str(p), str(out), options, key, spec))
     if jobs > 1 and len(todo) > 1:  # worker processes read their design again (a program does not pickle)
         todo = [(*t[:4], None) for t in todo]
     t0 = time.perf_counter()

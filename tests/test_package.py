@@ -142,16 +142,16 @@ def test_package_examples_library(tmp_path):
 
 
 def test_internal_error_on_one_design_does_not_lose_the_others(designs, tmp_path, monkeypatch):
-    import camfab.jobs
+    import camfab.package
 
-    real = camfab.jobs.run_design
+    real = camfab.package.run
 
-    def flaky(spec, *a, **k):
-        if spec.name == "Ejemplo1RT":
+    def flaky(cam, *a, **k):
+        if cam.name == "Ejemplo1RT":
             raise RuntimeError("simulated bug")
-        return real(spec, *a, **k)
+        return real(cam, *a, **k)
 
-    monkeypatch.setattr(camfab.jobs, "run_design", flaky)
+    monkeypatch.setattr(camfab.package, "run", flaky)
     out = tmp_path / "out"
     assert main(["package", str(designs), "-o", str(out), "--outputs", "dxf", "--jobs", "1"]) == 2
     cams = {c["name"]: c for c in _manifest(out)["cams"]}

@@ -189,7 +189,7 @@ def _fmt(v: float, dec: int = 3) -> str:
 
 def title_fields(spec, report, layout: SheetLayout) -> dict[str, str]:
     """The values written into the title block, keyed by template field."""
-    from .. import __version__
+    from ..version import __version__
 
     return {"name": spec.name, "material": spec.manufacturing.material or "to be specified",
             "scale": layout.scale_label, "units": "mm", "tolerance": f"±{spec.manufacturing.tolerance_mm:g} mm",

@@ -88,7 +88,8 @@ def _suffix(i: int, n: int) -> str:
 
 
 def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_flavour: str = "lwpolyline",
-                    tool_paths: bool = False, progress: Callable[[str], None] | None = None) -> list[Artifact]:
+                    tool_paths: bool = False, progress: Callable[[str], None] | None = None,
+                    shapes: CamShapes | None = None) -> list[Artifact]:
     """Build the requested artifacts in memory.
 
     Parameters
@@ -100,11 +101,14 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
         Maximum distance (mm) between every written entity and the exact profile.
     tool_paths : bool
         Add the tool-centre paths (``[manufacturing] tool_diameter_mm``) on the DXF's TOOL_PATH layer.
+    shapes : CamShapes, optional
+        The arc fits within ``tol`` when the caller has them already (with the pitch curves for a DXF).
     """
     say = progress or (lambda msg: None)
     formats = [f for f in FORMATS if f in set(formats)]
-    say(f"fitting arcs within {tol:g} mm")
-    shapes = cam_shapes(geometry, tol=tol, with_pitch="dxf" in formats)
+    if shapes is None:
+        say(f"fitting arcs within {tol:g} mm")
+        shapes = cam_shapes(geometry, tol=tol, with_pitch="dxf" in formats)
     plate = _plate(spec)
     out: list[Artifact] = []
     n = len(shapes.profiles)

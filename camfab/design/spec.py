@@ -17,13 +17,14 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..errors import Problem, SpecError
-from ..tolerances import DEFAULT_EXPORT_TOL_MM, MAX_EXPORT_TOL_MM, MIN_EXPORT_TOL_MM
 from ..units import DEG, RPM
 from .kinds import CamKind, Direction, FollowerMotion, FollowerType, LiftUnit, Rotation
 from .knots import KnotFile, KnotTable, build_knot_table
 from .laws import law_names
 from .mechanisms import MECHANISMS, mechanism_class
 from .program import TWO_PI, MotionProgram, SegmentInput, build_program
+from .shop import (POSTS, MachiningSpec, ManufacturingSpec, OutputsSpec, machining_section, manufacturing_section,
+                   outputs_section)
 from .validator import Validator
 
 __all__ = [
@@ -31,6 +32,7 @@ __all__ = [
     "FollowerSpec",
     "SegmentSpec",
     "ManufacturingSpec",
+    "MachiningSpec",
     "OutputsSpec",
     "DynamicsSpec",
     "DesignSpec",
@@ -39,9 +41,8 @@ __all__ = [
     "POSTS",
 ]
 
-POSTS = ("linuxcnc", "fanuc", "grbl")
 
-_TOP_KEYS = ("name", "description", "cam", "follower", "motion", "motion_table", "manufacturing",
+_TOP_KEYS = ("name", "description", "cam", "follower", "motion", "motion_table", "manufacturing", "machining",
              "outputs", "checks", "dynamics")
 _CAM_KEYS = ("kind", "rotation", "direction", "speed_rpm", "omega_rad_s", "speed_mm_s")
 _FOLLOWER_FLOATS = ("base_radius_mm", "roller_radius_mm", "offset_mm", "pivot_distance_mm",
@@ -54,9 +55,6 @@ _POSITIVE = ("base_radius_mm", "arm_length_mm", "cam_length_mm", "follower_dista
              "face_radius_mm")
 _NON_NEGATIVE = ("roller_radius_mm", "pivot_distance_mm", "second_roller_radius_mm", "base_height_mm")
 _SEGMENT_KEYS = ("law", "lift", "angle_deg", "length_mm", "shape")
-_MFG_KEYS = ("thickness_mm", "bore_mm", "keyway", "hub_diameter_mm", "hub_length_mm",
-             "tool_diameter_mm", "tolerance_mm", "material")
-_OUTPUT_KEYS = ("dxf", "step", "stl", "gcode", "report", "xlsx", "drawing", "lift_table")
 _CHECK_KEYS = ("pressure_angle_limit_deg", "face_margin_mm")
 #: [dynamics] keys by follower motion (the units are in the names) and for both
 _DYN_TRANSLATING = ("mass_kg", "spring_rate_n_per_mm", "spring_preload_n", "damping_n_s_per_m", "external_force_n")
@@ -121,34 +119,6 @@ class SegmentSpec:
 
 
 @dataclass(frozen=True, slots=True)
-class ManufacturingSpec:
-    """``[manufacturing]``: stock and tool (mm)."""
-
-    thickness_mm: float = 10.0
-    bore_mm: float = 0.0
-    keyway: bool = False
-    hub_diameter_mm: float | None = None
-    hub_length_mm: float | None = None
-    tool_diameter_mm: float | None = None
-    tolerance_mm: float = DEFAULT_EXPORT_TOL_MM
-    material: str = ""
-
-
-@dataclass(frozen=True, slots=True)
-class OutputsSpec:
-    """``[outputs]``: what ``camfab run`` produces for this design."""
-
-    dxf: bool = True
-    step: bool = False
-    stl: bool = False
-    gcode: str | None = None
-    report: bool = True
-    xlsx: bool = False
-    drawing: bool = False
-    lift_table: bool = False
-
-
-@dataclass(frozen=True, slots=True)
 class DynamicsSpec:
     """``[dynamics]``: the spring-loaded follower's mass, spring, damper and loads.
 
@@ -197,6 +167,7 @@ class DesignSpec:
     source: str | None = None
     face_margin_mm: float = 0.0
     dynamics: DynamicsSpec | None = None
+    machining: MachiningSpec = field(default_factory=MachiningSpec)
 
     @property
     def is_translating_cam(self) -> bool:
@@ -280,8 +251,10 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
     cam = _cam(v, v.table(data, "cam"))
     fol = _follower(v, v.table(data, "follower"), cam)
     motion, table = _motion(v, data, cam)
-    mfg = _manufacturing(v, v.table(data, "manufacturing"), fol, cam.kind == CamKind.TRANSLATING)
-    out = _outputs(v, v.table(data, "outputs"))
+    mfg = manufacturing_section(v, v.table(data, "manufacturing"), fol.base_radius_mm,
+                                cam.kind == CamKind.TRANSLATING)
+    out = outputs_section(v, v.table(data, "outputs"))
+    machining = machining_section(v, v.table(data, "machining"))
     checks = v.table(data, "checks")
     v.keys(checks, _CHECK_KEYS, "checks")
     pa = v.number(checks, "pressure_angle_limit_deg", "checks", None, lo=0.0, hi=90.0, lo_open=True, hi_open=True)
@@ -289,7 +262,7 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
     dyn = _dynamics(v, data, cam, fol)
     return DesignSpec(name.strip(), cam, fol, motion, table, mfg, out, pressure_angle_limit_deg=pa,
                       description=str(data.get("description", "")), source=source, face_margin_mm=margin,
-                      dynamics=dyn)
+                      dynamics=dyn, machining=machining)
 
 
 # ---------------------------------------------------------------------------
@@ -436,36 +409,6 @@ def _segment(v: Validator, r: Mapping[str, Any], p: str, span_key: str) -> Segme
 
 
 # ---------------------------------------------------------------------------
-def _manufacturing(v: Validator, t: Mapping[str, Any], fol: FollowerSpec,
-                   translating: bool = False) -> ManufacturingSpec:
-    v.keys(t, _MFG_KEYS, "manufacturing")
-    m = ManufacturingSpec(
-        thickness_mm=v.number(t, "thickness_mm", "manufacturing", 10.0, lo=0.0, lo_open=True, hi=1e4),
-        bore_mm=v.number(t, "bore_mm", "manufacturing", 0.0, lo=0.0, hi=1e4),
-        keyway=v.boolean(t, "keyway", "manufacturing", False),
-        hub_diameter_mm=v.number(t, "hub_diameter_mm", "manufacturing", None, lo=0.0, lo_open=True, hi=1e4),
-        hub_length_mm=v.number(t, "hub_length_mm", "manufacturing", None, lo=0.0, lo_open=True, hi=1e4),
-        tool_diameter_mm=v.number(t, "tool_diameter_mm", "manufacturing", None, lo=0.0, lo_open=True, hi=1e3),
-        tolerance_mm=v.number(t, "tolerance_mm", "manufacturing", DEFAULT_EXPORT_TOL_MM,
-                              lo=MIN_EXPORT_TOL_MM, hi=MAX_EXPORT_TOL_MM),
-        material=str(t.get("material", "")),
-    )
-    rb = fol.base_radius_mm
-    if rb is not None and m.bore_mm >= 2 * rb:
-        v.add("manufacturing.bore_mm", m.bore_mm,
-              f"the bore does not fit inside the base circle (diameter {2 * rb:g} mm)",
-              "use a smaller bore or a larger base_radius_mm")
-    if translating:
-        for key in ("bore_mm", "hub_diameter_mm", "hub_length_mm"):
-            if getattr(m, key):
-                v.add(f"manufacturing.{key}", getattr(m, key), "a translating cam is a plate that slides; it has "
-                      "no shaft, bore or hub", f"remove {key} (mount the plate with your own holes in CAD)")
-    if m.keyway and m.bore_mm == 0:
-        v.add("manufacturing.keyway", True, "a keyway needs a bore", "set bore_mm or keyway = false")
-    return m
-
-
-# ---------------------------------------------------------------------------
 # [dynamics]: the keys of the follower's motion, form closure, the speed, then the numbers
 def _dynamics(v: Validator, data: Mapping[str, Any], cam: CamSpec, fol: FollowerSpec) -> DynamicsSpec | None:
     if "dynamics" not in data:
@@ -517,24 +460,6 @@ def _dynamics_values(v: Validator, t: Mapping[str, Any], own: tuple[str, ...]) -
             v.number(t, own[4], "dynamics", 0.0, lo=-big, hi=big),
             v.number(t, "friction_coefficient", "dynamics", 0.0, lo=0.0, hi=2.0),
             v.number(t, "safety_force_n", "dynamics", 0.0, lo=0.0, hi=big))
-
-
-def _outputs(v: Validator, t: Mapping[str, Any]) -> OutputsSpec:
-    v.keys(t, _OUTPUT_KEYS, "outputs")
-    gcode = t.get("gcode", False)
-    if gcode is False:
-        post = None
-    elif gcode is True:
-        post = "linuxcnc"
-    elif gcode in POSTS:
-        post = gcode
-    else:
-        v.add("outputs.gcode", gcode, "is not a valid option", "must be false or one of: " + ", ".join(POSTS))
-        post = None
-    defaults = OutputsSpec()
-    flags = {k: v.boolean(t, k, "outputs", getattr(defaults, k))
-             for k in ("dxf", "step", "stl", "report", "xlsx", "drawing", "lift_table")}
-    return OutputsSpec(gcode=post, **flags)
 
 
 # ---------------------------------------------------------------------------

@@ -21,11 +21,13 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from ..errors import MissingDependencyError
 from ..results import DynamicsSummary, IssueCode, Severity
 from ._common import (VERDICT_CLASS, VERDICT_TEXT, _cell, axis_of, conclusions_rows, fmt, fmt_at, key_values,
                       mechanism_text, range_text)
 
-__all__ = ["render_report", "write_files", "template_environment", "report_context", "dynamics_rows", "PLOT_TEXT"]
+__all__ = ["render_report", "write_files", "template_environment", "report_context", "dynamics_rows", "PLOT_TEXT",
+           "require_report_dependencies"]
 
 #: file stem → (title, caption) of every report plot
 PLOT_TEXT = {
@@ -53,6 +55,15 @@ _DYNAMICS_CODES = ((IssueCode.SELF_LOCKING, "Friction wedges the follower: see t
                    (IssueCode.FOLLOWER_JUMP, "The follower leaves the cam (N < 0): see the findings"),
                    (IssueCode.CONTACT_FORCE_BELOW_SAFETY, "Below the safety force {fs:g} N: see the findings"))
 _SEVERITY_ORDER = {Severity.ERROR: 0, Severity.WARNING: 1, Severity.INFO: 2}
+
+
+def require_report_dependencies() -> None:
+    """Raise :class:`~camfab.errors.MissingDependencyError` (exit code 3) without jinja2 or matplotlib."""
+    for mod in ("jinja2", "matplotlib"):
+        try:
+            __import__(mod)
+        except ImportError as exc:
+            raise MissingDependencyError(f"HTML reports need {mod}: pip install {mod}") from exc
 
 
 def _read_asset(name: str) -> str:
@@ -83,7 +94,7 @@ def common_context(source: str | None) -> dict[str, Any]:
     """Keys every page template needs: version, css, source name."""
     from markupsafe import Markup
 
-    from .. import __version__
+    from ..version import __version__
 
     return {"version": __version__, "css": Markup(_read_asset("report.css")),
             "source": Path(source).name if source else None}

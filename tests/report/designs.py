@@ -48,3 +48,11 @@ DESIGNS = {
         name="TooSmall", follower={"type": "roller", "motion": "translating", "base_radius_mm": 12.0,
                                    "roller_radius_mm": 9.0, "offset_mm": 0.0}),
 }
+
+
+def checked_design(spec):
+    """``(spec, geometry, check report)`` of a design, as the report commands build them."""
+    from camfab.pipeline import Cam
+
+    cam = Cam(spec)
+    return spec, cam.geometry, cam.check()

@@ -1,13 +1,12 @@
 """``camfab compare``: overlaid plots and the side-by-side table (CAM-DAS "Pizarra")."""
 from __future__ import annotations
 
-import argparse
 import io
 from html.parser import HTMLParser
 
 import pytest
 
-from camfab.report.commands import cmd_compare, cmd_report
+from camfab.cli import main
 from camfab.report.compare import comparison_rows, design_labels, render_comparison
 
 from ..conftest import EXAMPLES
@@ -108,26 +107,11 @@ def test_duplicate_names_get_numbered(e9):
         render_comparison([])
 
 
-def _args(fn, argv):
-    p = argparse.ArgumentParser()
-    fn.add_arguments(p)
-    return p.parse_args(argv)
-
-
 def test_compare_and_report_commands(tmp_path, capsys):
     out = tmp_path / "cmp"
-    rc = cmd_compare(_args(cmd_compare, [str(EXAMPLES / "ejemplo9rt.toml"), "valve_exhaust_ej1", "-o", str(out)]))
+    rc = main(["compare", str(EXAMPLES / "ejemplo9rt.toml"), "valve_exhaust_ej1", "-o", str(out)])
     assert rc == 0 and (out / "compare.html").is_file() and (out / "plots" / "svaj.svg").is_file()
     assert "Ejemplo9RT: not_for_high_speed" in capsys.readouterr().out
-    rc = cmd_report(_args(cmd_report, ["ejemplo9rt", "-o", str(tmp_path / "rep"), "--standalone"]))
+    rc = main(["report", "ejemplo9rt", "-o", str(tmp_path / "rep"), "--standalone"])
     assert rc == 0 and (tmp_path / "rep" / "report.html").is_file()
     assert b"data:image/svg+xml;base64," in (tmp_path / "rep" / "report.html").read_bytes()
-
-
-def test_cli_entry_point_when_registered(tmp_path):
-    from camfab import cli
-
-    if "compare" not in cli.COMMANDS:
-        pytest.skip("camfab compare is not registered in camfab/cli.py yet (see camfab.report.commands)")
-    rc = cli.main(["compare", "ejemplo9rt", "valve_exhaust_ej1", "-o", str(tmp_path)])
-    assert rc == 0 and (tmp_path / "compare.html").is_file()

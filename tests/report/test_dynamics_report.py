@@ -20,7 +20,7 @@ from camfab.design.spec import design_from_dict
 from camfab.errors import SpecError
 from camfab.formats import design_from_data, design_rows, design_to_xlsx, load_design, load_design_xlsx
 from camfab.report._common import sample_grid
-from camfab.report.commands import checked_design
+from tests.report.designs import checked_design
 from camfab.report.html import render_report
 from camfab.report.xlsx import camdas_workbook
 

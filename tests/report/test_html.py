@@ -17,7 +17,7 @@ import pytest
 from camfab.design.spec import design_from_dict
 from camfab.report._common import VERDICT_TEXT, conclusions_rows
 from camfab.report.animation import animation_data
-from camfab.report.commands import checked_design
+from tests.report.designs import checked_design
 from camfab.report.html import render_report
 
 from ..conftest import base_design

@@ -11,7 +11,7 @@ import pytest
 
 from camfab.design.spec import design_from_dict
 from camfab.report._common import axis_of, finding_spans, sample_grid
-from camfab.report.commands import checked_design
+from tests.report.designs import checked_design
 from camfab.report.plots import figure_bytes, pressure_angle_figure, report_figures, svaj_figure
 
 from .designs import DESIGNS

@@ -1,0 +1,176 @@
+"""The shop sections of a design: ``[manufacturing]`` (stock and tool), ``[machining]`` (how the G-code cuts)
+and ``[outputs]`` (what ``camfab run`` writes) — their values and their validation.
+
+Every reader collects its problems in a :class:`~camfab.design.validator.Validator` (field path, value,
+rule, fix); nothing here raises.  The defaults of ``[machining]`` are the values ``camfab gcode`` used
+before the table existed, so a design without it cuts the same program as before; command-line flags
+override it (``camfab.pipeline.gcode_job``), so ``gcode``, ``run`` and ``package`` cut the same program
+for the same inputs.
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from enum import StrEnum
+from typing import Any
+
+from ..tolerances import DEFAULT_EXPORT_TOL_MM, MAX_EXPORT_TOL_MM, MIN_EXPORT_TOL_MM
+from .validator import Validator
+
+__all__ = ["POSTS", "Post", "ManufacturingSpec", "MachiningSpec", "OutputsSpec", "manufacturing_section",
+           "machining_section", "outputs_section"]
+
+
+class Post(StrEnum):
+    """The controller dialects camfab writes."""
+
+    LINUXCNC = "linuxcnc"
+    FANUC = "fanuc"
+    GRBL = "grbl"
+
+
+POSTS = tuple(p.value for p in Post)
+
+_MFG_KEYS = ("thickness_mm", "bore_mm", "keyway", "hub_diameter_mm", "hub_length_mm",
+             "tool_diameter_mm", "tolerance_mm", "material")
+_OUTPUT_KEYS = ("dxf", "step", "stl", "gcode", "report", "xlsx", "drawing", "lift_table")
+
+
+@dataclass(frozen=True, slots=True)
+class ManufacturingSpec:
+    """``[manufacturing]``: stock and tool (mm)."""
+
+    thickness_mm: float = 10.0
+    bore_mm: float = 0.0
+    keyway: bool = False
+    hub_diameter_mm: float | None = None
+    hub_length_mm: float | None = None
+    tool_diameter_mm: float | None = None
+    tolerance_mm: float = DEFAULT_EXPORT_TOL_MM
+    material: str = ""
+
+
+@dataclass(frozen=True, slots=True)
+class MachiningSpec:
+    """``[machining]``: how the contour-milling program cuts (lengths mm, feeds mm/min, speeds rpm).
+
+    ``compensation`` = ``"G41"`` / ``"G42"`` writes the part contour with the controller's cutter
+    compensation instead of tool-centre coordinates (no roughing passes then); ``lines_only`` writes the
+    finishing contour as G1 lines.
+    """
+
+    tool_number: int = 1
+    spindle_rpm: float = 3000.0
+    feed_mm_min: float = 600.0
+    plunge_feed_mm_min: float = 200.0
+    step_down_mm: float = 3.0
+    safe_z_mm: float = 25.0
+    clearance_mm: float = 2.0
+    roughing_passes: int = 1
+    roughing_allowance_mm: float = 0.2
+    roughing_stepover_mm: float | None = None
+    lead_radius_mm: float | None = None
+    direction: str = "climb"
+    coolant: str = "flood"
+    units: str = "mm"
+    compensation: str | None = None
+    lines_only: bool = False
+
+
+#: [machining] keys: positive numbers (with their upper bounds), then the choices
+_MACHINING_NUMBERS = {"spindle_rpm": 1e6, "feed_mm_min": 1e6, "plunge_feed_mm_min": 1e6, "step_down_mm": 1e3,
+                      "safe_z_mm": 1e4, "clearance_mm": 1e3, "roughing_allowance_mm": 1e2,
+                      "roughing_stepover_mm": 1e3, "lead_radius_mm": 1e3}
+_MACHINING_CHOICES = {"direction": ("climb", "conventional"), "coolant": ("flood", "mist", "off"),
+                      "units": ("mm", "inch"), "compensation": ("G41", "G42")}
+_MACHINING_KEYS = (*_MACHINING_NUMBERS, *_MACHINING_CHOICES, "tool_number", "roughing_passes", "lines_only")
+
+
+@dataclass(frozen=True, slots=True)
+class OutputsSpec:
+    """``[outputs]``: what ``camfab run`` produces for this design."""
+
+    dxf: bool = True
+    step: bool = False
+    stl: bool = False
+    gcode: str | None = None
+    report: bool = True
+    xlsx: bool = False
+    drawing: bool = False
+    lift_table: bool = False
+
+
+def manufacturing_section(v: Validator, t: Mapping[str, Any], base_radius_mm: float | None,
+                          translating: bool = False) -> ManufacturingSpec:
+    """``[manufacturing]``: numbers in range, a bore inside the base circle, no bore on a sliding plate."""
+    v.keys(t, _MFG_KEYS, "manufacturing")
+    m = ManufacturingSpec(
+        thickness_mm=v.number(t, "thickness_mm", "manufacturing", 10.0, lo=0.0, lo_open=True, hi=1e4),
+        bore_mm=v.number(t, "bore_mm", "manufacturing", 0.0, lo=0.0, hi=1e4),
+        keyway=v.boolean(t, "keyway", "manufacturing", False),
+        hub_diameter_mm=v.number(t, "hub_diameter_mm", "manufacturing", None, lo=0.0, lo_open=True, hi=1e4),
+        hub_length_mm=v.number(t, "hub_length_mm", "manufacturing", None, lo=0.0, lo_open=True, hi=1e4),
+        tool_diameter_mm=v.number(t, "tool_diameter_mm", "manufacturing", None, lo=0.0, lo_open=True, hi=1e3),
+        tolerance_mm=v.number(t, "tolerance_mm", "manufacturing", DEFAULT_EXPORT_TOL_MM,
+                              lo=MIN_EXPORT_TOL_MM, hi=MAX_EXPORT_TOL_MM),
+        material=str(t.get("material", "")),
+    )
+    rb = base_radius_mm
+    if rb is not None and m.bore_mm >= 2 * rb:
+        v.add("manufacturing.bore_mm", m.bore_mm,
+              f"the bore does not fit inside the base circle (diameter {2 * rb:g} mm)",
+              "use a smaller bore or a larger base_radius_mm")
+    if translating:
+        for key in ("bore_mm", "hub_diameter_mm", "hub_length_mm"):
+            if getattr(m, key):
+                v.add(f"manufacturing.{key}", getattr(m, key), "a translating cam is a plate that slides; it has "
+                      "no shaft, bore or hub", f"remove {key} (mount the plate with your own holes in CAD)")
+    if m.keyway and m.bore_mm == 0:
+        v.add("manufacturing.keyway", True, "a keyway needs a bore", "set bore_mm or keyway = false")
+    return m
+
+
+def machining_section(v: Validator, t: Mapping[str, Any]) -> MachiningSpec:
+    """``[machining]``: positive feeds, speeds and lengths, whole numbers of tools and passes, the choices."""
+    v.keys(t, _MACHINING_KEYS, "machining")
+    d = MachiningSpec()
+    values: dict[str, Any] = {}
+    for key, hi in _MACHINING_NUMBERS.items():
+        values[key] = v.number(t, key, "machining", getattr(d, key), lo=0.0, lo_open=True, hi=hi)
+    for key, options in _MACHINING_CHOICES.items():
+        val = t.get(key, getattr(d, key))
+        if val is not None and val not in options:
+            v.add(f"machining.{key}", val, "is not a valid option", "must be one of: " + ", ".join(options))
+            val = getattr(d, key)
+        values[key] = val
+    values["tool_number"] = _whole(v, t, "tool_number", d.tool_number, 1, 99999)
+    values["roughing_passes"] = _whole(v, t, "roughing_passes", d.roughing_passes, 0, 100)
+    values["lines_only"] = v.boolean(t, "lines_only", "machining", d.lines_only)
+    return MachiningSpec(**values)
+
+
+def _whole(v: Validator, t: Mapping[str, Any], key: str, default: int, lo: int, hi: int) -> int:
+    val = t.get(key, default)
+    if isinstance(val, bool) or not isinstance(val, int) or not lo <= val <= hi:
+        v.add(f"machining.{key}", val, f"must be a whole number in [{lo}, {hi}]", f"give {key} as an integer")
+        return default
+    return val
+
+
+def outputs_section(v: Validator, t: Mapping[str, Any]) -> OutputsSpec:
+    """``[outputs]``: booleans, and the G-code post (``false``, ``true`` = linuxcnc, or a post's name)."""
+    v.keys(t, _OUTPUT_KEYS, "outputs")
+    gcode = t.get("gcode", False)
+    if gcode is False:
+        post = None
+    elif gcode is True:
+        post = "linuxcnc"
+    elif gcode in POSTS:
+        post = gcode
+    else:
+        v.add("outputs.gcode", gcode, "is not a valid option", "must be false or one of: " + ", ".join(POSTS))
+        post = None
+    defaults = OutputsSpec()
+    flags = {k: v.boolean(t, k, "outputs", getattr(defaults, k))
+             for k in ("dxf", "step", "stl", "report", "xlsx", "drawing", "lift_table")}
+    return OutputsSpec(gcode=post, **flags)

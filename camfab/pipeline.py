@@ -1,0 +1,418 @@
+"""One pipeline: a cam built once, and one stage function per artifact.
+
+A :class:`Cam` holds a validated design and computes each stage on first use and keeps it — the mechanism,
+the exact geometry, the check report, the arc fits per tolerance — so that every command (``check``,
+``export``, ``gcode``, ``report``, ``run``, ``package``) and the Python API build each thing once and agree.
+
+Every artifact is an :class:`Output`; :data:`EXPORTERS` maps each one to a stage function with one signature,
+``stage(cam, request) -> list[Artifact]``, that builds the files in memory.  :func:`run` checks the design,
+withholds the shop outputs of an unacceptable design unless forced, builds what the :class:`Request` asks for
+and writes the files atomically at the end, so a failure leaves nothing half-written.
+
+The G-code job comes from one place, :func:`gcode_job`: the design's ``[machining]`` table, overridden by
+command-line flags.
+"""
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass, field, replace
+from enum import StrEnum
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .cad.export import Artifact, CamShapes, build_artifacts, cam_shapes
+from .design.assemble import check_design, mechanism_from_spec
+from .design.mechanisms import geometry_from_spec
+from .design.profile import CamGeometry, ProfileSample
+from .design.spec import DesignSpec
+from .discretize import validate_tol
+from .errors import GeometryError, Problem, SpecError
+from .formats import EXAMPLES_DIR, load_design, resolve_design_path
+from .io import atomic_write
+from .results import CheckReport, Verdict
+
+__all__ = ["Output", "SHOP_OUTPUTS", "Request", "RunResult", "Cam", "EXPORTERS", "gcode_job", "run", "load",
+           "examples"]
+
+
+class Output(StrEnum):
+    """Every artifact ``camfab run`` can write (the ``[outputs]`` keys)."""
+
+    DXF = "dxf"
+    STEP = "step"
+    STL = "stl"
+    GCODE = "gcode"
+    LIFT_TABLE = "lift_table"
+    XLSX = "xlsx"
+    REPORT = "report"
+    DRAWING = "drawing"
+
+
+#: artifacts withheld for an unacceptable design unless the job is forced (in the order they are named)
+SHOP_OUTPUTS = (Output.DXF, Output.STEP, Output.STL, Output.GCODE, Output.DRAWING, Output.LIFT_TABLE)
+
+
+@dataclass(frozen=True)
+class Request:
+    """What to produce for one design, and how.
+
+    Parameters
+    ----------
+    outputs : frozenset of Output
+    post : str
+        The G-code dialect (``linuxcnc``, ``fanuc``, ``grbl``).
+    tol : float or None
+        Export tolerance (mm); None = the design's ``[manufacturing] tolerance_mm``.
+    force : bool
+        Write the shop outputs even for an unacceptable design.
+    dxf_flavour : str
+        ``lwpolyline`` (bulges), ``r12`` (LINE/ARC) or ``spline``.
+    tool_paths : bool or None
+        Put the tool-centre paths on the DXF's TOOL_PATH layer; None = when G-code is asked for.
+    machining : Mapping
+        ``[machining]`` values given on the command line (None values are not given).
+    """
+
+    outputs: frozenset[Output] = frozenset()
+    post: str = "linuxcnc"
+    tol: float | None = None
+    force: bool = False
+    dxf_flavour: str = "lwpolyline"
+    tool_paths: bool | None = None
+    lift_step_deg: float = 1.0
+    xlsx_step_deg: float = 1.0
+    machining: Mapping[str, Any] = field(default_factory=dict)
+
+    @classmethod
+    def from_design(cls, spec: DesignSpec, outputs: Iterable[str] | None = None, **over: Any) -> Request:
+        """The request a design's ``[outputs]`` table makes (``outputs`` replaces it), with overrides."""
+        o = spec.outputs
+        if outputs is None:
+            chosen = {Output(k) for k in ("dxf", "step", "stl", "lift_table", "xlsx", "report", "drawing")
+                      if getattr(o, k)}
+            if o.gcode:
+                chosen.add(Output.GCODE)
+        else:
+            chosen = {Output(k) for k in outputs}
+        post = over.pop("post", None) or o.gcode or "linuxcnc"
+        return cls(frozenset(chosen), post, **{k: v for k, v in over.items() if v is not None})
+
+    def key(self) -> dict[str, Any]:
+        """The options that change the output (for incremental builds)."""
+        return {"outputs": sorted(self.outputs), "post": self.post, "tol": self.tol, "force": self.force,
+                "dxf_flavour": self.dxf_flavour, "tool_paths": self.tool_paths, "lift_step_deg": self.lift_step_deg,
+                "xlsx_step_deg": self.xlsx_step_deg, "machining": dict(sorted(self.machining.items()))}
+
+
+@dataclass
+class RunResult:
+    """Files written for one design, with the verdict, measured deviations and stage timings."""
+
+    name: str
+    verdict: str
+    files: dict[str, Path] = field(default_factory=dict)
+    deviations: dict[str, float | None] = field(default_factory=dict)
+    timings: dict[str, float] = field(default_factory=dict)
+    withheld: list[str] = field(default_factory=list)
+    tol: float = 0.0
+
+
+# ---------------------------------------------------------------------------
+class Cam:
+    """A cam built from a validated design, each stage computed once on first use.
+
+    >>> import camfab
+    >>> cam = camfab.load("ejemplo9rt")
+    >>> cam.check().verdict
+    <Verdict.NOT_FOR_HIGH_SPEED: 'not_for_high_speed'>
+    >>> round(float(cam.profile([0.0]).point[0, 1]), 6)   # the contact point at 0°, on +Y (mm)
+    35.0
+    """
+
+    def __init__(self, spec: DesignSpec):
+        self.spec = spec
+        self._shapes: dict[float, CamShapes] = {}
+        self._report: CheckReport | None = None
+        self._geometry: CamGeometry | None = None
+
+    def __repr__(self) -> str:
+        return f"<Cam {self.spec.name!r}: {self.spec.cam.kind} cam, {self.spec.follower.motion} " \
+               f"{self.spec.follower.type} follower>"
+
+    @property
+    def name(self) -> str:
+        return self.spec.name
+
+    @property
+    def mechanism(self) -> Any:
+        """The mechanism (cam family) the design describes."""
+        return mechanism_from_spec(self.spec)
+
+    @property
+    def geometry(self) -> CamGeometry:
+        """The exact geometry (built once)."""
+        if self._geometry is None:
+            self._geometry = geometry_from_spec(self.spec)
+        return self._geometry
+
+    @property
+    def tool_radius_mm(self) -> float | None:
+        tool = self.spec.manufacturing.tool_diameter_mm
+        return tool / 2 if tool else None
+
+    def check(self) -> CheckReport:
+        """The ``camfab check`` report: findings and verdict (the design's tool radius, dynamics and knot
+        warnings included); computed once."""
+        if self._report is None:
+            self._report = check_design(self.spec, tool_radius_mm=self.tool_radius_mm)
+        return self._report
+
+    @property
+    def verdict(self) -> Verdict:
+        return self.check().verdict
+
+    def tolerance(self, tol: float | None = None) -> float:
+        """``tol`` or the design's tolerance, validated (mm)."""
+        return validate_tol(self.spec.manufacturing.tolerance_mm if tol is None else tol)
+
+    def shapes(self, tol: float | None = None) -> CamShapes:
+        """Every profile arc-fitted within ``tol`` (and the pitch curves), measured; once per tolerance."""
+        t = self.tolerance(tol)
+        if t not in self._shapes:
+            self._shapes[t] = cam_shapes(self.geometry, tol=t)
+        return self._shapes[t]
+
+    def profile(self, x, *, profile: int = 0) -> ProfileSample:
+        """The exact profile at cam angles ``x`` in degrees (mm of travel for a translating cam), cam frame."""
+        axis = self.geometry.axis
+        return self.geometry.evaluate(axis.from_user(np.asarray(x, dtype=float)), profile)
+
+    # ---- exports -------------------------------------------------------------
+    def to_dxf(self, path: str | Path | None = None, *, tol: float | None = None, flavour: str = "lwpolyline",
+               tool_paths: bool = False) -> Any:
+        """The DXF drawing of the profile(s): an ``ezdxf`` document, or written to ``path`` (returned)."""
+        req = Request(frozenset({Output.DXF}), tol=tol, dxf_flavour=flavour, tool_paths=tool_paths)
+        (art,) = _dxf(self, req)
+        if path is not None:
+            return atomic_write(path, art.data)
+        import io
+
+        import ezdxf
+
+        return ezdxf.read(io.StringIO(art.data.decode("utf-8")))
+
+    def to_stl(self, path: str | Path | None = None, *, tol: float | None = None) -> Any:
+        """The plate as a mesh: a ``trimesh.Trimesh`` (profile 1 of a pair), or written to ``path``."""
+        arts = _stl(self, Request(frozenset({Output.STL}), tol=tol))
+        if path is not None:
+            return atomic_write(path, arts[0].data)
+        import io
+
+        import trimesh
+
+        return trimesh.load(io.BytesIO(arts[0].data), file_type="stl")
+
+    def to_step(self, path: str | Path, *, tol: float | None = None) -> Path:
+        """The plate as a STEP solid, written to ``path`` (needs cadquery)."""
+        arts = _step(self, Request(frozenset({Output.STEP}), tol=tol))
+        return atomic_write(path, arts[0].data)
+
+    def to_gcode(self, post: str | None = None, path: str | Path | None = None, *, tol: float | None = None,
+                 **machining: Any) -> str | Path:
+        """The contour-milling program of profile 1 (``[machining]`` values may be overridden as keywords):
+        its text, or written to ``path``."""
+        req = Request(frozenset({Output.GCODE}), post or self.spec.outputs.gcode or "linuxcnc", tol=tol,
+                      machining=machining)
+        text = _gcode(self, req)[0].data
+        return atomic_write(path, text) if path is not None else text.decode("utf-8")
+
+    def to_shapely(self, *, tol: float | None = None, profile: int = 0) -> Any:
+        """The profile as a ``shapely.Polygon`` (a polyline within ``tol`` of the exact curve)."""
+        from shapely.geometry import Polygon
+
+        from .discretize import polyline
+        from .offset import profile_curve
+
+        line = polyline(profile_curve(self.geometry.profiles[profile]), tol=self.tolerance(tol))
+        return Polygon(line.points)
+
+    def run(self, outdir: str | Path, outputs: Iterable[str] | None = None, *, force: bool = False,
+            tol: float | None = None) -> RunResult:
+        """Everything the design's ``[outputs]`` (or ``outputs``) asks for, written into ``outdir``."""
+        return run(self, outdir, Request.from_design(self.spec, outputs, force=force, tol=tol))
+
+
+def load(design: str | Path) -> Cam:
+    """A :class:`Cam` from a design file (TOML or xlsx) or the name of a built-in example."""
+    return Cam(load_design(resolve_design_path(design)))
+
+
+def examples() -> list[str]:
+    """The names of the built-in example designs (for :func:`load`)."""
+    return sorted(p.stem for p in EXAMPLES_DIR.glob("*.toml"))
+
+
+# ---------------------------------------------------------------------------
+# the G-code job: [machining], overridden by the command line
+def gcode_job(spec: DesignSpec, *, tol: float, overrides: Mapping[str, Any] | None = None) -> Any:
+    """The :class:`camfab.gcode.Job` of a design: ``[manufacturing]`` tool and thickness and ``[machining]``,
+    each value replaced by ``overrides[key]`` when given (not None); ``tool_diameter_mm`` may be
+    overridden too.
+
+    Raises
+    ------
+    SpecError
+        No tool diameter, or a job value out of range.
+    """
+    from .gcode import Job
+
+    over = {k: v for k, v in (overrides or {}).items() if v is not None}
+    m = replace(spec.machining, **{k: v for k, v in over.items() if k != "tool_diameter_mm"})
+    tool = over.get("tool_diameter_mm", spec.manufacturing.tool_diameter_mm)
+    if not tool:
+        raise SpecError(Problem("manufacturing.tool_diameter_mm", None, "G-code needs a tool",
+                                "add tool_diameter_mm to [manufacturing] (or give --tool-diameter)"), spec.source)
+    return Job(tool_diameter_mm=tool, depth_mm=spec.manufacturing.thickness_mm, tool_number=m.tool_number,
+               spindle_rpm=m.spindle_rpm, feed_mm_min=m.feed_mm_min, plunge_feed_mm_min=m.plunge_feed_mm_min,
+               step_down_mm=m.step_down_mm, safe_z_mm=m.safe_z_mm, clearance_mm=m.clearance_mm,
+               roughing_allowance_mm=m.roughing_allowance_mm,
+               roughing_passes=0 if m.compensation else m.roughing_passes,
+               roughing_stepover_mm=m.roughing_stepover_mm, direction=m.direction, coolant=m.coolant,
+               units=m.units, tolerance_mm=tol, design_name=spec.name, lead_radius_mm=m.lead_radius_mm)
+
+
+def machining_of(spec: DesignSpec, overrides: Mapping[str, Any] | None = None) -> Any:
+    """``[machining]`` with the given overrides applied (None values ignored)."""
+    over = {k: v for k, v in (overrides or {}).items() if v is not None and k != "tool_diameter_mm"}
+    return replace(spec.machining, **over)
+
+
+# ---------------------------------------------------------------------------
+# stages: (cam, request) -> artifacts
+Stage = Callable[[Cam, Request], list[Artifact]]
+
+
+def _suffix(i: int, n: int) -> str:
+    return f"_cam{i + 1}" if n > 1 else ""
+
+
+def _tool_paths(cam: Cam, req: Request) -> bool:
+    return bool(req.tool_paths if req.tool_paths is not None else Output.GCODE in req.outputs)
+
+
+def _dxf(cam: Cam, req: Request) -> list[Artifact]:
+    tol = cam.tolerance(req.tol)
+    return build_artifacts(cam.spec, cam.geometry, ["dxf"], tol=tol, dxf_flavour=req.dxf_flavour,
+                           tool_paths=_tool_paths(cam, req), shapes=cam.shapes(tol))
+
+
+def _stl(cam: Cam, req: Request) -> list[Artifact]:
+    tol = cam.tolerance(req.tol)
+    return build_artifacts(cam.spec, cam.geometry, ["stl"], tol=tol, shapes=cam.shapes(tol))
+
+
+def _step(cam: Cam, req: Request) -> list[Artifact]:
+    tol = cam.tolerance(req.tol)
+    return build_artifacts(cam.spec, cam.geometry, ["step"], tol=tol, shapes=cam.shapes(tol))
+
+
+def _gcode(cam: Cam, req: Request) -> list[Artifact]:
+    from .gcode import dumps
+    from .gcode.cam import cam_program
+
+    tol = cam.tolerance(req.tol)
+    job = gcode_job(cam.spec, tol=tol, overrides=req.machining)
+    m = machining_of(cam.spec, req.machining)
+    n = len(cam.geometry.profiles)
+    out = []
+    for i, contact in enumerate(cam.geometry.profiles):
+        cp = cam_program(contact, job, tol=tol, compensation=m.compensation, arcs_allowed=not m.lines_only)
+        out.append(Artifact(f"{cam.name}{_suffix(i, n)}.nc", dumps(cp.program, req.post).encode(), "gcode",
+                            cp.entities, cp.deviation_mm, req.post))
+    return out
+
+
+def _lift_table(cam: Cam, req: Request) -> list[Artifact]:
+    from .gcode import lift_angles, lift_table_csv
+
+    prog = cam.spec.program()
+    if not prog.axis.rotating:
+        raise GeometryError("a polar lift table needs a rotating cam")
+    ang = lift_angles(req.lift_step_deg)
+    text = lift_table_csv(ang, prog(np.radians(ang)), lift_unit=prog.axis.lift_unit)
+    return [Artifact(f"{cam.name}_lift.csv", text.encode(), "lift_table")]
+
+
+def _xlsx(cam: Cam, req: Request) -> list[Artifact]:
+    from .report.xlsx import camdas_workbook
+
+    data = camdas_workbook(cam.spec, cam.geometry, cam.check(), step_deg=req.xlsx_step_deg)
+    return [Artifact(f"{cam.name}.xlsx", data, "xlsx")]
+
+
+def _report(cam: Cam, req: Request) -> list[Artifact]:
+    from .report.html import render_report, require_report_dependencies
+
+    require_report_dependencies()
+    return [Artifact(name, data, "report") for name, data in render_report(cam.spec, cam.geometry,
+                                                                           cam.check()).items()]
+
+
+def _drawing(cam: Cam, req: Request) -> list[Artifact]:
+    from .cad.drawing import drawing_sheet
+
+    shapes = cam.shapes(req.tol)
+    text = drawing_sheet(cam.spec, cam.geometry, cam.check(), shapes)
+    return [Artifact(f"{cam.name}_drawing.dxf", text.encode(), "drawing", None, max(shapes.profile_deviation))]
+
+
+#: every artifact's stage, in the order :func:`run` builds them
+EXPORTERS: dict[Output, Stage] = {
+    Output.DXF: _dxf,
+    Output.STL: _stl,
+    Output.STEP: _step,
+    Output.DRAWING: _drawing,
+    Output.GCODE: _gcode,
+    Output.LIFT_TABLE: _lift_table,
+    Output.XLSX: _xlsx,
+    Output.REPORT: _report,
+}
+
+
+def run(cam: Cam, outdir: str | Path, req: Request, *, progress: Callable[[str], None] | None = None) -> RunResult:
+    """Build what ``req`` asks for and write it into ``outdir`` (``check.json`` always).
+
+    Raises the usual camfab errors (SpecError, GeometryError, MissingDependencyError) before anything is
+    written.
+    """
+    say = progress or (lambda m: None)
+    res = RunResult(cam.name, "", tol=cam.tolerance(req.tol))
+    report = _timed(res, "check", say, cam.check)
+    res.verdict = report.verdict
+    wanted = [o for o in EXPORTERS if o in req.outputs]
+    if report.verdict == Verdict.UNACCEPTABLE and not req.force:
+        res.withheld = [str(o) for o in SHOP_OUTPUTS if o in req.outputs]
+        wanted = [o for o in wanted if o not in SHOP_OUTPUTS]
+    _timed(res, "geometry", say, lambda: cam.geometry)
+    files: dict[str, bytes] = {"check.json": (json.dumps(report.to_dict(), indent=2) + "\n").encode()}
+    for out in wanted:
+        for art in _timed(res, str(out), say, EXPORTERS[out], cam, req):
+            files[art.filename] = art.data
+            if art.kind != "report":
+                res.deviations[art.filename] = art.deviation_mm
+    folder = Path(outdir)
+    for name, data in sorted(files.items()):
+        res.files[name] = atomic_write(folder / name, data)
+    return res
+
+
+def _timed(res: RunResult, stage: str, say: Callable[[str], None], fn: Callable[..., Any], *args: Any) -> Any:
+    say(stage)
+    t = time.perf_counter()
+    out = fn(*args)
+    res.timings[stage] = res.timings.get(stage, 0.0) + time.perf_counter() - t
+    return out
