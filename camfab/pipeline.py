@@ -348,7 +348,7 @@ def _lift_table(cam: Cam, req: Request) -> list[Artifact]:
 
 
 def _xlsx(cam: Cam, req: Request) -> list[Artifact]:
-    from .report.xlsx import camdas_workbook
+    from .formats.camdas_workbook import camdas_workbook
 
     data = camdas_workbook(cam.spec, cam.geometry, cam.check(), step_deg=req.xlsx_step_deg)
     return [Artifact(f"{cam.name}.xlsx", data, "xlsx")]

@@ -417,13 +417,13 @@ def _new_doc(spec, layout: SheetLayout, shapes, tpl):
 
 def build_drawing(spec, geometry, report, shapes, *, paper: str = "auto", lift_step_deg: float = 10.0):
     """The ezdxf document of :func:`drawing_sheet` and its :class:`SheetLayout`."""
-    from ..report.xlsx import lift_table
+    from ..design.tables import lift_table
 
     tpl = load_template()
     if not geometry.closed:
-        table = lift_table(spec, geometry, 360.0 / _plate_table_intervals(geometry.period))
+        table = lift_table(geometry, 360.0 / _plate_table_intervals(geometry.period))
         return _build_plate_drawing(spec, geometry, report, shapes, table, paper, tpl)
-    table = lift_table(spec, geometry, lift_step_deg)
+    table = lift_table(geometry, lift_step_deg)
     extent = max([float(np.max(np.hypot(*lp.points.T))) for lp in shapes.profiles] + [geometry.max_radius])
     layout = sheet_layout(extent, len(table.angle), paper)
     doc, msp = _new_doc(spec, layout, shapes, tpl)

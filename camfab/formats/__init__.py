@@ -13,6 +13,8 @@ Modules
     Design workbooks: read one, and write a spec back (:func:`design_to_xlsx`).
 ``knot_files``
     Knot rows from CSV/text and xlsx files; a ``[motion_table]``'s ``file`` read.
+``camdas_workbook``
+    The CAM-DAS results workbook of a checked cam (tables, conclusions, lift table, dynamics).
 
 Examples
 --------
@@ -23,6 +25,7 @@ Examples
 """
 from __future__ import annotations
 
+from .camdas_workbook import camdas_workbook
 from .design_files import EXAMPLES_DIR, load_design, resolve_design_path
 from .knot_files import (
     load_motion_table,
@@ -37,6 +40,7 @@ from .xlsx_design import design_rows, design_to_xlsx, load_design_xlsx
 
 __all__ = [
     "EXAMPLES_DIR",
+    "camdas_workbook",
     "design_from_data",
     "design_rows",
     "design_to_xlsx",

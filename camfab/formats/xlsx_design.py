@@ -48,7 +48,7 @@ from typing import Any
 from ..design.knots import KnotFile
 from ..design.spec import CamSpec, DesignSpec, FollowerSpec, ManufacturingSpec, OutputsSpec, dynamics_items
 from ..errors import Problem, SpecError
-from ..report.xlsx import FIXED_DATE, fixed_zip
+from .camdas_workbook import FIXED_DATE, fixed_zip
 from ..units import RPM
 from .toml_design import design_from_data
 

@@ -22,7 +22,7 @@ from camfab.formats import design_from_data, design_rows, design_to_xlsx, load_d
 from camfab.report._common import sample_grid
 from tests.report.designs import checked_design
 from camfab.report.html import render_report
-from camfab.report.xlsx import camdas_workbook
+from camfab.formats.camdas_workbook import camdas_workbook
 
 from ..conftest import EXAMPLES
 from .designs import DESIGNS

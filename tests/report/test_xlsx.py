@@ -13,7 +13,7 @@ from camfab.design.assemble import check_design, geometry_from_spec
 from camfab.design.spec import design_from_dict
 from camfab.errors import SpecError
 from camfab.formats import load_design
-from camfab.report.xlsx import camdas_workbook
+from camfab.formats.camdas_workbook import camdas_workbook
 from tests.conftest import EJEMPLO11RO, EXAMPLES, base_design
 
 openpyxl = pytest.importorskip("openpyxl")

@@ -73,6 +73,7 @@ from typing import Any
 
 import numpy as np
 
+from ..design.tables import LiftTable, intervals, lift_table, sample_params
 from ..errors import Problem, SpecError
 from ..results import JUMP_CODES, IssueCode, Severity, Verdict
 
@@ -103,28 +104,6 @@ def verdict_sentence(report) -> str:
         why = sorted({f.code.lower().replace("_", " ") for f in report.findings if f.severity == Severity.ERROR})
         text += ": " + ", ".join(why)
     return f"{text} [{v}]"
-
-
-def sample_params(geometry, step: float) -> np.ndarray:
-    """Sample parameters (radians, or mm for a translating cam) from 0 to the period inclusive.
-
-    ``step`` is in degrees; it must divide 360.  A translating cam is cut into
-    the same number of equal intervals (``360/step``) over its length.
-    """
-    n = _intervals(step, "step_deg")
-    k = np.arange(n + 1, dtype=float)
-    if geometry.closed:
-        return np.radians(k * (360.0 / n))
-    return k * (geometry.period / n)
-
-
-def _intervals(step: Any, field: str) -> int:
-    if isinstance(step, bool) or not isinstance(step, (int, float)) or not math.isfinite(step) or step <= 0:
-        raise SpecError(Problem(field, step, "must be a positive number of degrees", "e.g. 1 or 0.5"))
-    n = 360.0 / step
-    if abs(n - round(n)) > 1e-9 * max(1.0, n):
-        raise SpecError(Problem(field, step, "must divide 360", "e.g. 0.25, 0.5, 1, 2, 5, 10"))
-    return int(round(n))
 
 
 # ---------------------------------------------------------------------------
@@ -286,46 +265,6 @@ def dynamics_summary_rows(report) -> list[tuple[str, Any, str, float | None]]:
 
 # ---------------------------------------------------------------------------
 # the lift table
-@dataclass(frozen=True)
-class LiftTable:
-    """Follower lift against cam angle.
-
-    Attributes
-    ----------
-    angle : (n,) float
-        Cam angle in degrees (travel in mm for a translating cam), 0 up to, not including, the period.
-    lift : (n,) float
-        Follower lift S (mm, or degrees for oscillating followers).
-    radius : (n,) float
-        Distance from the cam centre to the follower's reference: the roller
-        centre (pitch radius) for rollers and knife edges, the face for flat
-        faces (mm).  For a translating cam: the roller-centre height.
-    lift_unit : str
-    radius_label : str
-    """
-
-    angle: np.ndarray
-    lift: np.ndarray
-    radius: np.ndarray
-    lift_unit: str
-    radius_label: str
-
-
-def lift_table(spec, geometry, step_deg: float = 10.0, *, profile: int = 0) -> LiftTable:
-    """The lift table of profile ``profile`` at ``step_deg`` (must divide 360)."""
-    c = geometry.profiles[profile]
-    x = sample_params(geometry, step_deg)[:-1]
-    smp = c.evaluate(x)
-    lift = c.motion.evaluate(x, (0,))[0]
-    if not geometry.closed:
-        radius, label = smp.pitch[:, 1], "Roller centre height (mm)"
-    elif c.kind == "roller":
-        radius, label = np.hypot(smp.pitch[:, 0], smp.pitch[:, 1]), "Pitch radius (mm)"
-    else:
-        radius, label = np.einsum("ij,ij->i", smp.point, smp.normal), "Face distance (mm)"
-    return LiftTable(geometry.to_user(x), lift, radius, _unit(spec), label)
-
-
 # ---------------------------------------------------------------------------
 # the workbook
 def camdas_workbook(spec, geometry, report, *, step_deg: float = 1.0, lift_step_deg: float = 10.0) -> bytes:
@@ -355,15 +294,15 @@ def camdas_workbook(spec, geometry, report, *, step_deg: float = 1.0, lift_step_
     """
     from openpyxl import Workbook
 
-    _intervals(step_deg, "step_deg")
-    _intervals(lift_step_deg, "lift_step_deg")
+    intervals(step_deg, "step_deg")
+    intervals(lift_step_deg, "lift_step_deg")
     wb = Workbook()
     wb.remove(wb.active)
     for k in range(len(geometry.profiles)):
         _camdas_sheet(wb.create_sheet("CAM-DAS" if k == 0 else f"CAM-DAS {k + 1}"), spec, geometry, report,
                       step_deg, k)
     _checks_sheet(wb.create_sheet("Checks"), spec, report)
-    _lift_sheet(wb.create_sheet("Lift table"), lift_table(spec, geometry, lift_step_deg), geometry)
+    _lift_sheet(wb.create_sheet("Lift table"), lift_table(geometry, lift_step_deg), geometry)
     if spec.dynamics is not None:
         _dynamics_sheet(wb.create_sheet("Dynamics"), *dynamics_columns(spec, geometry, step_deg=step_deg))
     wb.properties.creator = "camfab"
