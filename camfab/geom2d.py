@@ -30,6 +30,7 @@ __all__ = [
     "cross",
     "dot",
     "rotate",
+    "rotate_cs",
     "unit",
     "arc_sweep",
     "bulge_centre",
@@ -63,7 +64,12 @@ def dot(u: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 def rotate(v: np.ndarray, angle) -> np.ndarray:
     """``v`` ``(..., 2)`` turned counter-clockwise by ``angle`` (radians, broadcast over ``...``)."""
-    c, s = np.cos(angle), np.sin(angle)
+    return rotate_cs(v, np.cos(angle), np.sin(angle))
+
+
+def rotate_cs(v: np.ndarray, c, s) -> np.ndarray:
+    """``v`` ``(..., 2)`` turned counter-clockwise by the angle whose cosine and sine are ``c``, ``s``
+    (broadcast over ``...``; for callers that already have them)."""
     return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1]], axis=-1)
 
 

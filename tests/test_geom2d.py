@@ -18,6 +18,7 @@ from camfab.geom2d import (
     cross,
     dot,
     rotate,
+    rotate_cs,
     unit,
 )
 
@@ -34,6 +35,7 @@ def test_vector_ops_broadcast_over_leading_axes():
     ang = RNG.uniform(-4, 4, size=(4, 3))
     np.testing.assert_allclose(rotate(u, ang), u[..., 0:1] * np.stack([np.cos(ang), np.sin(ang)], -1)
                                + u[..., 1:2] * np.stack([-np.sin(ang), np.cos(ang)], -1))
+    np.testing.assert_array_equal(rotate_cs(u, np.cos(ang), np.sin(ang)), rotate(u, ang))
     np.testing.assert_allclose(np.hypot(*unit(u).T), 1.0)
     np.testing.assert_array_equal(unit(np.zeros((2, 2))), 0.0)
     assert J(np.array([1.0, 2.0])).tolist() == [-2.0, 1.0]  # a single vector too
