@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from typing import NamedTuple
 
 import numpy as np
@@ -72,10 +72,10 @@ class Grid:
     hi: np.ndarray
     step: float
 
-    @property
+    @cached_property
     def sizes(self) -> np.ndarray:
         """(k,) int: samples per interval."""
-        return np.diff(np.r_[self.starts, self.x.size])
+        return np.diff(np.append(self.starts, self.x.size))
 
 
 def dense_grid(edges, step: float | None = None) -> Grid:
@@ -264,7 +264,7 @@ class _Search(NamedTuple):
 def _candidates(grid: Grid, v: np.ndarray) -> np.ndarray:
     """Indices of the :data:`_KEEP` smallest local minima of v (NaN-free) within the intervals
     (stable by value; the first and last sample of an interval compare one-sidedly)."""
-    le_prev, le_next = np.r_[True, v[1:] <= v[:-1]], np.r_[v[:-1] <= v[1:], True]
+    le_prev, le_next = np.append(True, v[1:] <= v[:-1]), np.append(v[:-1] <= v[1:], True)
     le_prev[grid.starts] = True  # the first sample of an interval compares with its successor only
     le_next[grid.starts[1:] - 1] = True  # the last one with its predecessor only
     loc = np.flatnonzero(le_prev & le_next)
@@ -284,7 +284,7 @@ def _prepare(searches: Sequence[_Search], dense: Sequence[np.ndarray | None], ba
         loc = _candidates(g, v)
         iv = np.searchsorted(g.starts, loc, side="right") - 1
         lo_i = np.maximum(loc - 1, g.starts[iv])
-        hi_i = np.minimum(loc + 1, np.r_[g.starts[1:], g.x.size][iv] - 1)
+        hi_i = np.minimum(loc + 1, np.append(g.starts[1:], g.x.size)[iv] - 1)
         ref = g.x[hi_i] > g.x[lo_i]
         plans.append((v, loc, ref, off))
         if k := int(ref.sum()):
@@ -408,7 +408,7 @@ def _sign_ranges(grid: Grid, xa: np.ndarray, pos: np.ndarray, st: np.ndarray, ro
     inn = np.ones(xa.size - 1, dtype=bool)  # the sample pairs inside one interval
     inn[st[1:] - 1] = False
     chg = np.flatnonzero((pos[:-1] != pos[1:]) & inn)
-    cut = np.r_[np.searchsorted(chg, st), chg.size]
+    cut = np.append(np.searchsorted(chg, st), chg.size)
     raw: list[list] = []
     for m in np.flatnonzero(np.logical_or.reduceat(pos, st)):
         start = grid.lo[m] if pos[st[m]] else None
