@@ -92,3 +92,9 @@ def test_integrate_is_exact_for_smooth_functions():
     assert integrate(np.cos, [0.0, 1.0, 2.0]) == pytest.approx(math.sin(2.0), rel=1e-13)
     assert integrate(lambda x: x ** 7, EDGES) == pytest.approx((2 * math.pi) ** 8 / 8, rel=1e-13)
     assert abs(integrate(np.sin, EDGES, atol=1e-12)) < 1e-12
+
+
+def test_integrate_stops_on_what_cannot_be_integrated():
+    """NaN (an undefined integrand) is not split for ever: the result says so, quickly."""
+    assert math.isnan(integrate(lambda x: np.where(x > 1.0, np.nan, x), [0.0, 2.0]))
+    assert math.isfinite(integrate(lambda x: 1.0 / (x - 1.0) ** 2, [0.0, 2.0]))  # work bounded, not hung
