@@ -6,10 +6,10 @@ reports wall time (best of N) and peak traced memory.  Target: within 3x of the
 bare evaluation.  Small inputs (10, 100, 1000 angles, as a check's searches ask for)
 are timed on the same program and on one made of the piecewise and double-harmonic laws.
 
-``--baseline REF`` also times the same programs with the code of git ref REF (default: the
-merge-base with ``main``), checked out into a temporary ``git worktree`` and run in a
-subprocess, and prints both figures and their ratio; the redesign's target is a ratio of at
-most 1.3 at 10^6 angles.  Both sides run alternately ``--rounds`` times and keep their best.
+``--baseline [REF]`` also times the same programs with the code of git ref REF (default: the code
+before the core redesign, ``benchmarks/baseline.py``), checked out into a temporary ``git worktree``
+and run in a subprocess, and prints both figures and their ratio; the redesign's target is a ratio of
+at most 1.3 at 10^6 angles.  Both sides run alternately ``--rounds`` times and keep their best.
 
 Run:  python3 benchmarks/bench_motion.py [--n 1000000] [--repeat 5] [--baseline [REF]]
 """
@@ -119,12 +119,6 @@ def _child(root: Path, n: int, repeat: int) -> dict[str, float]:
     return json.loads(res.stdout)
 
 
-def _merge_base() -> str:
-    res = subprocess.run(["git", "-C", str(ROOT), "merge-base", "HEAD", "main"], capture_output=True,
-                         text=True, check=True)
-    return res.stdout.strip()
-
-
 def compare(ref: str, n: int, repeat: int, rounds: int) -> bool:
     """Time this tree and ``ref`` alternately; print both, the ratios and the verdict."""
     with tempfile.TemporaryDirectory(prefix="camfab-baseline-") as tmp:
@@ -181,7 +175,10 @@ def main() -> None:
     for key, t in small_timings(a.repeat).items():
         print(f"  {key:32}{t * 1e6:>10.1f} us")
     if a.baseline is not None:
-        ok = compare(a.baseline or _merge_base(), a.n, a.repeat, a.rounds)
+        sys.path.insert(0, str(Path(__file__).resolve().parent))
+        from baseline import BASELINE_REF
+
+        ok = compare(a.baseline or BASELINE_REF, a.n, a.repeat, a.rounds)
         sys.exit(0 if ok else 1)
 
 

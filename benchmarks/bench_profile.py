@@ -8,13 +8,20 @@ A program computes its exact peaks and junctions once, so a repeated check reuse
 times check() on a freshly built program and geometry.
 Timings are best-of-``--repeat`` (the machine may be shared).
 
-Run:  python3 benchmarks/bench_profile.py [--n 100000] [--repeat 5]
+``--baseline [REF]`` also times the motion and the profile evaluation at 10^5 angles in the code before the
+core redesign (``benchmarks/baseline.py``), in the same run; the redesign's target is a ratio of at most
+1.3 for each.
+
+Run:  python3 benchmarks/bench_profile.py [--n 100000] [--repeat 5] [--baseline]
 """
 from __future__ import annotations
 
 import argparse
+import json
 import math
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -54,11 +61,36 @@ def best_cold(make, repeat):
     return t
 
 
+CAMS = (("translating roller", lambda p: CamGeometry(TranslatingRoller(40.0, 8.0, 5.0), p), ROWS),
+        ("oscillating roller", lambda p: CamGeometry(OscillatingRoller(50.0, 8.0, 120.0, 90.0), p), OSC_ROWS),
+        ("translating flat", lambda p: CamGeometry(TranslatingFlat(80.0), p), ROWS))
+#: the ratio (this code / the code before the redesign) the redesign must stay within
+TARGET_RATIO = 1.3
+
+
+def timings(n: int, repeat: int) -> dict[str, float]:
+    """Seconds of the motion and of each mechanism's profile evaluation at n angles (whichever camfab is
+    imported; API common to the code before and after the redesign)."""
+    phi = np.linspace(0, 2 * math.pi, n, endpoint=False)
+    prog = MotionProgram.from_segments(ROWS)
+    out = {f"motion S..S‴ at {n:,} angles": best(lambda: prog.evaluate(phi), repeat)}
+    for name, build, rows in CAMS:
+        geom = build(MotionProgram.from_segments(rows))
+        out[f"profile, {name}, {n:,} angles"] = best(lambda: geom.evaluate(phi), repeat)
+    return out
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=100_000)
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--baseline", nargs="?", const="", default=None, metavar="REF")
+    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args()
+    if a.child:
+        print(json.dumps(timings(a.n, a.repeat)))
+        return
     prog = MotionProgram.from_segments(ROWS)
     osc = MotionProgram.from_segments(OSC_ROWS)
     phi = np.linspace(0, 2 * math.pi, a.n, endpoint=False)
@@ -66,11 +98,7 @@ def main() -> None:
     print(f"12-segment cam, {a.n:,} angles; motion engine S..S''' {t_motion * 1e3:.1f} ms")
     print(f"{'mechanism':<22}{'profile+rho+pa ms':>18}{'ratio':>8}{'check() ms':>12}{'profile+check ms':>18}"
           f"{'ratio':>8}{'cold check() ms':>17}{'ratio (cold)':>14}")
-    cams = (("translating roller", lambda p: CamGeometry(TranslatingRoller(40.0, 8.0, 5.0), p), ROWS),
-            ("oscillating roller", lambda p: CamGeometry(OscillatingRoller(50.0, 8.0, 120.0, 90.0), p),
-             OSC_ROWS),
-            ("translating flat", lambda p: CamGeometry(TranslatingFlat(80.0), p), ROWS))
-    for name, build, rows in cams:
+    for name, build, rows in CAMS:
         geom = build(prog if rows is ROWS else osc)
         t_geo = best(lambda: geom.evaluate(phi), a.repeat)
         t_chk = best(lambda: check(geom), a.repeat)
@@ -81,6 +109,12 @@ def main() -> None:
     print("target: profile evaluation (+ check) within 3x of the motion evaluation; check() is timed on a geometry")
     print("already checked (its program caches its exact peaks and junctions), cold check() on a fresh one; the")
     print("per-law tables (critical points, end values) are built once per process and kept")
+    if a.baseline is not None:
+        sys.path.insert(0, str(Path(__file__).resolve().parent))
+        from baseline import print_ratios, run_both
+
+        mine, base = run_both(__file__, ["--n", str(a.n), "--repeat", str(a.repeat)], a.baseline or None, a.rounds)
+        sys.exit(0 if print_ratios(mine, base, a.baseline or None, TARGET_RATIO) else 1)
 
 
 if __name__ == "__main__":
