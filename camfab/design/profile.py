@@ -61,7 +61,8 @@ import numpy as np
 
 from ..errors import SpecError
 from .kinds import Axis, ContactKind
-from ..numeric import extrema, extremum, integrate
+from ..geom2d import cross, dot
+from ..numeric import extrema, integrate
 
 __all__ = [
     "MotionLike",
@@ -74,10 +75,6 @@ __all__ = [
     "block",
     "rot_into",
     "inverse",
-    "perp",
-    "cross",
-    "dot",
-    "rotate",
     "xy",
     "pressure_angle",
 ]
@@ -153,27 +150,6 @@ class Extremes:
 
 
 # ---------------------------------------------------------------------------
-# small vector helpers on (n, 2) arrays
-def perp(v: np.ndarray) -> np.ndarray:
-    """J·v: each row turned by +90°."""
-    return np.stack([-v[:, 1], v[:, 0]], axis=1)
-
-
-def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise a × b (the z component)."""
-    return a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-
-
-def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise a · b."""
-    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1]
-
-
-def rotate(v: np.ndarray, c: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """Rows of v turned by the angles whose cosines and sines are c, s."""
-    return np.stack([v[:, 0] * c - v[:, 1] * s, v[:, 0] * s + v[:, 1] * c], axis=1)
-
-
 def xy(x, y) -> np.ndarray:
     """(n, 2) array of the broadcast coordinates x, y."""
     x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))

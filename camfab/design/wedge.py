@@ -15,7 +15,8 @@ import numpy as np
 from ..errors import Problem
 from .kinds import CamKind, Direction
 from .mechanism import Mechanism, finite_fields, require_non_negative
-from .profile import Contact, MotionLike, ProfileSample, cross, inverse, perp, pressure_angle, xy
+from ..geom2d import J, cross
+from .profile import Contact, MotionLike, ProfileSample, inverse, pressure_angle, xy
 
 __all__ = ["TranslatingCamContact", "TranslatingCamRoller"]
 
@@ -25,7 +26,7 @@ def _roller(C, T, A2, v, rr, sg):
     speed = np.hypot(T[:, 0], T[:, 1])
     t = T / speed[:, None]
     kp = sg * cross(T, A2) / speed**3
-    n = -sg * perp(t)
+    n = -sg * J(t)
     point = C - rr * n
     scale = 1.0 - rr * kp
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -1,7 +1,7 @@
 """Spreadsheet export (openpyxl): the CAM-DAS "Exportar-Excel" layout, checks and a lift table.
 
-Sheet ``CAM-DAS`` follows the map of ``spec/camdas-reference.md`` §1.11 cell
-for cell:
+Sheet ``CAM-DAS`` follows the CAM-DAS program's own "Exportar-Excel" sheet cell for cell
+(``docs/decisions.md``, "CAM-DAS spreadsheet layout"):
 
 ==========  =================================================================
 Cells       Content
@@ -38,7 +38,8 @@ points (0° … 360°, both ends included), so at the CAM-DAS step of 1° the da
 fill rows 10 … 370 and row 371 stays empty; row 9 holds the headings.  No row
 is invented to reach 371.  At another step the block is ``360/step + 1`` rows.
 
-Cam frame and angles follow ``design.md`` §3 (follower along +Y at 0°).  A
+Cam frame and angles follow camfab's convention (``docs/decisions.md``, "Rotation sense and the cam
+frame": the follower along +Y at 0°).  A
 translating cam has no polar coordinates (columns I, J, O, P stay empty).  A
 cam with several profiles (conjugate cams) gets one ``CAM-DAS`` sheet per
 profile (``CAM-DAS 2`` …).
