@@ -4,7 +4,8 @@ The templates live in the repository's top-level ``templates/`` folder.  A wheel
 ``camfab/templates/`` (``pyproject.toml`` maps the package ``camfab.templates`` to that folder), and they are read
 through :mod:`importlib.resources`.  An editable install (``pip install -e .``) or a plain checkout on
 ``sys.path`` has no ``camfab/templates/``: there the folder beside the package, ``<checkout>/templates/``, is
-the one.  Only the location of the ``camfab`` package decides (never another installed copy of camfab).
+the one.  Only the location of the ``camfab`` package decides, never another installed copy of camfab
+(``docs/decisions.md, "Where the templates and the examples live"``).
 
 >>> "report.html.j2" in {p.name for p in templates().joinpath("report").iterdir()}
 True
