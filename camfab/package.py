@@ -25,6 +25,7 @@ from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
+from .assets import read_template, templates_hash
 from .design.spec import DesignSpec
 from .formats import load_design
 from .io import atomic_write
@@ -36,7 +37,6 @@ __all__ = ["discover", "input_key", "package", "exit_status", "MANIFEST", "INDEX
 
 MANIFEST = "manifest.json"
 INDEX = "index.html"
-_TEMPLATES = Path(__file__).parent / "templates"
 
 
 def discover(paths: Iterable[str | Path]) -> list[Path]:
@@ -58,15 +58,6 @@ def discover(paths: Iterable[str | Path]) -> list[Path]:
 
 def _sha(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
-
-
-def _templates_hash() -> str:
-    h = hashlib.sha256()
-    for f in sorted(_TEMPLATES.rglob("*")):
-        if f.is_file() and "examples" not in f.parts:
-            h.update(str(f.relative_to(_TEMPLATES)).encode())
-            h.update(f.read_bytes())
-    return h.hexdigest()
 
 
 def input_key(sources: Sequence[str | Path], options: dict, templates: str) -> str:
@@ -168,7 +159,7 @@ def package(paths: Iterable[str | Path], out: str | Path, *, jobs: int = 1, outp
     options = {"outputs": sorted(outputs) if outputs is not None else None, "force": force}
     designs = discover(paths)
     old = _old_entries(out)
-    templates = _templates_hash()
+    templates = templates_hash()
     opts = options if (outputs is not None or force) else {}
     todo, entries = [], {}
     for p in designs:
@@ -244,7 +235,7 @@ def _index_html(manifest: dict) -> str:
     from jinja2 import Environment, select_autoescape
 
     env = Environment(autoescape=select_autoescape(default=True))
-    tpl = env.from_string((_TEMPLATES / "package" / "index.html.j2").read_text(encoding="utf-8"))
+    tpl = env.from_string(read_template("package", "index.html.j2"))
     rows = []
     for e in manifest["cams"]:
         files = {Path(f["path"]).name: f["path"] for f in e.get("files", [])}

@@ -13,7 +13,7 @@ settings.register_profile("ci", derandomize=True, print_blob=True)
 if os.environ.get("CI"):
     settings.load_profile("ci")
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "camfab" / "templates" / "examples"
+EXAMPLES = Path(__file__).resolve().parents[1] / "camfab" / "examples"
 SHARED = Path(__file__).resolve().parents[2] / "shared"
 
 #: Ejemplo9RT's segment list (spec camdas-reference §2.1)

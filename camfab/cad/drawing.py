@@ -4,8 +4,8 @@ The sheet is drawn in **paper millimetres** in model space: the cam is placed
 at a standard scale (ISO 5455: 10:1 … 1:100) with its centre in the middle of
 the view area, and every DIMENSION carries ``dimlfac = 1/scale`` so CAD shows
 true sizes.  The frame, title block, notes column and lift-table sizes come
-from ``templates/drawing/title_block.toml`` (data, loaded through
-:mod:`importlib.resources`).
+from ``templates/drawing/title_block.toml`` (data shipped in the wheel, found by
+:mod:`camfab.assets`).
 
 Layout (landscape)
 ------------------
@@ -46,11 +46,11 @@ import functools
 import math
 import tomllib
 from dataclasses import dataclass
-from importlib import resources
 from typing import Any
 
 import numpy as np
 
+from ..assets import read_template
 from ..errors import ExportError
 from ..geom2d import ArcChain
 from ..results import Severity, Verdict
@@ -72,8 +72,8 @@ LAYERS = {
 
 @functools.lru_cache(maxsize=1)
 def load_template() -> dict[str, Any]:
-    """The title-block template (``camfab/templates/drawing/title_block.toml``) as a dict."""
-    text = resources.files("camfab").joinpath("templates", "drawing", "title_block.toml").read_text("utf-8")
+    """The title-block template (``templates/drawing/title_block.toml``) as a dict."""
+    text = read_template("drawing", "title_block.toml")
     return tomllib.loads(text)
 
 

@@ -9,8 +9,9 @@ from .xlsx_design import load_design_xlsx
 
 __all__ = ["EXAMPLES_DIR", "load_design", "resolve_design_path"]
 
-#: the built-in example designs (TOML files and the knot files they name)
-EXAMPLES_DIR = Path(__file__).parent.parent / "templates" / "examples"
+#: the built-in example designs (TOML files and the knot files they name): data shipped inside the package
+#: (``camfab/examples/``), apart from the templates
+EXAMPLES_DIR = Path(__file__).resolve().parent.parent / "examples"
 
 
 def load_design(path: str | Path) -> DesignSpec:

@@ -8,7 +8,7 @@ Examples
 >>> from camfab.formats import load_design
 >>> from camfab.design.assemble import geometry_from_spec, check_design
 >>> from camfab.report import render_report, write_files
->>> spec = load_design("camfab/templates/examples/ejemplo9rt.toml")          # doctest: +SKIP
+>>> spec = load_design("camfab/examples/ejemplo9rt.toml")          # doctest: +SKIP
 >>> files = render_report(spec, geometry_from_spec(spec), check_design(spec))  # doctest: +SKIP
 >>> write_files(files, "out/report")                                         # doctest: +SKIP
 """

@@ -3,8 +3,8 @@
 :func:`render_report` returns the files of a report directory as
 ``{relative path: bytes}`` — ``report.html`` plus ``plots/<name>.png`` and
 ``plots/<name>.svg`` — and writes nothing (see :func:`write_files`).  The page is
-rendered from the jinja2 templates shipped in ``camfab/templates/report/``
-(loaded with :mod:`importlib.resources`); it needs no network: the stylesheet and
+rendered from the jinja2 templates in the repository's ``templates/report/``
+(shipped in the wheel, found by :mod:`camfab.assets`); it needs no network: the stylesheet and
 the animation script are inlined, the plots are relative ``<img>`` links (or
 ``data:`` URIs with ``standalone=True``).  The output is deterministic: no
 timestamps, rounded animation frames, byte-stable plots.
@@ -15,12 +15,12 @@ import base64
 import dataclasses
 import json
 import math
-from importlib import resources
 from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
 
+from ..assets import read_template
 from ..errors import MissingDependencyError
 from ..results import DynamicsSummary, IssueCode, Severity
 from ._common import (VERDICT_CLASS, VERDICT_TEXT, _cell, axis_of, conclusions_rows, fmt, fmt_at, key_values,
@@ -67,7 +67,7 @@ def require_report_dependencies() -> None:
 
 
 def _read_asset(name: str) -> str:
-    return resources.files("camfab").joinpath("templates", "report", name).read_text(encoding="utf-8")
+    return read_template("report", name)
 
 
 def template_environment():

@@ -16,7 +16,7 @@ from camfab.errors import SpecError
 from camfab.formats import load_design, load_motion_table, read_knot_file, read_knots_csv, read_knots_xlsx
 from camfab.results import Finding
 
-EXAMPLES = Path(__file__).resolve().parents[2] / "camfab" / "templates" / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "camfab" / "examples"
 VALVE_UNITS = {"angle": "deg", "s": "m", "v": "m/s", "a": "m/s2"}
 OMEGA_1500 = 1500 * 2 * math.pi / 60
 REL = 1e-9

@@ -40,7 +40,7 @@ def example(name):
         if name == "typical12":
             g = typical12()
         else:
-            g = geometry_from_spec(load_design(f"camfab/templates/examples/{name}.toml"))
+            g = geometry_from_spec(load_design(f"camfab/examples/{name}.toml"))
         c = profile_curve(g.profiles[0])
         _CACHE[name] = (g, c, Dense(c))
     return _CACHE[name]
@@ -164,7 +164,7 @@ def test_cam_profile_breakpoints_are_g1():
 def test_translating_outline_keeps_corners(tol):
     """The plate outline of a translating cam: within tol, G1 except at its true (plate) corners."""
     if "wedge_translating" not in _CACHE:
-        g = geometry_from_spec(load_design("camfab/templates/examples/wedge_translating.toml"))
+        g = geometry_from_spec(load_design("camfab/examples/wedge_translating.toml"))
         c = profile_curve(g.profiles[0])
         _CACHE["wedge_translating"] = (g, c, Dense(c))
     _, curve, dense = _CACHE["wedge_translating"]

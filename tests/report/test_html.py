@@ -9,11 +9,11 @@ import math
 import re
 import xml.etree.ElementTree as ET
 from html.parser import HTMLParser
-from importlib import resources
 
 import numpy as np
 import pytest
 
+from camfab.assets import templates
 from camfab.design.spec import design_from_dict
 from camfab.report._common import VERDICT_TEXT, conclusions_rows
 from camfab.report.animation import animation_data
@@ -57,8 +57,8 @@ def _anim(page: bytes) -> dict:
     return json.loads(m.group(1))
 
 
-def test_templates_ship_inside_the_package():
-    base = resources.files("camfab").joinpath("templates", "report")
+def test_report_templates_are_found():
+    base = templates().joinpath("report")
     for name in ("report.html.j2", "compare.html.j2", "base.html.j2", "_macros.html.j2", "animation.js",
                  "report.css"):
         assert base.joinpath(name).is_file(), name
