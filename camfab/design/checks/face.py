@@ -29,7 +29,7 @@ def face_rule(contact: Contact, limits: Limits, sample: ContactSample) -> RuleRe
                        f"the face must reach {right:.6g} mm to the right of the stem axis (contact furthest right at "
                        f"{b:.6g}°; margin {margin:g} mm included)"))
         return RuleResult(out, {"face_length": FaceLength(left, right, pmin, pmax)})
-    along = ", measured along its arc," if contact.curved_face else ""
+    along = ", measured along its arc" if contact.curved_face else ""
     out = (Finding(IssueCode.FACE_LENGTH, Severity.INFO, b, b, pmax + margin, None,
                    f"the face must be at least {pmax + margin:.6g} mm long from the vertex{along} (contact between "
                    f"{pmin:.6g} mm at {a:.6g}° and {pmax:.6g} mm at {b:.6g}°; margin {margin:g} mm included)"
