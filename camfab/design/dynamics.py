@@ -15,8 +15,9 @@ spring preload at S = 0 and F_ext a constant load, both pressing the follower on
 The cam touches the follower at P (fixed frame) with the outward unit normal n; the contact
 force on the follower is ``N·n + f`` — f the sliding friction (knife edges and faces, flat or
 curved — :attr:`~camfab.design.profile.Contact.sliding`: f = μN along the sliding velocity of the
-cam past the follower; a roller is taken to roll without slip, f = 0).  With w the velocity of the follower's point of force per unit q̇ (the roller
-centre, or the follower's material point at P), virtual work gives::
+cam past the follower; a roller is taken to roll without slip, f = 0).  With w the velocity of the
+follower's point of force per unit q̇ (the roller centre, or the follower's material point at P),
+virtual work gives::
 
     N = G / D,   D = n·w + μ·v̂·w      (rollers: D = |w|·cos δ, δ the pressure angle)
 

@@ -242,7 +242,7 @@ def test_curved_face_contact_force_from_first_principles(name):
     grid = np.linspace(0.0, 2 * np.pi, 7201)
     prof = c.evaluate(grid).point  # the cam (cam frame)
     P = np.empty_like(C)
-    for i, (phi, ci) in enumerate(zip(x, C)):
+    for i, (phi, ci) in enumerate(zip(x, C, strict=True)):
         turn = -c.sense * phi  # the cam frame → the fixed frame at cam angle φ
         cs, sn = math.cos(turn), math.sin(turn)
 
