@@ -320,7 +320,7 @@ class PressureAngle(Extreme):
 
 @dataclass(frozen=True)
 class FaceLength:
-    """Flat faces: where the contact runs along the face (mm, ``min``/``max``) and, for a translating
+    """Faces (flat or curved): where the contact runs along the face (mm, ``min``/``max``) and, for a translating
     face, the length needed each side of the stem (``left``/``right``, margin included; None for an
     oscillating face, whose position is measured from the vertex)."""
 

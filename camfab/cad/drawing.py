@@ -16,7 +16,9 @@ Layout (landscape)
   column groups when it is taller than the space;
 * the cam view between them: profile(s) (arc-fitted bulge loops, layer
   ``PROFILE``), bore and keyway (``BORE``), base circle and — for rollers —
-  prime circle (thin phantom/centre lines), centre lines and centre mark, a
+  prime circle (for curved faces the face-centre circle R_b + R, clipped to
+  the view when the face radius makes it larger; thin phantom/centre lines),
+  centre lines and centre mark, a
   0° mark on +Y, a rotation arrow, and DIMENSION entities: base-circle
   diameter, DMAX radius, bore diameter and, with a keyway, its width and the
   ``d + t2`` depth.
@@ -51,6 +53,7 @@ from typing import Any
 import numpy as np
 
 from ..assets import read_template
+from ..design.kinds import ContactKind, FollowerType
 from ..errors import ExportError
 from ..geom2d import ArcChain
 from ..results import Severity, Verdict
@@ -217,21 +220,31 @@ def notes_text(spec, geometry, report, shapes, layout: SheetLayout) -> list[str]
         if m.keyway:
             b, t2 = keyway_size(m.bore_mm)
             bore += f" with keyway DIN 6885-1 b = {b:g} mm, t2 = {t2:g} mm (d + t2 = {m.bore_mm + t2:g} mm) on +Y"
-    if f.type == "flat":
-        fol = f"{f.motion} flat-face follower"
-    else:
-        fol = f"{f.motion} {'knife-edge' if f.type == 'knife' else 'roller'} follower"
-        if f.type == "roller":
-            fol += f", roller Ø{2 * (f.roller_radius_mm or 0.0):g} mm"
-    if f.motion == "oscillating":
+    c = geometry.profiles[0]
+    fol = f"{f.motion} {FollowerType(f.type).title} follower"
+    if c.curved_face:
+        fol += f", face radius R{c.roller_radius:g} mm"
+    elif f.type == FollowerType.ROLLER:
+        fol += f", roller Ø{2 * (f.roller_radius_mm or 0.0):g} mm"
+    if c.oscillating:
         fol += f", pivot at {f.pivot_distance_mm:g} mm on +X"
         if f.arm_length_mm:
             fol += f", arm {f.arm_length_mm:g} mm"
-    elif f.type != "flat" and f.offset_mm:
+        if c.curved_face:
+            fol += f", face offset {f.face_offset_mm or 0.0:g} mm (pivot to the face's tangent at its vertex)"
+    elif c.kind is ContactKind.ROLLER and f.offset_mm:
         fol += f", offset {f.offset_mm:g} mm"
-    radius_word = "roller-centre distance (pitch radius)" if f.type != "flat" else "face distance"
+    if c.kind is not ContactKind.ROLLER:
+        radius_word = "face distance"
+    elif c.curved_face:
+        radius_word = "distance of the face's centre of curvature"
+    else:
+        radius_word = "roller-centre distance (pitch radius)"
     dev = max(shapes.profile_deviation) if shapes.profile_deviation else 0.0
     verdict = _verdict_note(report)
+    centre = ([f"Face-centre circle (chain line) R{f.base_radius_mm + c.roller_radius:g} mm = base radius + face "
+               "radius: the face's centre of curvature lies on it while the follower rests on the base circle."]
+              if c.curved_face else [])
     return [
         f"Material: {m.material or 'to be specified'}.",
         f"Plate thickness {m.thickness_mm:g} mm; {bore}.",
@@ -242,6 +255,7 @@ def notes_text(spec, geometry, report, shapes, layout: SheetLayout) -> list[str]
         "the lift table gives the follower lift after the cam has turned by the angle in its sense of rotation.",
         f"Follower: {fol}.",
         f"Base radius R_b = {f.base_radius_mm:g} mm; largest radius DMAX = {geometry.max_radius:.3f} mm.",
+        *centre,
         f"Lift table: lift in {'degrees of arm rotation' if f.motion == 'oscillating' else 'mm'}; "
         f"RADIUS = {radius_word} from the cam centre (mm).",
         verdict + ".",
@@ -365,7 +379,10 @@ def _view(msp, spec, geometry, shapes, layout: SheetLayout) -> None:
         msp.add_lwpolyline(_place(bore_loop(m.bore_mm, m.keyway), s, (cx, cy)), format="xyseb", close=True,
                            dxfattribs={"layer": "BORE"})
     msp.add_circle((cx, cy), f.base_radius_mm * s, dxfattribs={"layer": "BASE_CIRCLE"})
-    if f.type == "roller" and f.roller_radius_mm:
+    c = geometry.profiles[0]
+    if c.curved_face:  # the face-centre circle, as large as the face radius makes it: clipped to the view
+        _clipped_circle(msp, (cx, cy), (f.base_radius_mm + c.roller_radius) * s, layout.view, "PRIME_CIRCLE")
+    elif f.type == FollowerType.ROLLER and f.roller_radius_mm:
         msp.add_circle((cx, cy), (f.base_radius_mm + f.roller_radius_mm) * s, dxfattribs={"layer": "PRIME_CIRCLE"})
     rmax = max([float(np.max(np.hypot(*lp.points.T))) for lp in shapes.profiles] + [geometry.max_radius])
     reach = rmax * s + 4.0
@@ -389,6 +406,23 @@ def _view(msp, spec, geometry, shapes, layout: SheetLayout) -> None:
                   dxfattribs={"layer": "ANNOTATION"})
     _text(msp, "CW" if cw else "CCW", (cx + (ra + 2) * math.cos(math.radians(55)),
                                        cy + (ra + 2) * math.sin(math.radians(55))), 2.5, "ANNOTATION")
+
+
+def _clipped_circle(msp, centre, r: float, box, layer: str) -> None:
+    """A circle of radius ``r`` (paper mm) about ``centre``, drawn whole when it fits the box (x0, y0, x1, y1)
+    and otherwise as the arcs of it inside the box."""
+    cx, cy = centre
+    x0, y0, x1, y1 = box
+    hw, hh = min(cx - x0, x1 - cx), min(cy - y0, y1 - cy)
+    if r <= min(hw, hh):
+        msp.add_circle((cx, cy), r, dxfattribs={"layer": layer})
+        return
+    # inside where |cos t| ≤ hw/r and |sin t| ≤ hh/r: four arcs symmetric about the axes
+    a, b = math.degrees(math.acos(min(1.0, hw / r))), math.degrees(math.asin(min(1.0, hh / r)))
+    if a >= b:
+        return
+    for start, end in ((a, b), (180.0 - b, 180.0 - a), (180.0 + a, 180.0 + b), (360.0 - b, 360.0 - a)):
+        msp.add_arc((cx, cy), r, start, end, dxfattribs={"layer": layer})
 
 
 def _new_doc(spec, layout: SheetLayout, shapes, tpl):

@@ -13,10 +13,11 @@ Flavours
 
 Layers: ``PROFILE``, ``PITCH_CURVE``, ``BASE_CIRCLE``, ``PRIME_CIRCLE``, ``BORE``,
 ``TOOL_PATH``, ``CENTRE_MARKS``; the second cam of a conjugate pair is on ``PROFILE_2``
-and ``PITCH_CURVE_2``.  Units are recorded as ``$INSUNITS = 4`` (mm)
-and the tolerance and achieved deviation as custom header properties
-``CAMFAB_TOL_MM`` / ``CAMFAB_DEVIATION_MM``.  Output is byte-identical for the
-same input (ezdxf's fixed-metadata mode, no timestamps).
+and ``PITCH_CURVE_2``.  For a curved-face follower the pitch curve is the path of the
+face's centre of curvature and the prime circle the circle R_b + R it starts on.  Units
+are recorded as ``$INSUNITS = 4`` (mm) and the tolerance and achieved deviation as custom
+header properties ``CAMFAB_TOL_MM`` / ``CAMFAB_DEVIATION_MM``.  Output is byte-identical
+for the same input (ezdxf's fixed-metadata mode, no timestamps).
 """
 from __future__ import annotations
 

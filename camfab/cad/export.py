@@ -12,6 +12,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..design.kinds import ContactKind
 from ..discretize import ArcDiscretisation, arcs, measure_deviation, validate_tol
 from ..geom2d import ArcChain
 from ..io import atomic_write
@@ -145,10 +146,11 @@ def _dxf(spec, geometry, shapes: CamShapes, plate: PlateSpec, tol: float, flavou
     tool_d = spec.manufacturing.tool_diameter_mm
     if tool_paths and tool_d:
         tools = tuple(tool_centre_path(c, tool_d / 2, tol=tol).arcs for c in geometry.profiles)
-    rr = f.roller_radius_mm or 0.0
+    c = geometry.profiles[0]  # a roller's prime circle; a curved face's centre of curvature starts on R_b + R
+    rr = c.roller_radius if c.kind is ContactKind.ROLLER else 0.0
     content = dxf_mod.DxfContent(
         profiles=shapes.profiles, pitch_curves=shapes.pitch, base_radius=f.base_radius_mm,
-        prime_radius=(f.base_radius_mm + rr) if (f.type == "roller" and rr > 0 and f.base_radius_mm) else None,
+        prime_radius=(f.base_radius_mm + rr) if (rr > 0 and f.base_radius_mm) else None,
         bore=bore_loop(plate.bore_mm, plate.keyway) if plate.bore_mm > 0 else None,
         tool_paths=tools, tol_mm=tol, deviation_mm=max(shapes.profile_deviation), name=spec.name)
     text = dxf_mod.dumps(content, flavour=flavour)

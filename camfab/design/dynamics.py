@@ -13,10 +13,11 @@ external load ask for::
 with q̇ = q′·ṡ, q̈ = q″·ṡ² (ṡ = ω in rad/s, or the travel speed of a translating cam); F₀ is the
 spring preload at S = 0 and F_ext a constant load, both pressing the follower onto the cam.
 The cam touches the follower at P (fixed frame) with the outward unit normal n; the contact
-force on the follower is ``N·n + f`` — f the sliding friction (knife edges and flat faces:
-f = μN along the sliding velocity of the cam past the follower; a roller is taken to roll
-without slip, f = 0).  With w the velocity of the follower's point of force per unit q̇ (the roller
-centre, or the follower's material point at P), virtual work gives::
+force on the follower is ``N·n + f`` — f the sliding friction (knife edges and faces, flat or
+curved — :attr:`~camfab.design.profile.Contact.sliding`: f = μN along the sliding velocity of the
+cam past the follower; a roller is taken to roll without slip, f = 0).  With w the velocity of the
+follower's point of force per unit q̇ (the roller centre, or the follower's material point at P),
+virtual work gives::
 
     N = G / D,   D = n·w + μ·v̂·w      (rollers: D = |w|·cos δ, δ the pressure angle)
 
@@ -82,7 +83,7 @@ class Loads:
     external : float
         Constant load pressing the follower onto the cam (weight, process force): N or N·m.
     friction_coefficient : float
-        μ ≥ 0 of the sliding contact (knife edges and flat faces).
+        μ ≥ 0 of the sliding contact (knife edges and faces, flat or curved).
     safety_force_n : float
         Smallest acceptable contact force (N), ≥ 0.
     """
@@ -118,7 +119,7 @@ class ContactDynamics:
     Parameters
     ----------
     contact : Contact
-        A single-follower contact (translating or oscillating roller, knife edge or flat face,
+        A single-follower contact (translating or oscillating roller, knife edge, flat or curved face,
         or a translating cam's roller).
     loads : Loads
     speed : float

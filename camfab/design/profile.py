@@ -113,13 +113,14 @@ class ProfileSample:
         Signed profile curvature (1/mm) and radius ρ = 1/κ (mm, ±inf at an
         inflection); positive = convex.
     pitch : (n, 2) float or None
-        Pitch curve (roller centre); None for flat faces.
+        Pitch curve (roller centre; a curved face's centre of curvature); None for flat faces.
     curvature_pitch, rho_pitch : (n,) float or None
         The same for the pitch curve (rollers only).
     pressure_angle : (n,) float
         Signed pressure angle in radians (0 for a translating flat face).
     face_position : (n,) float or None
-        Flat faces: contact position along the face (mm), see module notes.
+        Faces (flat or curved): contact position along the face (mm), see module notes and
+        :mod:`camfab.design.curved`.
     arm_angle : (n,) float or None
         Oscillating followers: arm angle ξ (radians).
     """
@@ -174,7 +175,7 @@ class Contact:
     kind : ContactKind
         ROLLER (a circle about a point of the follower; a knife edge has radius 0) or FLAT.
     roller_radius : float
-        R_r in mm (0 for flat faces and knife edges).
+        R_r in mm (0 for flat faces and knife edges; the face radius of a curved face).
     closed : bool
         True for disc cams (periodic closed curve), False for a translating cam.
     oscillating : bool
@@ -185,6 +186,9 @@ class Contact:
     sliding : bool
         True when the follower slides on the cam (knife edges and faces; friction applies), False
         for a roller that rolls.
+    curved_face : bool
+        True for a curved (convex circular) face: kind ROLLER with a face; ``roller_radius`` is the
+        face radius and ``pitch`` the face's centre of curvature.
     """
 
     kind = ContactKind.ROLLER
@@ -197,6 +201,13 @@ class Contact:
     def sliding(self) -> bool:
         """Knife edges and faces slide on the cam; a roller of radius > 0 rolls."""
         return self.has_face or self.kind is ContactKind.FLAT or self.roller_radius == 0.0
+
+    @property
+    def curved_face(self) -> bool:
+        """A convex circular face (mushroom, finger follower): it envelopes the cam as a roller of radius
+        ``roller_radius`` about the face's centre of curvature (``pitch``), and has a contact position
+        along the face."""
+        return self.kind is ContactKind.ROLLER and self.has_face
 
     def __init__(self, motion: MotionLike, sense: int = 1):
         if sense not in (1, -1):

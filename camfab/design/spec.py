@@ -127,8 +127,8 @@ class DynamicsSpec:
     (a constant load pressing the follower onto the cam, e.g. its weight).  Oscillating followers:
     ``inertia_kg_m2`` (about the pivot, required), ``spring_rate_nm_per_deg``, ``spring_preload_nm``,
     ``damping_nm_s_per_deg``, ``external_torque_nm``.  Both: ``friction_coefficient`` (sliding
-    contacts: knife edges and flat faces) and ``safety_force_n`` (the smallest acceptable contact
-    force).  Form-closed cams (conjugate, constant width/diameter) take no spring and no safety force.
+    contacts: knife edges and faces, flat or curved) and ``safety_force_n`` (the smallest acceptable
+    contact force).  Form-closed cams (conjugate, constant width/diameter) take no spring and no safety force.
     The fields of the other motion are None."""
 
     motion: FollowerMotion
@@ -433,7 +433,7 @@ def _dynamics(v: Validator, data: Mapping[str, Any], cam: CamSpec, fol: Follower
     values = _dynamics_values(v, t, own)
     if values[4] and fol.type == FollowerType.ROLLER and (fol.roller_radius_mm or 0.0) > 0:
         v.add("dynamics.friction_coefficient", values[4], "a roller rolls on the cam (no sliding friction is "
-              "modelled)", "remove friction_coefficient, or model a knife edge or flat face")
+              "modelled)", "remove friction_coefficient, or model a knife edge, flat or curved face")
     if m is None:
         return None
     motion = FollowerMotion.OSCILLATING if osc else FollowerMotion.TRANSLATING

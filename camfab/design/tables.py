@@ -53,8 +53,9 @@ class LiftTable:
         Follower lift S (mm, or degrees for oscillating followers).
     radius : (n,) float
         Distance from the cam centre to the follower's reference: the roller
-        centre (pitch radius) for rollers and knife edges, the face for flat
-        faces (mm).  For a translating cam: the roller-centre height.
+        centre (pitch radius) for rollers and knife edges, the face's centre of
+        curvature for curved faces, the face for flat faces (mm).  For a
+        translating cam: the roller-centre height.
     lift_unit : str
     radius_label : str
     """
@@ -75,7 +76,8 @@ def lift_table(geometry, step_deg: float = 10.0, *, profile: int = 0) -> LiftTab
     if not geometry.closed:
         radius, label = smp.pitch[:, 1], "Roller centre height (mm)"
     elif c.kind is ContactKind.ROLLER:
-        radius, label = np.hypot(smp.pitch[:, 0], smp.pitch[:, 1]), "Pitch radius (mm)"
+        label = "Face-centre radius (mm)" if c.curved_face else "Pitch radius (mm)"
+        radius = np.hypot(smp.pitch[:, 0], smp.pitch[:, 1])
     else:
         radius, label = np.einsum("ij,ij->i", smp.point, smp.normal), "Face distance (mm)"
     return LiftTable(geometry.to_user(x), lift, radius, str(geometry.axis.lift_unit), label)

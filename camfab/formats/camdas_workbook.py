@@ -20,7 +20,11 @@ B, C, D, E  S, V, A, J in time units at the design speed: mm, mm/s, mm/s²,
             mm/s³ — degrees (°, °/s, …) for oscillating followers
 F           radius of curvature of the profile, mm (+ convex, − concave;
             empty where it is infinite, at an inflection)
-G           rollers and knife edges: pressure angle, degrees (signed)
+G           rollers, knife edges and curved faces: pressure angle, degrees
+            (signed)
+H           curved faces: contact position along the face, mm — from the
+            stem axis (+ = right) for a mushroom, the arc length from the
+            face vertex for a finger follower
 G, H        flat translating face: left / right distance of the contact
             point from the stem axis, mm (each ≥ 0, the other side 0)
 G           flat oscillating face: distance along the face from the
@@ -28,8 +32,9 @@ G           flat oscillating face: distance along the face from the
             is 0), mm
 I, J        profile, polar: radius (mm), polar angle (degrees, 0 … 360)
 L, M        profile, Cartesian: x, y (mm, cam frame)
-O, P        pitch curve (roller centre), polar: radius, angle — rollers
-R, S        pitch curve, Cartesian: x, y — rollers
+O, P        pitch curve (roller centre; a curved face's centre of
+            curvature), polar: radius, angle — rollers and curved faces
+R, S        pitch curve, Cartesian: x, y — rollers and curved faces
 ==========  =================================================================
 
 The 361-vs-362-rows note of §1.11 is resolved as follows: the map's
@@ -74,6 +79,7 @@ from typing import Any
 
 import numpy as np
 
+from ..design.kinds import ContactKind, FollowerType
 from ..design.tables import LiftTable, intervals, lift_table, sample_params
 from ..errors import Problem, SpecError
 from ..results import JUMP_CODES, IssueCode, Severity, Verdict
@@ -86,7 +92,8 @@ __all__ = ["CAMDAS_COLUMNS", "FIXED_DATE", "LiftTable", "camdas_workbook", "camd
 FIXED_DATE = datetime.datetime(2000, 1, 1, 0, 0, 0)
 #: column letter -> quantity, as in the CAM-DAS map (G/H depend on the follower)
 CAMDAS_COLUMNS = {"A": "angle", "B": "S", "C": "V", "D": "A", "E": "J", "F": "radius of curvature",
-                  "G": "pressure angle | left distance | distance along the face", "H": "right distance",
+                  "G": "pressure angle | left distance | distance along the face",
+                  "H": "right distance | contact position along a curved face",
                   "I": "profile r", "J": "profile polar angle", "L": "profile x", "M": "profile y",
                   "O": "pitch r", "P": "pitch polar angle", "R": "pitch x", "S": "pitch y"}
 FIRST_DATA_ROW = 10
@@ -116,7 +123,7 @@ def _unit(spec) -> str:
 def type_text(spec) -> str:
     """The A1 cam/follower type string."""
     f, cam = spec.follower, spec.cam
-    ftype = {"roller": "roller", "flat": "flat-face", "knife": "knife-edge"}[f.type]
+    ftype = FollowerType(f.type).title
     if spec.is_translating_cam:
         return f"Translating cam (slides {cam.direction}) with {ftype} follower, translating motion"
     sense = "clockwise" if cam.rotation == "cw" else "counter-clockwise"
@@ -124,25 +131,34 @@ def type_text(spec) -> str:
 
 
 def geometry_rows(spec, geometry) -> list[tuple[str, float | None, str]]:
-    """Rows A4:A8: up to four geometry values, then the speed (label, value, unit)."""
+    """Rows A4:A8: up to four geometry values, then the speed (label, value, unit).
+
+    Which rows a follower has comes from its first contact: a roller (radius > 0) gives its radius and,
+    translating, the prime radius; a curved face its face radius and, translating, the radius of the
+    circle its centre of curvature starts on (R_b + R); a face (flat or curved) on an arm its face offset.
+    """
     f = spec.follower
+    c = geometry.profiles[0]
     rows: list[tuple[str, float | None, str]] = []
     if spec.is_translating_cam:
         rows += [("Roller radius R_r", f.roller_radius_mm, "mm"), ("Base height h", f.base_height_mm or 0.0, "mm"),
                  ("Cam length L", geometry.period, "mm")]
     else:
         rows.append(("Base radius R_b", f.base_radius_mm, "mm"))
-        if f.type == "roller":
-            rows.append(("Roller radius R_r", f.roller_radius_mm, "mm"))
-        if f.motion == "translating":
-            if f.type == "flat":
+        circle = c.kind is ContactKind.ROLLER and c.roller_radius > 0  # a roller or a curved face
+        if circle:
+            rows.append(("Face radius R", c.roller_radius, "mm") if c.curved_face
+                        else ("Roller radius R_r", c.roller_radius, "mm"))
+        if not c.oscillating:
+            if c.kind is ContactKind.FLAT:
                 rows.append(("Face offset", f.face_offset_mm or 0.0, "mm"))
             else:
                 rows.append(("Offset e", f.offset_mm or 0.0, "mm"))
-                rows.append(("Prime radius R_p", f.base_radius_mm + (f.roller_radius_mm or 0.0), "mm"))
+                rows.append(("Face-centre circle R_b + R" if c.curved_face else "Prime radius R_p",
+                             f.base_radius_mm + (c.roller_radius if circle else 0.0), "mm"))
         else:
             rows.append(("Pivot distance PivCen", f.pivot_distance_mm, "mm"))
-            if f.type == "flat":
+            if c.has_face:
                 rows.append(("Face offset (Excentricidad)", f.face_offset_mm or 0.0, "mm"))
             else:
                 rows.append(("Arm length", f.arm_length_mm, "mm"))
@@ -185,10 +201,14 @@ def camdas_columns(spec, geometry, *, step_deg: float = 1.0, profile: int = 0) -
             "C": f"V ({u}/s)", "D": f"A ({u}/s2)", "E": f"J ({u}/s3)", "F": "Radius of curvature (mm)"}
     cols: dict[str, np.ndarray] = {"A": geometry.to_user(x), "B": S[0], "C": S[1] * w, "D": S[2] * w**2,
                                    "E": S[3] * w**3, "F": np.where(np.isfinite(smp.rho), smp.rho, np.nan)}
-    if c.kind == "roller":
+    if c.kind is ContactKind.ROLLER:
         head["G"] = "Pressure angle (deg)"
         cols["G"] = np.degrees(smp.pressure_angle)
-    elif getattr(c, "xi0", None) is None:
+        if c.curved_face:
+            head["H"] = ("Contact arc length from the face vertex (mm)" if c.oscillating
+                         else "Contact position from the stem axis, + right (mm)")
+            cols["H"] = smp.face_position
+    elif not c.oscillating:
         head["G"], head["H"] = "Left contact distance (mm)", "Right contact distance (mm)"
         cols["G"], cols["H"] = np.maximum(-smp.face_position, 0.0), np.maximum(smp.face_position, 0.0)
     else:
@@ -199,11 +219,12 @@ def camdas_columns(spec, geometry, *, step_deg: float = 1.0, profile: int = 0) -
         cols["I"], cols["J"] = _polar(smp.point)
     head["L"], head["M"] = "Profile x (mm)", "Profile y (mm)"
     cols["L"], cols["M"] = smp.point[:, 0], smp.point[:, 1]
-    if c.kind == "roller" and smp.pitch is not None:
+    if c.kind is ContactKind.ROLLER and smp.pitch is not None:
+        what = "Face centre" if c.curved_face else "Pitch"
         if geometry.closed:
-            head["O"], head["P"] = "Pitch radius (mm)", "Pitch polar angle (deg)"
+            head["O"], head["P"] = f"{what} radius (mm)", f"{what} polar angle (deg)"
             cols["O"], cols["P"] = _polar(smp.pitch)
-        head["R"], head["S"] = "Pitch x (mm)", "Pitch y (mm)"
+        head["R"], head["S"] = f"{what} x (mm)", f"{what} y (mm)"
         cols["R"], cols["S"] = smp.pitch[:, 0], smp.pitch[:, 1]
     return head, cols
 

@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from ..design.kinds import FollowerType
 from ..results import CURVATURE_CODES, JUMP_CODES, IssueCode, Severity, Verdict
 
 __all__ = ["Axis", "axis_of", "sample_grid", "finding_spans", "fmt", "fmt_at", "range_text",
@@ -133,11 +134,12 @@ def range_text(f, unit: str = "°") -> str:
 
 
 def mechanism_text(spec) -> str:
-    """One line describing the mechanism ("disc cam (cw), translating roller follower")."""
+    """One line describing the mechanism ("disc cam (cw), translating roller follower"); the follower's name
+    is :attr:`FollowerType.title` ("roller", "flat-face", "knife-edge", "curved-face")."""
     c, f = spec.cam, spec.follower
     kind = c.kind.replace("_", "-")
     sense = f"slides {c.direction}" if c.kind == "translating" else c.rotation
-    ftype = "knife-edge" if f.type == "knife" else ("flat-face" if f.type == "flat" else "roller")
+    ftype = FollowerType(f.type).title
     double = "double " if c.kind in ("conjugate", "constant_width", "constant_diameter") else ""
     return f"{kind} cam ({sense}), {double}{f.motion} {ftype} follower"
 

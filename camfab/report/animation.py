@@ -3,8 +3,9 @@
 The browser does no kinematics: for ``frames`` cam angles (default 360, one per
 degree; a translating cam: evenly over its length) Python evaluates the exact
 geometry and stores, in the *fixed* frame (cam centre at the origin, follower
-above), every follower's primitives — roller circle, face segment, stem or arm
-line, contact point and line of action — plus the cam outline in the *cam*
+above), every follower's primitives — roller circle, face segment, curved face
+(an arc about its centre of curvature), stem or arm line, contact point and line
+of action — plus the cam outline in the *cam*
 frame.  The script of ``templates/report/animation.js`` rotates the outline by
 −σφ (σ = +1 clockwise, as :mod:`camfab.design.profile` maps a fixed point q to
 ``R(σφ)·q`` in the cam frame) or slides it (translating cam), and draws the
@@ -115,7 +116,7 @@ def animation_data(spec, geometry, report, *, frames: int = 360, outline_points:
             circles.append({"r": spec.manufacturing.bore_mm / 2, "kind": "bore"})
     pivot = None
     c0 = geometry.profiles[0]
-    if getattr(c0, "xi0", None) is not None:
+    if c0.oscillating:
         pivot = [float(c0.m), 0.0]
     pa_lim = report.pressure_angle.limit if report.pressure_angle is not None else None
     return {
@@ -131,6 +132,42 @@ def animation_data(spec, geometry, report, *, frames: int = 360, outline_points:
     }
 
 
+def _curved_face(out: dict[str, Any], pts: list, centre: np.ndarray, normal: np.ndarray, r: float,
+                 pivot: np.ndarray | None, stem: float) -> np.ndarray:
+    """A curved face: the arc of radius ``r`` about its centre of curvature that the contact runs over (plus
+    a margin; from the vertex on for a finger), on a stem rising from the vertex (mushroom) or on the arm
+    from the pivot to the vertex (finger).  Fills ``out["centre"]`` and ``out["arc"]`` (per frame the arc's
+    start and end angles, radians, counter-clockwise in the fixed frame) and returns the link."""
+    if pivot is None:  # the vertex is the face's lowest point, on the stem axis
+        up = float(np.sign(np.median(centre[:, 1])) or 1.0)
+        vertex_dir = np.broadcast_to(np.array([0.0, -up]), centre.shape)
+    else:  # the vertex lies on the line from the pivot to the centre of curvature
+        arm = centre - pivot
+        vertex_dir = -arm / np.hypot(arm[:, 0], arm[:, 1])[:, None]
+    # ψ: the angle at the centre from the vertex to the contact (at −n), counter-clockwise
+    psi = np.arctan2(vertex_dir[:, 0] * -normal[:, 1] + vertex_dir[:, 1] * normal[:, 0],
+                     -(vertex_dir[:, 0] * normal[:, 0] + vertex_dir[:, 1] * normal[:, 1]))
+    lo, hi = float(psi.min()), float(psi.max())
+    lo, hi = (min(lo, 0.0), max(hi, 0.0)) if pivot is not None else (-max(-lo, hi), max(-lo, hi))
+    pad = 0.08 * (hi - lo) + 0.05 * stem / r
+    lo, hi = max(lo - pad, -0.9 * math.pi), min(hi + pad, 0.9 * math.pi)
+    base = np.arctan2(vertex_dir[:, 1], vertex_dir[:, 0])
+    out["centre"] = _r(centre.ravel())
+    out["arc"] = _r(np.stack([base + lo, base + hi], axis=1).ravel(), 8)
+    for t in np.linspace(0.0, 1.0, 9):  # the arc's extent, for the view
+        a = base + lo + t * (hi - lo)
+        pts.append(centre + r * np.stack([np.cos(a), np.sin(a)], axis=1))
+    vertex = centre + r * vertex_dir
+    if pivot is not None:
+        return np.concatenate([np.broadcast_to(pivot, vertex.shape), vertex], axis=1)
+    up = -vertex_dir[0, 1]
+    xg = float(np.median(vertex[:, 0]))
+    y0 = float(np.max(np.abs(vertex[:, 1]))) + 0.25 * stem
+    out["guides"] = [[xg + sx * 0.06 * stem, up * y0, xg + sx * 0.06 * stem, up * (y0 + 0.45 * stem)]
+                     for sx in (-1, 1)]
+    return np.concatenate([vertex, vertex + np.array([0.0, up * stem])], axis=1)
+
+
 def _follower(c, s, rot: np.ndarray, shift: np.ndarray, stem: float, closed: bool) -> dict[str, Any]:
     """Fixed-frame primitives of one follower over all frames."""
     def fixed(p):
@@ -141,11 +178,13 @@ def _follower(c, s, rot: np.ndarray, shift: np.ndarray, stem: float, closed: boo
     contact = fixed(s.point)
     normal = _rotate(s.normal, rot)
     tangent = np.stack([-normal[:, 1], normal[:, 0]], axis=1)
-    oscillating = getattr(c, "xi0", None) is not None
+    oscillating = c.oscillating
     pivot = np.array([float(getattr(c, "m", 0.0)), 0.0])
     out: dict[str, Any] = {"kind": c.kind, "r": float(c.roller_radius), "guides": []}
     pts = [contact]
-    if c.kind == "roller":
+    if c.curved_face:
+        link = _curved_face(out, pts, fixed(s.pitch), normal, c.roller_radius, pivot if oscillating else None, stem)
+    elif c.kind == "roller":
         centre = fixed(s.pitch)
         out["centre"] = _r(centre.ravel())
         pts.append(centre + c.roller_radius)

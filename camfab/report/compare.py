@@ -112,7 +112,7 @@ def compare_pressure_angle_figure(items, labels: Sequence[str] | None = None):
             for k, c in enumerate(geom.profiles):
                 x = sample_grid(c.period, c.breakpoints)
                 pa = c.evaluate(x).pressure_angle
-                if pa is None or (c.kind == "flat" and spec.follower.motion == "translating"):
+                if pa is None or (c.kind == "flat" and not c.oscillating):
                     continue
                 ax.plot(x * axis.scale, np.degrees(pa), color=f"C{i}", ls="-" if k == 0 else "--",
                         label=labels[i] + (f" cam {k + 1}" if len(geom.profiles) > 1 else ""))
@@ -171,6 +171,12 @@ def _part(obj, attr: str):
     return None if obj is None else getattr(obj, attr)
 
 
+def _vertex_face_length(rep):
+    """How far from its vertex the contact runs on an oscillating face, flat or curved (None otherwise)."""
+    face = rep.face_length
+    return None if face is None or face.left is not None else face.max
+
+
 def comparison_rows(items) -> list[dict[str, Any]]:
     """The side-by-side table: ``[{"label": str, "cells": [{"text", "value", "cls"}, ...]}, ...]``,
     one cell per design (``value`` is the exact report number, or None)."""
@@ -188,6 +194,7 @@ def comparison_rows(items) -> list[dict[str, Any]]:
                                  f"{s.speed * 30 / math.pi:.4g} rpm"))
     add("Base radius Rb (mm)", lambda s, r: _c(s.follower.base_radius_mm))
     add("Roller radius (mm)", lambda s, r: _c(s.follower.roller_radius_mm if s.follower.type == "roller" else None))
+    add("Face radius (mm)", lambda s, r: _c(s.follower.face_radius_mm))
     add("DMIN (mm)", lambda s, r: _c(None if r.base_radius_mm is None else 2 * r.base_radius_mm))
     add("DMAX (mm)", lambda s, r: _c(None if r.max_radius_mm is None else 2 * r.max_radius_mm))
     add("Profile area (mm²)", lambda s, r: _c(r.area_mm2))
@@ -202,6 +209,7 @@ def comparison_rows(items) -> list[dict[str, Any]]:
     add("Pressure-angle limit (°)", lambda s, r: _c(_part(r.pressure_angle, "limit"), digits=1))
     add("Face length left (mm)", lambda s, r: _c(_part(r.face_length, "left")))
     add("Face length right (mm)", lambda s, r: _c(_part(r.face_length, "right")))
+    add("Contact from the face vertex, max (mm)", lambda s, r: _c(_vertex_face_length(r)))
     add("Min contact force (N)", lambda s, r: _c(_min_contact_force(r)))
     add("Max contact force (N)", lambda s, r: _c(_max_contact_force(r)))
     add("Peak drive torque (N·m)", lambda s, r: _c(_peak_torque(r)))
@@ -231,7 +239,7 @@ def render_comparison(items, *, standalone: bool = False) -> dict[str, bytes]:
         raise ValueError("render_comparison needs at least one (spec, geometry, report) item")
     labels = design_labels(items)
     figs = {"svaj": compare_svaj_figure(items, labels), "curvature": compare_curvature_figure(items, labels)}
-    if any(c.kind == "roller" or s.follower.motion == "oscillating" for s, g, _ in items for c in g.profiles):
+    if any(c.kind == "roller" or c.oscillating for _, g, _ in items for c in g.profiles):
         figs["pressure_angle"] = compare_pressure_angle_figure(items, labels)
     files, plots = plot_files(figs, standalone=standalone)
     ctx = common_context(None)

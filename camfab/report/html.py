@@ -27,7 +27,7 @@ from ._common import (VERDICT_CLASS, VERDICT_TEXT, _cell, axis_of, conclusions_r
                       mechanism_text, range_text)
 
 __all__ = ["render_report", "write_files", "template_environment", "report_context", "dynamics_rows", "PLOT_TEXT",
-           "require_report_dependencies"]
+           "CURVED_PLOT_TEXT", "plot_text", "require_report_dependencies"]
 
 #: file stem → (title, caption) of every report plot
 PLOT_TEXT = {
@@ -50,6 +50,32 @@ PLOT_TEXT = {
                  "safety force, purple: self-locking. Below: the drive torque (drive force of a translating "
                  "cam) that keeps the speed constant."),
 }
+#: what changes in :data:`PLOT_TEXT` for a curved-face follower (its pitch curve is the path of the face's
+#: centre of curvature; its contact runs along the face)
+CURVED_PLOT_TEXT = {
+    "profile": ("Cam profile",
+                "Cam frame (the follower sits at +Y at 0°); contact points every 30°, labelled every 90°; "
+                "DMIN/DMAX are the smallest and largest diameters of the profile. The path of the face's centre "
+                "of curvature, a face radius further out, is in the workbook and on the DXF's PITCH_CURVE layer."),
+    "curvature": ("Radius of curvature",
+                  "Signed: positive is convex. A curved face touches the cam as a roller of the face radius centred "
+                  "at the face's centre of curvature, so ρ is the radius of that centre's path less the face "
+                  "radius and must stay positive (else undercut); red bands mark undercuts, cusps and stretches "
+                  "too tight for the cutter."),
+    "face_position": ("Curved-face contact position",
+                      "Where the cam touches the face (from the stem axis for a translating face, the arc length "
+                      "from the vertex for a face on an arm); the green band is the face length needed."),
+}
+
+
+def plot_text(geometry) -> dict[str, tuple[str, str]]:
+    """The (title, caption) of every report plot for ``geometry``: :data:`PLOT_TEXT`, with the curved face's
+    words when a contact is one."""
+    if any(c.curved_face for c in geometry.profiles):
+        return {**PLOT_TEXT, **CURVED_PLOT_TEXT}
+    return PLOT_TEXT
+
+
 #: finding codes of the follower dynamics (the contact-force row of the dynamics table)
 _DYNAMICS_CODES = ((IssueCode.SELF_LOCKING, "Friction wedges the follower: see the findings"),
                    (IssueCode.FOLLOWER_JUMP, "The follower leaves the cam (N < 0): see the findings"),
@@ -100,8 +126,11 @@ def common_context(source: str | None) -> dict[str, Any]:
             "source": Path(source).name if source else None}
 
 
-def plot_files(figures: Mapping[str, Any], *, standalone: bool = False) -> tuple[dict[str, bytes], list[dict]]:
-    """Render figures to ``plots/<name>.png|svg`` and describe them for the templates."""
+def plot_files(figures: Mapping[str, Any], *, standalone: bool = False,
+               text: Mapping[str, tuple[str, str]] | None = None) -> tuple[dict[str, bytes], list[dict]]:
+    """Render figures to ``plots/<name>.png|svg`` and describe them for the templates (titles and captions
+    from ``text``, default :data:`PLOT_TEXT`)."""
+    text = PLOT_TEXT if text is None else text
     from .plots import figure_bytes
 
     files: dict[str, bytes] = {}
@@ -110,7 +139,7 @@ def plot_files(figures: Mapping[str, Any], *, standalone: bool = False) -> tuple
         png, svg = figure_bytes(fig, "png"), figure_bytes(fig, "svg")
         files[f"plots/{name}.png"], files[f"plots/{name}.svg"] = png, svg
         w, h = (fig.get_size_inches() * 110).round().astype(int)
-        title, caption = PLOT_TEXT.get(name, (name.replace("_", " ").capitalize(), ""))
+        title, caption = text.get(name, (name.replace("_", " ").capitalize(), ""))
         src = ("data:image/svg+xml;base64," + base64.b64encode(svg).decode("ascii")) if standalone \
             else f"plots/{name}.svg"
         plots.append({"name": name, "title": title, "caption": caption, "src": src, "png": f"plots/{name}.png",
@@ -317,7 +346,8 @@ def render_report(spec, geometry, report, *, standalone: bool = False, frames: i
     from .animation import animation_data
     from .plots import report_figures
 
-    files, plots = plot_files(report_figures(spec, geometry, report), standalone=standalone)
+    files, plots = plot_files(report_figures(spec, geometry, report), standalone=standalone,
+                              text=plot_text(geometry))
     anim = animation_data(spec, geometry, report, frames=frames)
     html = template_environment().get_template("report.html.j2").render(
         report_context(spec, geometry, report, plots, anim))

@@ -1,5 +1,6 @@
 """Report figures (matplotlib): S-V-A-J, profile, radius of curvature, pressure
-angle, flat-face contact position and (designs with ``[dynamics]``) follower dynamics.
+angle, face contact position (flat and curved faces) and (designs with ``[dynamics]``)
+follower dynamics.
 
 Every function returns a :class:`matplotlib.figure.Figure` built without pyplot:
 the figure gets its own Agg canvas, so no global backend is switched and
@@ -22,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from ..design.kinds import ContactKind
 from ..results import Extreme, IssueCode
 from ._common import CURVATURE_CODES, Axis, axis_of, finding_spans, fmt, fmt_at, sample_grid
 
@@ -181,7 +183,8 @@ def _circle(ax, r: float, **kw) -> None:
 
 
 def profile_figure(spec, geometry, report):
-    """The cam profile(s) in the cam frame with base, prime, DMIN/DMAX circles and pitch curve.
+    """The cam profile(s) in the cam frame with base, prime, DMIN/DMAX circles and pitch curve (not for a
+    curved face: its centre of curvature runs a face radius further out and would dwarf the cam).
 
     Parameters
     ----------
@@ -198,6 +201,8 @@ def profile_figure(spec, geometry, report):
     """
     rr = spec.follower.roller_radius_mm or 0.0
     multi = len(geometry.profiles) > 1
+    # a curved face's pitch curve (its centre of curvature) lies a face radius out and would dwarf the cam
+    curved = any(c.curved_face for c in geometry.profiles)
     with plot_style():
         fig = new_figure(8.8, 6.6)
         ax = fig.subplots()
@@ -208,7 +213,7 @@ def profile_figure(spec, geometry, report):
             col = f"C{k}"
             tag = f"cam {k + 1} " if multi else ""
             ax.plot(s.point[:, 0], s.point[:, 1], color=col, lw=2.0, label=f"{tag}profile")
-            if s.pitch is not None and c.roller_radius > 0:
+            if s.pitch is not None and c.roller_radius > 0 and not c.curved_face:
                 ax.plot(s.pitch[:, 0], s.pitch[:, 1], color=col, lw=0.9, ls="--", label=f"{tag}pitch curve")
             if c.closed:
                 _angle_marks(ax, c, col)
@@ -216,7 +221,7 @@ def profile_figure(spec, geometry, report):
             rb = spec.follower.base_radius_mm
             if rb:
                 _circle(ax, rb, color="0.35", lw=0.9, ls=(0, (4, 3)), label=f"base circle Rb = {rb:g} mm")
-                if rr > 0 and spec.cam.kind not in ("constant_width",):
+                if rr > 0 and spec.cam.kind not in ("constant_width",) and not curved:
                     _circle(ax, rb + rr, color="0.35", lw=0.8, ls="-.", label=f"prime circle Rp = {rb + rr:g} mm")
             if report.base_radius_mm is not None:
                 _circle(ax, report.base_radius_mm, color=_BAD, lw=0.8,
@@ -278,7 +283,9 @@ def curvature_figure(spec, geometry, report, *, n: int = _N):
     """Radius of curvature against the cam angle, with undercut/cusp/cutter violations shaded.
 
     ρ is signed (positive = convex); it passes through ±∞ at inflections, so the view is
-    clipped to a few times the cam size.  Rollers also show the pitch-curve radius ρₚ.
+    clipped to a few times the cam size.  Rollers also show the pitch-curve radius ρₚ; a curved
+    face does not (its centre of curvature's path, ρₚ = ρ + R, lies a face radius above ρ: its
+    undercut limit ρₚ = R is the line ρ = 0).
 
     Returns
     -------
@@ -298,11 +305,12 @@ def curvature_figure(spec, geometry, report, *, n: int = _N):
             rho = _off_view(s.rho, lim)
             ax.plot(x * axis.scale, rho, color=f"C{k}", label=f"{tag}profile ρ")
             lo, hi = min(lo, np.nanmin(rho, initial=0.0)), max(hi, np.nanmax(rho, initial=0.0))
-            if s.rho_pitch is not None and c.roller_radius > 0:
+            if s.rho_pitch is not None and c.roller_radius > 0 and not c.curved_face:
                 ax.plot(x * axis.scale, _off_view(s.rho_pitch, lim), color=f"C{k}", lw=0.8, ls="--",
                         label=f"{tag}pitch curve ρₚ")
         ax.axhline(0.0, color="0.1", lw=0.9, label="ρ = 0 (cusp limit)")
-        rr = max((c.roller_radius for c in geometry.profiles if c.kind == "roller"), default=0.0)
+        rr = max((c.roller_radius for c in geometry.profiles if c.kind == "roller" and not c.curved_face),
+                 default=0.0)
         if rr > 0:
             ax.axhline(rr, color=_BAD, lw=0.9, ls=":", label=f"ρₚ = roller radius {rr:g} mm (undercut limit)")
         tool = spec.manufacturing.tool_diameter_mm
@@ -372,13 +380,21 @@ def pressure_angle_figure(spec, geometry, report, *, n: int = _N):
 
 
 def face_position_figure(spec, geometry, report, *, n: int = _N):
-    """Contact position along the flat face against the cam angle, with the face extent needed.
+    """Contact position along the follower's face (flat or curved) against the cam angle, with the face
+    extent needed: from the stem axis for a translating face, from the vertex for a face on an arm (a
+    curved face's arc length).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
     axis = axis_of(spec.program())
+    faces = [c for c in geometry.profiles if c.has_face]
+    word = "curved-face" if any(c.curved_face for c in faces) else "flat-face"
+    if faces and all(c.oscillating for c in faces):
+        where = "arc length from the vertex" if word == "curved-face" else "distance from the vertex"
+    else:
+        where = "+ = right of the stem"
     face = report.face_length
     multi = len(geometry.profiles) > 1
     with plot_style():
@@ -407,7 +423,7 @@ def face_position_figure(spec, geometry, report, *, n: int = _N):
         x_axis(ax, axis)
         ax.margins(y=0.15)
         ax.set_ylabel("contact position on the face (mm)")
-        ax.set_title(f"{spec.name}: flat-face contact position (+ = right of the stem)")
+        ax.set_title(f"{spec.name}: {word} contact position ({where})")
         ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     return fig
 
@@ -511,16 +527,16 @@ def report_figures(spec, geometry, report) -> dict[str, Any]:
     """The figures of one design's report, by file stem, in reading order.
 
     ``pressure_angle`` is included when some follower has a pressure angle that varies
-    (rollers, oscillating faces); ``face_position`` when a follower is a flat face; ``dynamics``
-    when the design has a ``[dynamics]`` section.
+    (rollers, curved faces, oscillating faces); ``face_position`` when a follower has a face (flat or
+    curved: :attr:`~camfab.design.profile.Contact.has_face`); ``dynamics`` when the design has a
+    ``[dynamics]`` section.
     """
     figs: dict[str, Any] = {"svaj": svaj_figure(spec, spec.program()),
                             "profile": profile_figure(spec, geometry, report),
                             "curvature": curvature_figure(spec, geometry, report)}
-    kinds = {c.kind for c in geometry.profiles}
-    if "roller" in kinds or spec.follower.motion == "oscillating":
+    if any(c.kind is ContactKind.ROLLER or c.oscillating for c in geometry.profiles):
         figs["pressure_angle"] = pressure_angle_figure(spec, geometry, report)
-    if "flat" in kinds:
+    if any(c.has_face for c in geometry.profiles):
         figs["face_position"] = face_position_figure(spec, geometry, report)
     if spec.dynamics is not None:
         figs["dynamics"] = dynamics_figure(spec, geometry, report)

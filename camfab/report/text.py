@@ -115,9 +115,12 @@ def _geometry_rows(report, codes) -> list[tuple[str, str, str, str]]:
         rows.append(("Pressure angle (°)", _num(pa.max), _num(pa.min),
                      "Acceptable" if ok else f"High pressure angle (> {pa.limit:g}°)"))
     face = report.face_length
-    if face is not None:
+    if face is not None and face.left is not None:
         rows.append(("Face length left / right (mm)", _num(face.left), _num(face.right),
                      "minimum face length on each side to keep contact"))
+    elif face is not None:  # an oscillating face: the contact's distance from the vertex
+        rows.append(("Contact along the face (mm)", _num(face.max), _num(face.min),
+                     "distance of the contact from the face vertex"))
     return rows
 
 

@@ -1,7 +1,7 @@
 /* camfab report: mechanism animation (vanilla JS, no network).
  * Reads the precomputed frames of camfab.report.animation from <script id="anim-data">
  * and draws them on <canvas id="anim-canvas">: the cam turning about its centre (or
- * sliding), the follower of the same frame, the contact point with its line of action,
+ * sliding), the follower of the same frame (a curved face as its arc), the contact point with its line of action,
  * and a strip with S against the cam angle.  Controls: #anim-play, #anim-speed, #anim-angle.
  */
 (function () {
@@ -123,7 +123,11 @@
         var F = f.face;
         line(F[j], F[j + 1], F[j + 2], F[j + 3], COL.face, 5);
       }
-      if (f.kind === "roller") {
+      if (f.arc) {  // a curved face: the arc of the face about its centre of curvature
+        var A = f.arc, K = f.centre, h = 2 * i;
+        ctx.beginPath(); ctx.arc(X(K[h]), Y(K[h + 1]), f.r * view.s, -A[h], -A[h + 1], true);
+        ctx.strokeStyle = COL.face; ctx.lineWidth = 5; ctx.stroke();
+      } else if (f.kind === "roller") {
         var C = f.centre, m = 2 * i;
         if (f.r > 0) { circle(C[m], C[m + 1], f.r, COL.roller, COL.rollerLine, 1.5); }
         circle(C[m], C[m + 1], 0.012 * D.rmax, "#333");

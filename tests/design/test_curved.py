@@ -209,6 +209,39 @@ def test_a_small_face_radius_on_a_steep_cam_undercuts_like_the_roller():
         [(f.code, f.from_deg, f.to_deg) for f in b.findings]
 
 
+def test_undercut_advice_for_a_curved_face():
+    """The findings name the face and its radius, and their advice holds: a smaller face radius (or a larger
+    base circle) cures an undercut, as for a roller — a larger one sharpens the profile towards the flat
+    face's; a larger face radius lowers a mushroom's pressure angle (R_b + R grows)."""
+    steep = MotionProgram.from_segments([("cycloidal", 30, 40), ("dwell", 0, 140), ("cycloidal", -30, 40),
+                                         ("dwell", 0, 140)])
+    rep = check(TranslatingCurved(15, 25).geometry(steep))
+    under = [f.message for f in rep.findings if f.code == "UNDERCUT"]
+    assert under and all("smaller than the face radius (25 mm); the face cannot follow the law there" in m
+                         and m.endswith("Enlarge the base circle or use a smaller face radius") for m in under)
+    pa = [f.message for f in rep.findings if f.code == "PRESSURE_ANGLE_EXCEEDED"]
+    assert pa and all(m.endswith("change the offset or the law, or use a larger face radius") for m in pa)
+    assert not any("roller" in f.message for f in rep.findings)
+    assert "UNDERCUT" not in check(TranslatingCurved(15, 5).geometry(steep)).codes()
+    assert "UNDERCUT" not in check(TranslatingCurved(60, 25).geometry(steep)).codes()
+    # the smallest convex radius falls as R grows towards the flat face (valve_mushroom's geometry)
+    valve = MotionProgram.from_segments([("dwell", 0, 70), ("poly4567", 8, 110), ("poly4567", -8, 110),
+                                         ("dwell", 0, 70)])
+    convex = [check(m.geometry(valve)).curvature.min_convex
+              for m in (TranslatingCurved(20, 10, 1.5), TranslatingCurved(20, 60, 1.5), TranslatingFlat(20))]
+    assert convex == sorted(convex, reverse=True)
+    assert [round(v, 1) for v in convex] == [15.7, 13.3, 10.9]
+    big = [check(TranslatingCurved(15, r).geometry(steep)).pressure_angle.max for r in (5, 25, 100)]
+    assert big == sorted(big, reverse=True)
+    # a finger's pressure-angle advice names its own dimensions
+    swing = MotionProgram.from_segments([("poly4567", 30, 60), ("poly4567", -30, 60), ("dwell", 0, 240)],
+                                        lift_unit="deg")
+    rep = check(OscillatingCurved(20, 25, 60, 44.8).geometry(swing))
+    msgs = [f.message for f in rep.findings if f.code == "PRESSURE_ANGLE_EXCEEDED"]
+    assert msgs and all(m.endswith("move the pivot, or change the face offset, the face radius or the law")
+                        for m in msgs)
+
+
 @pytest.mark.parametrize("mech,path", [
     (TranslatingCurved(30, 0), "follower.face_radius_mm"),
     (TranslatingCurved(30, 10, 45), "follower.offset_mm"),

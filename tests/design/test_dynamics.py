@@ -9,10 +9,10 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from camfab.design.assemble import check_design, dynamics_of, loads_from_spec
+from camfab.design.assemble import check_design, dynamics_of, geometry_from_spec, loads_from_spec
 from camfab.design.dynamics import ContactDynamics, Loads, analyse_dynamics
-from camfab.design.mechanisms import OscillatingFlat, OscillatingRoller, TranslatingCamRoller, TranslatingFlat, \
-    TranslatingRoller
+from camfab.design.mechanisms import OscillatingCurved, OscillatingFlat, OscillatingRoller, TranslatingCamRoller, \
+    TranslatingCurved, TranslatingFlat, TranslatingRoller
 from camfab.design.profile import CamGeometry
 from camfab.design.program import MotionProgram
 from camfab.design.spec import design_from_dict
@@ -74,7 +74,7 @@ def test_translating_roller_force_is_axial_over_cos_pressure_angle():
 # property-based: power balance and energy per cycle over random designs
 @st.composite
 def cams(draw):
-    kind = draw(st.sampled_from(["tr", "knife", "tf", "or", "of", "wedge"]))
+    kind = draw(st.sampled_from(["tr", "knife", "tf", "or", "of", "wedge", "tc", "oc"]))
     rot = draw(st.sampled_from(["cw", "ccw"]))
     mu = draw(st.sampled_from([0.0, 0.0, 0.05, 0.2]))
     damping = draw(st.sampled_from([0.0, 0.0, 30.0]))
@@ -88,9 +88,14 @@ def cams(draw):
                       damping, 0.0, mu)
         return mech, prog, loads, speed
     speed = draw(st.floats(10.0, 1500.0)) * RPM
-    if kind in ("or", "of"):
+    if kind in ("or", "of", "oc"):
         m = draw(st.floats(60.0, 150.0))
-        if kind == "or":
+        if kind == "oc":  # a finger: the face's centre of curvature at A = f + R from the pivot
+            rb, R = draw(st.floats(20.0, 0.5 * m)), draw(st.floats(5.0, 80.0))
+            lo, hi = abs(m - rb - R) + 3, m + rb + R - 3
+            a = lo + draw(st.floats(0.1, 0.9)) * (hi - lo)
+            mech = OscillatingCurved(rb, R, m, a - R, rot)
+        elif kind == "or":
             a = draw(st.floats(0.6, 1.1)) * m
             rr = draw(st.floats(0.0, 10.0))
             rp = abs(a - m) + 5 + draw(st.floats(0.2, 0.6)) * (a + m - abs(a - m) - 10)
@@ -106,6 +111,8 @@ def cams(draw):
     rb = draw(st.floats(25.0, 80.0))
     if kind == "tf":
         mech = TranslatingFlat(rb, draw(st.floats(-5.0, 5.0)), rot)
+    elif kind == "tc":  # a mushroom: face radius from a near-roller to a near-flat face
+        mech = TranslatingCurved(rb, draw(st.floats(3.0, 500.0)), draw(st.floats(-0.3, 0.3)) * rb, rot)
     else:
         rr = 0.0 if kind == "knife" else draw(st.floats(2.0, 12.0))
         mech = TranslatingRoller(rb, rr, draw(st.floats(-0.3, 0.3)) * rb, rot)
@@ -164,19 +171,116 @@ def _friction_loss(d, y):
     return s.friction_force * np.hypot(*(u - w * qd[:, None]).T)
 
 
-def test_pressure_angle_free_force_matches_the_arm_moment_for_an_oscillating_roller():
-    """Oscillating roller: the contact force's moment about the pivot equals the required torque
-    (N·A·cos δ = G), an independent statement of the arm's moment balance."""
-    g = CamGeometry(OscillatingRoller(40.0, 10.0, 100.0, 90.0), SWING)
+@pytest.mark.parametrize("mech,mu", [
+    (OscillatingRoller(40.0, 10.0, 100.0, 90.0), 0.0),
+    (OscillatingCurved(40.0, 30.0, 100.0, 60.0), 0.08),
+    (OscillatingCurved(30.0, 20.0, 90.0, 75.0, "ccw"), 0.15),
+])
+def test_contact_force_moment_balances_the_arm(mech, mu):
+    """Oscillating roller (N·A·cos δ = G) and finger follower with friction: the moment about the pivot
+    of the force on the follower — N along the normal plus the friction μN along the cam's slip past the
+    follower's point at the contact — equals the required torque, an independent statement of the arm's
+    moment balance."""
+    g = CamGeometry(mech, SWING)
     c = g.profiles[0]
-    L = Loads(0.02, 30.0, 5.0)
+    assert c.sliding is (mu > 0)
+    L = Loads(0.02, 30.0, 5.0, friction_coefficient=mu)
     x = np.linspace(0.02, 2 * np.pi - 0.02, 400)
     s = ContactDynamics(c, L, W).evaluate(x)
     fs = c.evaluate_fixed(x)
-    arm = (fs.pitch - np.array([c.m, 0.0])) * 1e-3
-    force = s.contact_force[:, None] * fs.normal
+    force = s.contact_force[:, None] * (fs.normal + mu * _slip(c, fs.point, x, W))
+    arm = (fs.point - np.array([c.m, 0.0])) * 1e-3  # a roller's normal passes through its centre: same moment
     moment = -(arm[:, 0] * force[:, 1] - arm[:, 1] * force[:, 0])  # clockwise (ξ increasing) positive
     np.testing.assert_allclose(moment, s.required, rtol=1e-11, atol=1e-12 * np.abs(s.required).max())
+    np.testing.assert_allclose(s.friction_force, mu * s.contact_force, rtol=1e-14)
+
+
+def _slip(c, point, x, speed):
+    """Unit velocity of the cam's surface past the follower's material point at ``point`` (fixed frame,
+    mm): the cam turns at −σω about its centre, the follower's point turns clockwise about the pivot
+    (oscillating) or moves up (translating) at the rate of its lift."""
+    S1 = c.motion.evaluate(x, (1,))[0]
+    p = point * 1e-3
+    cam = -c.sense * speed * np.stack([-p[:, 1], p[:, 0]], axis=1)
+    if c.oscillating:
+        r = p - np.array([c.m * 1e-3, 0.0])
+        follower = (math.pi / 180 * S1 * speed)[:, None] * np.stack([r[:, 1], -r[:, 0]], axis=1)
+    else:
+        follower = np.stack([np.zeros_like(S1), 1e-3 * S1 * speed], axis=1)
+    rel = cam - follower
+    return rel / np.hypot(rel[:, 0], rel[:, 1])[:, None]
+
+
+@pytest.mark.parametrize("name", ["finger_follower", "valve_mushroom"])
+def test_curved_face_contact_force_from_first_principles(name):
+    """The contact force of the curved-face examples built without the contact's formulas: the face's
+    centre of curvature C from its definition (finger: pivot + (f + R)·n(ξ), ξ = ξ₀ + S; mushroom:
+    (e, √((R_b + R)² − e²) + S)), the contact as the point of the cam's profile, turned to the cam angle,
+    nearest to C (at the distance R), the normal along P→C, friction μN along the cam's slip, and the
+    balance of the follower — moments about the pivot, or forces along the stem — against the spring,
+    inertia and preload; with the example's friction μ = 0.05."""
+    from scipy.optimize import minimize_scalar
+
+    spec = load_design(EXAMPLES / f"{name}.toml")
+    g = geometry_from_spec(spec)
+    c, mech, L = g.profiles[0], g.mechanism, loads_from_spec(spec.dynamics)
+    w = spec.speed
+    assert L.friction_coefficient == 0.05 and c.sliding and c.curved_face
+    x = np.radians(np.arange(2.5, 360.0, 7.5))
+    S = spec.program().evaluate(x, (0, 1, 2))
+    R = mech.face_radius_mm
+    if c.oscillating:
+        xi = mech.initial_arm_angle + np.radians(S[0])
+        pivot = np.array([mech.pivot_distance_mm, 0.0])
+        C = pivot + (mech.face_offset_mm + R) * np.stack([np.sin(xi), np.cos(xi)], axis=1)
+        k = math.pi / 180  # q in rad per degree of S
+    else:
+        e = mech.offset_mm
+        C = np.stack([np.full_like(x, e), math.sqrt((mech.base_radius_mm + R) ** 2 - e * e) + S[0]], axis=1)
+        k = 1e-3  # q in m per mm of S
+    G = L.inertia * k * S[2] * w * w + L.preload + L.spring_rate * k * S[0]
+    grid = np.linspace(0.0, 2 * np.pi, 7201)
+    prof = c.evaluate(grid).point  # the cam (cam frame)
+    P = np.empty_like(C)
+    for i, (phi, ci) in enumerate(zip(x, C, strict=True)):
+        turn = -c.sense * phi  # the cam frame → the fixed frame at cam angle φ
+        cs, sn = math.cos(turn), math.sin(turn)
+
+        def dist(t, ci=ci, cs=cs, sn=sn):
+            q = c.evaluate(np.array([t])).point[0]
+            return math.hypot(q[0] * cs - q[1] * sn - ci[0], q[0] * sn + q[1] * cs - ci[1])
+
+        fixed = np.stack([prof[:, 0] * cs - prof[:, 1] * sn, prof[:, 0] * sn + prof[:, 1] * cs], axis=1)
+        j = int(np.argmin(np.hypot(*(fixed - ci).T)))
+        t = minimize_scalar(dist, bracket=(grid[j - 1], grid[j], grid[j + 1]), tol=1e-12).x
+        def slope(u, ci=ci, cs=cs, sn=sn):  # (q − C)·q′: 0 at the nearest point
+            q, d = _turned(c, u, cs, sn)
+            return float(np.dot(q - ci, d))
+
+        for _ in range(3):  # polish the minimiser's t with secant steps on the slope
+            f0, f1 = slope(t), slope(t + 1e-7)
+            t -= f0 * 1e-7 / (f1 - f0) if f1 != f0 else 0.0
+        P[i] = _turned(c, t, cs, sn)[0]
+    np.testing.assert_allclose(np.hypot(*(P - C).T), R, rtol=0, atol=1e-9)  # the face touches the cam
+    n = (C - P) / R
+    F = n + L.friction_coefficient * _slip(c, P, x, w)  # force on the follower per newton of N
+    if c.oscillating:
+        arm = (P - pivot) * 1e-3
+        lever = -(arm[:, 0] * F[:, 1] - arm[:, 1] * F[:, 0])  # clockwise moment per newton
+    else:
+        lever = F[:, 1]  # along the stem
+    N = G / lever
+    got = ContactDynamics(c, L, w).evaluate(x).contact_force
+    np.testing.assert_allclose(got, N, rtol=1e-9)
+    assert N.min() > L.safety_force_n
+
+
+def _turned(c, t, cs, sn):
+    """The profile point and its tangent (d/dt) at cam-frame parameter t, turned by the angle (cos, sin)."""
+    s = c.evaluate(np.array([t]))
+    q, d = s.point[0], s.point_d1[0]
+    return (np.array([q[0] * cs - q[1] * sn, q[0] * sn + q[1] * cs]),
+            np.array([d[0] * cs - d[1] * sn, d[0] * sn + d[1] * cs]))
 
 
 # ---------------------------------------------------------------------------
@@ -269,6 +373,22 @@ def test_bad_dynamics_input_is_refused_naming_the_field(dyn, over, path):
     assert any(p.path == path for p in err.value.problems), [p.path for p in err.value.problems]
 
 
+def test_a_curved_face_slides_and_takes_friction():
+    """A curved face (mushroom or finger) is accepted with a friction coefficient, as a flat face is; a
+    roller is refused it."""
+    mushroom = {"type": "curved", "base_radius_mm": 30, "face_radius_mm": 80, "offset_mm": 2}
+    spec = _design({"mass_kg": 0.1, "spring_rate_n_per_mm": 20, "spring_preload_n": 200,
+                    "friction_coefficient": 0.06}, follower=mushroom)
+    assert loads_from_spec(spec.dynamics).friction_coefficient == 0.06
+    g = geometry_from_spec(spec)
+    assert g.profiles[0].sliding and g.profiles[0].curved_face
+    rep = check_design(spec)
+    assert rep.dynamics.work_per_cycle_j > 0  # friction dissipates
+    with pytest.raises(SpecError):
+        _design({"mass_kg": 0.1, "friction_coefficient": 0.06},
+                follower={"type": "roller", "base_radius_mm": 30, "roller_radius_mm": 8})
+
+
 def test_check_report_carries_dynamics_and_its_verdict():
     ok = check_design(_design({"mass_kg": 0.2, "spring_rate_n_per_mm": 20, "spring_preload_n": 200,
                                "safety_force_n": 100}))
@@ -282,7 +402,7 @@ def test_check_report_carries_dynamics_and_its_verdict():
     assert dynamics_of(_design({"mass_kg": 0.2, "spring_preload_n": 200})).summary.safety_force_n == 0.0
 
 
-@pytest.mark.parametrize("name", ["valve_exhaust_ej1", "press_feed_oscillating"])
+@pytest.mark.parametrize("name", ["valve_exhaust_ej1", "press_feed_oscillating", "valve_mushroom", "finger_follower"])
 def test_examples_with_dynamics_hold_their_safety_force(name):
     rep = check_design(load_design(EXAMPLES / f"{name}.toml"))
     d = rep.to_dict()["dynamics"]

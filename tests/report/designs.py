@@ -43,6 +43,14 @@ DESIGNS = {
         name="ConstDiam", cam={"kind": "constant_diameter"},
         follower={"type": "roller", "motion": "translating", "base_radius_mm": 40.0, "roller_radius_mm": 8.0,
                   "width_mm": 100.0}).items() if k != "motion"},
+    "mushroom": base_design(
+        name="Mushroom", cam={"kind": "disc", "rotation": "ccw", "speed_rpm": 600.0},
+        follower={"type": "curved", "motion": "translating", "base_radius_mm": 40.0, "face_radius_mm": 30.0,
+                  "offset_mm": 2.0}),
+    "finger": base_design(
+        name="Finger", follower={"type": "curved", "motion": "oscillating", "base_radius_mm": 30.0,
+                                 "face_radius_mm": 25.0, "pivot_distance_mm": 90.0, "face_offset_mm": 70.0},
+        motion=_OSC),
     # small base circle: undercut and pressure-angle errors (unacceptable)
     "bad_roller": base_design(
         name="TooSmall", follower={"type": "roller", "motion": "translating", "base_radius_mm": 12.0,

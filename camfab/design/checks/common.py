@@ -20,7 +20,7 @@ from ..kinds import ContactKind
 from ..profile import Contact, ProfileSample
 
 __all__ = ["Limits", "RuleResult", "ContactSample", "QUANTITIES", "CUSP_TOL_MM", "DEFAULT_PRESSURE_LIMIT_DEG",
-           "radius", "span_text"]
+           "Words", "words", "radius", "span_text"]
 
 #: a radius margin within this many mm of its limit is a cusp (not an undercut)
 CUSP_TOL_MM = 1e-7
@@ -63,6 +63,27 @@ class RuleResult:
 
     findings: tuple[Finding, ...] = ()
     fields: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Words:
+    """How the findings of a circle-touching contact name its follower.
+
+    Attributes
+    ----------
+    surface : str
+        What touches the cam: "roller" or "face".
+    size : str
+        What its radius R is called: "roller" (as in "smaller than the roller (7 mm)") or "face radius".
+    """
+
+    surface: str
+    size: str
+
+
+def words(contact: Contact) -> Words:
+    """The words for a roller (knife edge: radius 0) or a curved face (:attr:`Contact.curved_face`)."""
+    return Words("face", "face radius") if contact.curved_face else Words("roller", "roller")
 
 
 def radius(s: ProfileSample) -> np.ndarray:

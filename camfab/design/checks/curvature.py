@@ -1,7 +1,8 @@
 """The curvature rule: undercut, cusp and concave stretches tighter than the cutter.
 
-* ``UNDERCUT`` (error) — rollers: the pitch curve is convex with radius 0 < ρ_p < R_r (the
-  roller cannot follow it: judged on the pitch curve, whose radius is the profile's plus R_r);
+* ``UNDERCUT`` (error) — rollers and curved faces: the pitch curve (the roller centre's path, the
+  face's centre of curvature's) is convex with radius 0 < ρ_p < R_r (the roller or face cannot
+  follow it: judged on the pitch curve, whose radius is the profile's plus R_r);
   flat faces: ρ < 0 (the profile crosses itself between two cusps).
 * ``CUSP`` (error) — the limit case: ρ_p = R_r (roller) or ρ = 0 (flat face) within
   :data:`~.common.CUSP_TOL_MM`: the profile has a sharp point.
@@ -17,7 +18,7 @@ import numpy as np
 from ...results import Curvature, Finding, IssueCode, Severity
 from ..kinds import ContactKind
 from ..profile import Contact
-from .common import CUSP_TOL_MM, ContactSample, Limits, RuleResult, span_text
+from .common import CUSP_TOL_MM, ContactSample, Limits, RuleResult, Words, span_text, words
 
 __all__ = ["curvature_rule"]
 
@@ -29,16 +30,17 @@ def curvature_rule(contact: Contact, limits: Limits, sample: ContactSample) -> R
     return _face(sample)
 
 
-def _cusp(sample: ContactSample, x: float, value: float, limit: float, why: str) -> Finding:
+def _cusp(sample: ContactSample, x: float, value: float, limit: float, why: str, size: str = "roller") -> Finding:
     a = sample.user(x)
     return Finding(IssueCode.CUSP, Severity.ERROR, a, a, value, limit,
                    f"cusp at {a:.6g}{sample.unit}: {why}, so the profile has a sharp point with very high contact "
-                   "stress. Enlarge the base circle (or use a smaller roller)")
+                   f"stress. Enlarge the base circle (or use a smaller {size})")
 
 
 def _roller(contact: Contact, limits: Limits, sample: ContactSample) -> RuleResult:
-    """Rollers (knife edges: radius 0): judged on the pitch-curve curvature κ_p."""
-    rr = contact.roller_radius
+    """Rollers (knife edges: radius 0) and curved faces: judged on the pitch-curve curvature κ_p (a curved
+    face's pitch curve is the path of its centre of curvature)."""
+    rr, say = contact.roller_radius, words(contact)
     lim = max(rr, limits.tool_radius_mm or 0.0)
     (xb, kmin), (xa, kmax) = sample.extremes("curvature_pitch")
     convex, concave = kmax > 0, kmin < 0
@@ -52,9 +54,11 @@ def _roller(contact: Contact, limits: Limits, sample: ContactSample) -> RuleResu
     found = sample.ranges(*wanted) if wanted else []
     out: list[Finding] = []
     if undercut:
-        out += _undercuts(sample, found.pop(0), rr)
+        out += _undercuts(sample, found.pop(0), rr, say)
     elif rr > 0 and convex and rr - 1.0 / kmax >= -CUSP_TOL_MM:
-        out.append(_cusp(sample, xa, 1.0 / kmax, rr, "the pitch-curve radius equals the roller radius"))
+        why = ("the radius of the path of the face's centre of curvature equals the face radius" if contact.curved_face
+               else "the pitch-curve radius equals the roller radius")
+        out.append(_cusp(sample, xa, 1.0 / kmax, rr, why, say.size))
     if tight:
         fits = 1.0 / -kmin + rr
         out += [Finding(IssueCode.CONCAVE_RADIUS_BELOW_ROLLER, Severity.WARNING, sample.user(lo), sample.user(hi),
@@ -65,16 +69,18 @@ def _roller(contact: Contact, limits: Limits, sample: ContactSample) -> RuleResu
     return RuleResult(tuple(out), {"curvature": summary})
 
 
-def _undercuts(sample: ContactSample, ranges, rr: float) -> list[Finding]:
-    """UNDERCUT from the ranges where R_r·κ_p − 1 > 0 (the worst value gives the smallest ρ_p)."""
+def _undercuts(sample: ContactSample, ranges, rr: float, say: Words) -> list[Finding]:
+    """UNDERCUT from the ranges where R_r·κ_p − 1 > 0 (the worst value gives the smallest ρ_p).  As for a
+    roller, the advice for a curved face is a smaller face radius or a larger base circle (a larger face
+    radius, towards the flat face, sharpens the profile: tested)."""
     out = []
     for lo, hi, xw, gw in ranges:
         rp = rr / (1.0 + gw)
         out.append(Finding(IssueCode.UNDERCUT, Severity.ERROR, sample.user(lo), sample.user(hi), rp, rr,
                            f"undercut {span_text(sample, lo, hi)}: the pitch curve is convex with radius down to "
-                           f"{rp:.6g} mm (at {sample.user(xw):.6g}{sample.unit}), smaller than the roller "
-                           f"({rr:.6g} mm); the roller cannot follow the law there. Enlarge the base circle or use a "
-                           "smaller roller"))
+                           f"{rp:.6g} mm (at {sample.user(xw):.6g}{sample.unit}), smaller than the {say.size} "
+                           f"({rr:.6g} mm); the {say.surface} cannot follow the law there. Enlarge the base circle or "
+                           f"use a smaller {say.size}"))
     return out
 
 

@@ -8,7 +8,7 @@ import math
 from ...results import Finding, IssueCode, PressureAngle, Severity
 from ..kinds import ContactKind
 from ..profile import Contact
-from .common import DEFAULT_PRESSURE_LIMIT_DEG, ContactSample, Limits, RuleResult, span_text
+from .common import DEFAULT_PRESSURE_LIMIT_DEG, ContactSample, Limits, RuleResult, span_text, words
 
 __all__ = ["pressure_angle_rule"]
 
@@ -17,7 +17,7 @@ _PA_TOL_RAD = 1e-10
 
 
 def pressure_angle_rule(contact: Contact, limits: Limits, sample: ContactSample) -> RuleResult:
-    """Pressure-angle extremes and the ranges beyond ± the limit (rollers and knife edges)."""
+    """Pressure-angle extremes and the ranges beyond ± the limit (rollers, knife edges and curved faces)."""
     if contact.kind is not ContactKind.ROLLER:
         return RuleResult()
     lim_deg = limits.pressure_angle_deg
@@ -36,5 +36,13 @@ def pressure_angle_rule(contact: Contact, limits: Limits, sample: ContactSample)
                                val, sign * lim_deg,
                                f"pressure angle {val:.4g}° (at {sample.user(xw):.6g}{sample.unit}) exceeds "
                                f"±{lim_deg:.4g}° {span_text(sample, lo, hi)}: high side load, risk of jamming. "
-                               "Enlarge the base circle, change the offset or the law, or use a larger roller"))
+                               + _remedy(contact)))
     return RuleResult(tuple(out), {"pressure_angle": summary})
+
+
+def _remedy(contact: Contact) -> str:
+    """What lowers the pressure angle: for a roller or a mushroom (whose face centre is a roller's centre) a
+    larger base circle, offset, law or radius; a finger follower's depends on where its pivot and face sit."""
+    if contact.curved_face and contact.oscillating:
+        return "Enlarge the base circle, move the pivot, or change the face offset, the face radius or the law"
+    return f"Enlarge the base circle, change the offset or the law, or use a larger {words(contact).size}"
