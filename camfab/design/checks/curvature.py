@@ -44,9 +44,7 @@ def _roller(contact: Contact, limits: Limits, sample: ContactSample) -> RuleResu
     lim = max(rr, limits.tool_radius_mm or 0.0)
     (xb, kmin), (xa, kmax) = sample.extremes("curvature_pitch")
     convex, concave = kmax > 0, kmin < 0
-    summary = Curvature(1.0 / kmax - rr if convex else None, sample.user(xa) if convex else None,
-                        1.0 / -kmin + rr if concave else None, sample.user(xb) if concave else None,
-                        1.0 / kmax if convex else None, None)
+    summary = _roller_summary(sample, rr, (xb, kmin), (xa, kmax))
     undercut = rr > 0 and convex and rr - 1.0 / kmax > CUSP_TOL_MM
     tight = lim > 0 and concave and 1.0 / -kmin + rr < lim
     wanted = ([lambda s: rr * s.curvature_pitch - 1.0] if undercut else []) + (
@@ -60,13 +58,28 @@ def _roller(contact: Contact, limits: Limits, sample: ContactSample) -> RuleResu
                else "the pitch-curve radius equals the roller radius")
         out.append(_cusp(sample, xa, 1.0 / kmax, rr, why, say.size))
     if tight:
-        fits = 1.0 / -kmin + rr
-        out += [Finding(IssueCode.CONCAVE_RADIUS_BELOW_ROLLER, Severity.WARNING, sample.user(lo), sample.user(hi),
-                        lim / (1.0 + gw), lim,
-                        f"concave stretch {span_text(sample, lo, hi)} with radius down to {fits:.6g} mm, tighter than "
-                        f"the {lim:.6g} mm cutter; the largest tool radius that fits is {fits:.6g} mm")
-                for lo, hi, _, gw in found.pop(0)]
+        out += _too_tight(sample, found.pop(0), lim, 1.0 / -kmin + rr)
     return RuleResult(tuple(out), {"curvature": summary})
+
+
+def _roller_summary(sample: ContactSample, rr: float, lowest: tuple[float, float],
+                    highest: tuple[float, float]) -> Curvature:
+    """The curvature summary of a roller or curved face from the extremes (x, κ_p) of the pitch curvature."""
+    (xb, kmin), (xa, kmax) = lowest, highest
+    convex, concave = kmax > 0, kmin < 0
+    return Curvature(1.0 / kmax - rr if convex else None, sample.user(xa) if convex else None,
+                     1.0 / -kmin + rr if concave else None, sample.user(xb) if concave else None,
+                     1.0 / kmax if convex else None, None)
+
+
+def _too_tight(sample: ContactSample, ranges, lim: float, fits: float) -> list[Finding]:
+    """CONCAVE_RADIUS_BELOW_ROLLER from the ranges where a concave stretch is tighter than the cutter or roller
+    radius ``lim``; ``fits`` is the smallest concave radius (the largest tool radius that fits)."""
+    return [Finding(IssueCode.CONCAVE_RADIUS_BELOW_ROLLER, Severity.WARNING, sample.user(lo), sample.user(hi),
+                    lim / (1.0 + gw), lim,
+                    f"concave stretch {span_text(sample, lo, hi)} with radius down to {fits:.6g} mm, tighter than "
+                    f"the {lim:.6g} mm cutter; the largest tool radius that fits is {fits:.6g} mm")
+            for lo, hi, _, gw in ranges]
 
 
 def _undercuts(sample: ContactSample, ranges, rr: float, say: Words) -> list[Finding]:
