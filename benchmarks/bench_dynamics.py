@@ -13,11 +13,10 @@ import argparse
 import math
 
 import numpy as np
-
 from bench_profile import OSC_ROWS, ROWS, best
-from camfab.design.mechanisms import ConjugateTranslatingRoller
+
 from camfab.design.dynamics import ContactDynamics, Loads, analyse_dynamics, pair_of
-from camfab.design.mechanisms import OscillatingRoller, TranslatingFlat, TranslatingRoller
+from camfab.design.mechanisms import ConjugateTranslatingRoller, OscillatingRoller, TranslatingFlat, TranslatingRoller
 from camfab.design.profile import CamGeometry
 from camfab.design.program import MotionProgram
 from camfab.units import RPM

@@ -8,7 +8,6 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from ..errors import SpecError
 from ..results import CheckReport, DynamicsReport, Finding
 from .checks import check
 from .dynamics import ContactDynamics, Loads, PairDynamics, analyse_dynamics, pair_of

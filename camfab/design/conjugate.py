@@ -47,12 +47,12 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ..errors import Problem
+from ..numeric import extremum
 from .faces import OscillatingFlat, OscillatingFlatContact, TranslatingFlat, TranslatingFlatContact
 from .kinds import CamKind, FollowerMotion, FollowerType
 from .mechanism import Mechanism, finite_fields, require_rotation
 from .profile import CamGeometry, Contact, MotionLike, ProfileSample
 from .rollers import OscillatingRoller, OscillatingRollerContact, TranslatingRoller, TranslatingRollerContact
-from ..numeric import extremum
 
 __all__ = [
     "ConjugateTranslatingFlat", "ConjugateTranslatingRoller", "ConjugateOscillatingFlat", "ConjugateOscillatingRoller",

@@ -172,7 +172,7 @@ class KnotTable:
     @classmethod
     def from_rows(cls, rows: Sequence[Sequence[float]], *, units: Mapping[str, str] | None = None,
                   speed_rpm: float | None = None, degree: int = 5, path: str = "motion_table",
-                  source: str | None = None) -> "KnotTable":
+                  source: str | None = None) -> KnotTable:
         """Validate rows ``(angle, s, v, a[, j])`` and build the table.
 
         Raises

@@ -54,15 +54,16 @@ with their families: :mod:`~camfab.design.rollers`, :mod:`~camfab.design.faces`,
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Protocol, Sequence
+from typing import Any, Protocol
 
 import numpy as np
 
 from ..errors import SpecError
-from .kinds import Axis, ContactKind
 from ..geom2d import cross, dot
 from ..numeric import extrema, integrate
+from .kinds import Axis, ContactKind
 
 __all__ = [
     "MotionLike",
@@ -317,7 +318,7 @@ class CamGeometry:
         self.profiles: tuple[Contact, ...] = tuple(mechanism.contacts(program))
 
     @classmethod
-    def from_contacts(cls, contacts: Sequence[Contact], mechanism=None, program=None) -> "CamGeometry":
+    def from_contacts(cls, contacts: Sequence[Contact], mechanism=None, program=None) -> CamGeometry:
         """A geometry made of ready-built contacts (conjugate cams and the like)."""
         self = cls.__new__(cls)
         self.mechanism, self.program, self.profiles = mechanism, program, tuple(contacts)

@@ -20,9 +20,8 @@ import numpy as np
 
 from ..errors import Problem
 from .kinds import FollowerMotion, FollowerType
-from .mechanism import (Mechanism, finite_fields, lift_range, require_non_negative, require_positive,
-                        require_rotation)
-from .profile import DEG, CHUNK, Contact, MotionLike, ProfileSample, block, rot_into, xy
+from .mechanism import Mechanism, finite_fields, lift_range, require_non_negative, require_positive, require_rotation
+from .profile import CHUNK, DEG, Contact, MotionLike, ProfileSample, block, rot_into
 from .trig import cos_sin
 
 __all__ = ["DiscRollerContact", "TranslatingRollerContact", "OscillatingRollerContact", "TranslatingRoller",

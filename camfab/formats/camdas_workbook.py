@@ -74,14 +74,12 @@ import io
 import math
 import re
 import zipfile
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from ..design.kinds import ContactKind, FollowerType
 from ..design.tables import LiftTable, intervals, lift_table, sample_params
-from ..errors import Problem, SpecError
 from ..results import JUMP_CODES, IssueCode, Severity, Verdict
 
 __all__ = ["CAMDAS_COLUMNS", "FIXED_DATE", "LiftTable", "camdas_workbook", "camdas_columns", "conclusions",

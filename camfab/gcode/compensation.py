@@ -41,8 +41,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from camfab.geom2d import TWO_PI, arc_sweep
 from camfab.gcode.parse import Move
+from camfab.geom2d import TWO_PI, arc_sweep
 from camfab.results import Finding, IssueCode
 
 __all__ = ["CompensatedPath", "simulate_compensation", "move_lengths"]

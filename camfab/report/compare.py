@@ -8,7 +8,8 @@ units (mm or degrees of lift; degrees of cam angle or mm of travel).
 from __future__ import annotations
 
 import math
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 

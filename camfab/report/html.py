@@ -15,16 +15,27 @@ import base64
 import dataclasses
 import json
 import math
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
 from ..assets import read_template
 from ..errors import MissingDependencyError
 from ..results import DynamicsSummary, IssueCode, Severity
-from ._common import (VERDICT_CLASS, VERDICT_TEXT, _cell, axis_of, conclusions_rows, fmt, fmt_at, key_values,
-                      mechanism_text, range_text)
+from ._common import (
+    VERDICT_CLASS,
+    VERDICT_TEXT,
+    _cell,
+    axis_of,
+    conclusions_rows,
+    fmt,
+    fmt_at,
+    key_values,
+    mechanism_text,
+    range_text,
+)
 
 __all__ = ["render_report", "write_files", "template_environment", "report_context", "dynamics_rows", "PLOT_TEXT",
            "CURVED_PLOT_TEXT", "plot_text", "require_report_dependencies"]

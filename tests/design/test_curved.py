@@ -109,7 +109,7 @@ def _converges_like_one_over_r(errs, last):
     limit is the flat face; at R = 1e6 mm each is below ``last``."""
     assert np.all(errs[-1] < last), errs
     ratio = errs[1:] / errs[:-1]
-    assert np.all((0.08 < ratio) & (ratio < 0.12)), ratio
+    assert np.all((ratio > 0.08) & (ratio < 0.12)), ratio
 
 
 # ---------------------------------------------------------------------------

@@ -13,11 +13,21 @@ import re
 import numpy as np
 import pytest
 
-from camfab.gcode import (ContourDistance, Segment, contour_toolpath, dumps, offset_contour, parse, sample,
-                          verify)
+from camfab.gcode import ContourDistance, Segment, contour_toolpath, dumps, offset_contour, parse, sample, verify
 from camfab.gcode.compensation import move_lengths, simulate_compensation
-from tests.gcode.parts import (HALF, PART, RP, R_TOOL, SAFE_Z, TOL, job, notched_disc, stadium,
-                               stadium_distance, stadium_points)
+from tests.gcode.parts import (
+    HALF,
+    PART,
+    R_TOOL,
+    RP,
+    SAFE_Z,
+    TOL,
+    job,
+    notched_disc,
+    stadium,
+    stadium_distance,
+    stadium_points,
+)
 
 FINISH = "FINISH CONTOUR"
 
@@ -108,7 +118,7 @@ def test_stadium_compensated_program_is_the_exact_tool_centre_path(post, comp):
     path = simulate_compensation(parse(text).moves, R_TOOL)
     fin = finish_moves(path)
     L = sum(move_lengths([m for m, _ in fin]))
-    assert L == pytest.approx(4 * HALF + 2 * math.pi * (RP + R_TOOL), abs=1e-6)
+    assert pytest.approx(4 * HALF + 2 * math.pi * (RP + R_TOOL), abs=1e-6) == L
     pts = sample([m for m, _ in fin], 0.02).points[:, :2]
     assert np.abs(centre(pts)).max() < 1e-9
 
@@ -219,7 +229,7 @@ def test_convex_polygon_gets_rolling_arcs_perimeter_plus_2_pi_r(shape, comp):
     L = float(move_lengths([m for m, _ in fin]).sum())
     # exact for the square; the pentagon's written (rounded) vertices leave kinks of ~3 microradians at
     # the lead-in/out junctions, which belong to the leads: r * 3e-6 ~ 1e-5 mm
-    assert L == pytest.approx(perimeter + 2 * math.pi * R_TOOL, abs=1e-9 if shape is square else 1e-4)
+    assert pytest.approx(perimeter + 2 * math.pi * R_TOOL, abs=1e-9 if shape is square else 1e-4) == L
     assert sum(abs(m.sweep) for m in corners) == pytest.approx(2 * math.pi, abs=1e-4)
     rep = check(text, part, offset_contour(part, R_TOOL))
     assert rep.ok, rep.to_dict()["problems"]
@@ -238,7 +248,7 @@ def test_rounded_rectangle_with_fillets_smaller_than_the_tool_is_fine_on_the_out
     fin = finish_moves(path)
     assert not [k for _, k in fin if k == "corner"]  # tangent joins: nothing inserted
     L = float(move_lengths([m for m, _ in fin]).sum())
-    assert L == pytest.approx(programmed_finish_length(text) + 2 * math.pi * R_TOOL, abs=1e-6)
+    assert pytest.approx(programmed_finish_length(text) + 2 * math.pi * R_TOOL, abs=1e-6) == L
     assert check(text, segs, offset_contour(segs, R_TOOL)).ok
 
 
@@ -251,7 +261,7 @@ def test_concave_corner_is_trimmed_to_the_exact_offset(comp):
     assert sum(k == "corner" for _, k in fin) == 5 and path.corners["trimmed"] >= 1
     # closed form: perimeter + r * (5 convex quarter turns) - 2 r tan(45 deg) at the concave corner
     L = float(move_lengths([m for m, _ in fin]).sum())
-    assert L == pytest.approx(160.0 + R_TOOL * 5 * math.pi / 2 - 2 * R_TOOL, abs=1e-9)
+    assert pytest.approx(160.0 + R_TOOL * 5 * math.pi / 2 - 2 * R_TOOL, abs=1e-9) == L
     # the trimmed corner sits on the bisector, r from both walls
     ends = np.array([m.end[:2] for m, _ in fin])
     assert np.min(np.hypot(*(ends - [R_TOOL, R_TOOL]).T)) < 1e-9

@@ -8,12 +8,26 @@ import math
 import re
 
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from camfab.errors import ExportError
 from camfab.gcode import POSTS, contour_toolpath, dumps, parse, verify, write_gcode
-from tests.gcode.parts import (CENTRE_CURVE, HALF, PART, RP, R_TOOL, SAFE_Z, TOL, centre_path, circle,
-                               circle_distance, job, stadium, stadium_points)
+from tests.gcode.parts import (
+    CENTRE_CURVE,
+    HALF,
+    PART,
+    R_TOOL,
+    RP,
+    SAFE_Z,
+    TOL,
+    centre_path,
+    circle,
+    circle_distance,
+    job,
+    stadium,
+    stadium_points,
+)
 
 CASES = [("linuxcnc", {}), ("fanuc", {}), ("fanuc", {"arc_format": "r"}), ("grbl", {})]
 IDS = ["linuxcnc", "fanuc-ij", "fanuc-r", "grbl"]

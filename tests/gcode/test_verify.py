@@ -6,9 +6,21 @@ import re
 import numpy as np
 import pytest
 
-from camfab.gcode import (ContourDistance, Segment, contour_toolpath, dumps, parse, verify)
-from tests.gcode.parts import (CENTRE_CURVE, HALF, PART, RP, R_TOOL, SAFE_Z, TOL, centre_path, job,
-                               notched_disc, notched_disc_distance, stadium_points)
+from camfab.gcode import ContourDistance, Segment, contour_toolpath, dumps, parse, verify
+from tests.gcode.parts import (
+    CENTRE_CURVE,
+    HALF,
+    PART,
+    R_TOOL,
+    RP,
+    SAFE_Z,
+    TOL,
+    centre_path,
+    job,
+    notched_disc,
+    notched_disc_distance,
+    stadium_points,
+)
 
 POSTS = [("linuxcnc", {}), ("fanuc", {}), ("grbl", {})]
 
