@@ -182,7 +182,7 @@ def _rect(msp, box, layer: str) -> None:
 
 def _place(loop: ArcChain, scale: float, centre) -> list[tuple[float, float, float, float, float]]:
     pts = loop.points * scale + np.asarray(centre)
-    return [(float(x), float(y), 0.0, 0.0, float(b)) for (x, y), b in zip(pts, loop.bulges)]
+    return [(float(x), float(y), 0.0, 0.0, float(b)) for (x, y), b in zip(pts, loop.bulges, strict=True)]
 
 
 def _fmt(v: float, dec: int = 3) -> str:

@@ -240,7 +240,8 @@ def arm_swing_problems(xi0: float, program: MotionLike, *, hi_limit: float = mat
                     f"the {what} would swing to {math.degrees(hi):.6g}° (from ξ0 = {math.degrees(xi0):.6g}°); "
                     f"it must stay strictly between {math.degrees(lo_limit):g}° and {math.degrees(hi_limit):g}° "
                     "from the line of centres",
-                    f"keep the total lift below {math.degrees(hi_limit) - math.degrees(xi0):.6g}° or change the arm geometry")]
+                    f"keep the total lift below {math.degrees(hi_limit) - math.degrees(xi0):.6g}° "
+                    "or change the arm geometry")]
 
 
 @dataclass(frozen=True)

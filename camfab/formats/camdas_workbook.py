@@ -483,7 +483,7 @@ def _lift_sheet(ws, table: LiftTable, geometry) -> None:
              table.radius_label)
     for col, text in enumerate(heads, 1):
         ws.cell(1, col, text).font = bold
-    for i, (a, s, r) in enumerate(zip(table.angle, table.lift, table.radius)):
+    for i, (a, s, r) in enumerate(zip(table.angle, table.lift, table.radius, strict=True)):
         ws.cell(2 + i, 1, float(a)), ws.cell(2 + i, 2, float(s)), ws.cell(2 + i, 3, float(r))
     ws.freeze_panes = "A2"
 

@@ -78,7 +78,8 @@ def lift_table_csv(angles_deg, lift_mm, *, lift_unit: str = "mm") -> str:
         problems.append(Problem("lift_unit", lift_unit, "is not a valid option", "must be one of: mm, deg"))
     if problems:
         raise SpecError(problems)
-    rows = [f"angle_deg,lift_{lift_unit}"] + [f"{_f6(x)},{_f6(y)}" for x, y in zip(a.tolist(), lift.tolist())]
+    rows = [f"angle_deg,lift_{lift_unit}"]
+    rows += [f"{_f6(x)},{_f6(y)}" for x, y in zip(a.tolist(), lift.tolist(), strict=True)]
     return "\n".join(rows) + "\n"
 
 

@@ -66,7 +66,7 @@ def compare_svaj_figure(items, labels: Sequence[str] | None = None):
             vals = prog.evaluate(x) * (spec.speed ** np.arange(4))[:, None]
             for k, ax in enumerate(axes):
                 ax.plot(x * axis.scale, vals[k], color=f"C{i}", lw=1.3, label=labels[i] if k == 0 else None)
-        for q, ax in zip("SVAJ", axes):
+        for q, ax in zip("SVAJ", axes, strict=True):
             ax.axhline(0.0, color="0.2", lw=0.6)
             ax.set_ylabel(f"{q} ({' | '.join(SVAJ_UNITS[q].format(u=u) for u in units)})")
             ax.margins(y=0.1)
