@@ -143,7 +143,6 @@ def test_curved_faces_match_finite_differences_and_their_definitions(design):
         g = mech.geometry(prog)
     except SpecError:
         assume(False)
-    c = g.profiles[0]
     h = 1e-4
     b = g.breakpoints
     x = np.linspace(0.013, 2 * math.pi - 0.013, 151)

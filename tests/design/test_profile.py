@@ -437,7 +437,7 @@ def test_fixed_frame_sample_is_the_cam_frame_sample_turned_back(name):
     x = np.linspace(0.0, g.period, 1001) if not g.closed else np.linspace(-1.0, 7.5, 1001)
     for c in g.profiles:
         cam, fix = c.evaluate(x), c.evaluate_fixed(x)
-        turn = (lambda v: v) if not c.closed else (lambda v: _rot(v, -c.sense * x))  # noqa: E731
+        turn = (lambda v: v) if not c.closed else (lambda v, c=c: _rot(v, -c.sense * x))  # noqa: E731
         for f in ("point", "point_d1", "normal", "tangent", "pitch"):
             a, b = getattr(cam, f), getattr(fix, f)
             if a is None:

@@ -103,7 +103,7 @@ def test_rapid_plunge_into_stock_is_caught():
 @pytest.mark.parametrize("post,opts", POSTS)
 def test_missing_feed_before_first_cut_is_caught(post, opts):
     lines = _lines(_text(post, opts))
-    k = next(i for i, l in enumerate(lines) if re.search(r"\bG0?1\b", l))
+    k = next(i for i, line in enumerate(lines) if re.search(r"\bG0?1\b", line))
     assert " F" in lines[k]
     lines[k] = re.sub(r" F[\d.]+", "", lines[k])
     rep = _verify("\n".join(lines) + "\n")
