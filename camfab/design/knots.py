@@ -297,6 +297,7 @@ class KnotTable:
 
 def _extremes(seg: Segment, nu: int) -> tuple[float, float, float, float]:
     """Exact (min, max, u_min, u_max) of S⁽ⁿᵘ⁾ (per radian) over one polynomial segment."""
+    assert seg.coeffs is not None  # a knot table's segments are Hermite polynomials (KnotTable.segments)
     p = np.polynomial.Polynomial(seg.coeffs).deriv(nu)
     r = p.deriv().roots() if p.degree() > 0 else np.array([])
     r = r.real[(np.abs(r.imag) <= 1e-12) & (r.real > 0.0) & (r.real < 1.0)]

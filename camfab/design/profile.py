@@ -85,10 +85,17 @@ DEG = math.pi / 180.0
 
 
 class MotionLike(Protocol):
-    """What a contact needs from a motion: S and derivatives, breakpoints, period, axis."""
+    """What a contact needs from a motion: S and derivatives, breakpoints, period, axis.
 
-    period: float
-    axis: Axis
+    Read-only members: motions are immutable (frozen dataclasses such as
+    :class:`~camfab.design.program.MotionProgram` satisfy the protocol).
+    """
+
+    @property
+    def period(self) -> float: ...
+
+    @property
+    def axis(self) -> Axis: ...
 
     @property
     def breakpoints(self) -> np.ndarray: ...

@@ -23,7 +23,8 @@ __all__ = ["render_comparison", "comparison_rows", "compare_svaj_figure", "compa
 
 def design_labels(items) -> list[str]:
     """Design names, made unique ("Cam", "Cam (2)") for legends and column heads."""
-    out, seen = [], {}
+    out: list[str] = []
+    seen: dict[str, int] = {}
     for spec, _, _ in items:
         n = seen.get(spec.name, 0) + 1
         seen[spec.name] = n
