@@ -71,7 +71,7 @@ ANY_CONST = 192.0
 def arc_count_estimates(curve: ParametricCurve, tol: float, n: int = 4001) -> tuple[float, float]:
     """``(est G1, LB any)``: ∫ (|κ'| / (c·tol))^(1/3) ds with c = 72·√3 and c = 192 (per smooth piece)."""
     g1 = lb = 0.0
-    for lo, hi in zip(*curve.pieces):
+    for lo, hi in zip(*curve.pieces, strict=True):
         t = np.linspace(lo, hi, n)
         p = np.asarray(curve.point(t))
         d = np.gradient(p, t, axis=0)
@@ -155,7 +155,8 @@ def main(argv=None) -> None:
         g1, lb = arc_count_estimates(curve, 1e-3)
         print(f"{variant}: Rb = {kw['base_radius_mm']:g} mm, Rr = {kw['roller_radius_mm']:g} mm, lifts x"
               f"{kw['lift_scale']:g}: uniform 1 µm polyline {uniform_vertices(curve, 1e-3)} vertices, "
-              f"{res.n_entities} arcs (max dev {res.max_deviation:.3e} mm, {t:.3f} s; est G1 {g1:.1f}, LB any {lb:.1f})")
+              f"{res.n_entities} arcs (max dev {res.max_deviation:.3e} mm, {t:.3f} s; "
+              f"est G1 {g1:.1f}, LB any {lb:.1f})")
 
 
 if __name__ == "__main__":

@@ -13,11 +13,10 @@ import argparse
 import math
 
 import numpy as np
-
 from bench_profile import OSC_ROWS, ROWS, best
-from camfab.design.mechanisms import ConjugateTranslatingRoller
+
 from camfab.design.dynamics import ContactDynamics, Loads, analyse_dynamics, pair_of
-from camfab.design.mechanisms import OscillatingRoller, TranslatingFlat, TranslatingRoller
+from camfab.design.mechanisms import ConjugateTranslatingRoller, OscillatingRoller, TranslatingFlat, TranslatingRoller
 from camfab.design.profile import CamGeometry
 from camfab.design.program import MotionProgram
 from camfab.units import RPM
@@ -45,8 +44,8 @@ def main() -> None:
     print(f"{'mechanism':<24}{'forces ms':>11}{'ratio':>8}{'analysis ms':>13}")
     for name, geom, loads in cams:
         dyn = pair_of(geom, loads, w) if len(geom.profiles) > 1 else ContactDynamics(geom.profiles[0], loads, w)
-        t_ev = best(lambda: dyn.evaluate(phi), a.repeat)
-        t_an = best(lambda: analyse_dynamics(geom, loads, w), a.repeat)
+        t_ev = best(lambda dyn=dyn: dyn.evaluate(phi), a.repeat)
+        t_an = best(lambda geom=geom, loads=loads: analyse_dynamics(geom, loads, w), a.repeat)
         print(f"{name:<24}{t_ev * 1e3:>11.1f}{t_ev / t_motion:>7.2f}x{t_an * 1e3:>13.1f}")
 
 

@@ -1,9 +1,9 @@
 """Benchmark: accuracy versus run time of the CAD/CAM geometry for a real cam design.
 
 For tol in 1e-1 … 1e-6 mm on the built-in Ejemplo9RT (8 segments), IndexingPackaging, a typical
-12-segment roller cam (``typical_cam.py``, passes ``camfab check``) and the two reference cams: arc count and measured deviation of
-the profile, of the tool-centre path, and the wall time (best of ``--repeat``) of a whole arc-fitted DXF
-export (profile + pitch curve + circles + bore, written to bytes).
+12-segment roller cam (``typical_cam.py``, passes ``camfab check``) and the two reference cams: arc count and
+measured deviation of the profile, of the tool-centre path, and the wall time (best of ``--repeat``) of a whole
+arc-fitted DXF export (profile + pitch curve + circles + bore, written to bytes).
 
 Run:  PYTHONPATH=. python3 benchmarks/bench_export.py [--repeat 3] [--tols 1e-3,1e-4]
 """

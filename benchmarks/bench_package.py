@@ -28,8 +28,8 @@ OUTPUTS = "dxf,stl,gcode,lift_table,xlsx,report,drawing"
 def design(i: int, rng: random.Random) -> str:
     kind = ("translating_roller", "oscillating_roller", "translating_flat")[i % 3]
     n_moves = 1 if kind == "translating_flat" else rng.choice((1, 2))
-    spans, rows = [], []
-    for k in range(n_moves):  # rise, dwell, return, dwell per move
+    rows = []
+    for _ in range(n_moves):  # rise, dwell, return, dwell per move
         h = rng.uniform(5, 15) if kind != "oscillating_roller" else rng.uniform(5, 12)
         b = rng.uniform(60, 100) / n_moves
         d = 180 / n_moves - b

@@ -76,7 +76,7 @@ def timings(n: int, repeat: int) -> dict[str, float]:
     out = {f"motion S..S‴ at {n:,} angles": best(lambda: prog.evaluate(phi), repeat)}
     for name, build, rows in CAMS:
         geom = build(MotionProgram.from_segments(rows))
-        out[f"profile, {name}, {n:,} angles"] = best(lambda: geom.evaluate(phi), repeat)
+        out[f"profile, {name}, {n:,} angles"] = best(lambda geom=geom: geom.evaluate(phi), repeat)
     return out
 
 
@@ -100,9 +100,9 @@ def main() -> None:
           f"{'ratio':>8}{'cold check() ms':>17}{'ratio (cold)':>14}")
     for name, build, rows in CAMS:
         geom = build(prog if rows is ROWS else osc)
-        t_geo = best(lambda: geom.evaluate(phi), a.repeat)
-        t_chk = best(lambda: check(geom), a.repeat)
-        t_cold = best_cold(lambda: build(MotionProgram.from_segments(rows)), a.repeat)
+        t_geo = best(lambda geom=geom: geom.evaluate(phi), a.repeat)
+        t_chk = best(lambda geom=geom: check(geom), a.repeat)
+        t_cold = best_cold(lambda build=build, rows=rows: build(MotionProgram.from_segments(rows)), a.repeat)
         t_all = t_geo + t_chk
         print(f"{name:<22}{t_geo * 1e3:>18.1f}{t_geo / t_motion:>7.2f}x{t_chk * 1e3:>12.1f}{t_all * 1e3:>18.1f}"
               f"{t_all / t_motion:>7.2f}x{t_cold * 1e3:>17.1f}{(t_geo + t_cold) / t_motion:>13.2f}x")

@@ -82,8 +82,8 @@ def unit(v: np.ndarray) -> np.ndarray:
 # --------------------------------------------------------------------------------------
 # arcs and bulges (scalar: one entity)
 # --------------------------------------------------------------------------------------
-def arc_sweep(start: Sequence[float], end: Sequence[float], center: Sequence[float],
-              clockwise: bool) -> float:
+def arc_sweep(start: Sequence[float] | np.ndarray, end: Sequence[float] | np.ndarray,
+              center: Sequence[float] | np.ndarray, clockwise: bool) -> float:
     """Signed sweep of an arc from ``start`` to ``end`` about ``center``.
 
     Parameters

@@ -174,9 +174,7 @@ def package(paths: Iterable[str | Path], out: str | Path, *, jobs: int = 1, outp
     if jobs > 1 and len(todo) > 1:  # worker processes read their design again (a program does not pickle)
         todo = [(*t[:4], None) for t in todo]
     t0 = time.perf_counter()
-    done = 0
-    for entry in _map(_build, todo, jobs):
-        done += 1
+    for done, entry in enumerate(_map(_build, todo, jobs), 1):
         entries[entry["source"]] = entry
         tail = entry.get("verdict") or f"ERROR: {entry.get('error', '').splitlines()[0]}"
         say(f"{_bar(done, len(todo))} {done}/{len(todo)} {entry['name']}: {tail} ({entry['seconds']:.2f} s)")

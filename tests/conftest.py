@@ -31,7 +31,7 @@ def base_design(**over):
         "cam": {"kind": "disc", "rotation": "cw", "omega_rad_s": 1.0},
         "follower": {"type": "roller", "motion": "translating", "base_radius_mm": 35.0,
                      "roller_radius_mm": 7.0, "offset_mm": 0.0},
-        "motion": [{"law": law, "lift": float(l), "angle_deg": float(b)} for law, l, b in EJEMPLO9RT],
+        "motion": [{"law": law, "lift": float(h), "angle_deg": float(b)} for law, h, b in EJEMPLO9RT],
     }
     d.update(over)
     return d

@@ -8,8 +8,21 @@ import pytest
 
 from camfab.design.assemble import check_design
 from camfab.formats import load_design
-from camfab.results import (CheckReport, Curvature, DynamicsSummary, Extreme, FaceLength, Finding, IssueCode,
-                            JumpSpeed, Maximum, Preload, PressureAngle, Severity, Verdict)
+from camfab.results import (
+    CheckReport,
+    Curvature,
+    DynamicsSummary,
+    Extreme,
+    FaceLength,
+    Finding,
+    IssueCode,
+    JumpSpeed,
+    Maximum,
+    Preload,
+    PressureAngle,
+    Severity,
+    Verdict,
+)
 
 from .conftest import EXAMPLES
 

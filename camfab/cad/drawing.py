@@ -48,7 +48,7 @@ import functools
 import math
 import tomllib
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -109,7 +109,7 @@ class SheetLayout:
     fits: bool
 
 
-def _layout_on(paper: str, extent_mm, n_rows: int, tpl: dict[str, Any]) -> SheetLayout:
+def _layout_on(paper: str, extent_mm: float | tuple[float, float], n_rows: int, tpl: dict[str, Any]) -> SheetLayout:
     w, h = tpl["paper"][paper]["width_mm"], tpl["paper"][paper]["height_mm"]
     fr, gap = tpl["frame"], tpl["frame"]["gap_mm"]
     fx0, fy0, fx1, fy1 = fr["left_mm"], fr["bottom_mm"], w - fr["right_mm"], h - fr["top_mm"]
@@ -125,7 +125,7 @@ def _layout_on(paper: str, extent_mm, n_rows: int, tpl: dict[str, Any]) -> Sheet
     notes = (fx0, fy0, fx0 + tpl["notes"]["width_mm"], fy1)
     view = (notes[2] + gap, title[3] + gap, table[0] - gap, fy1)
     clear = tpl["view"]["clearance_mm"]
-    half_w, half_h = (extent_mm, extent_mm) if np.isscalar(extent_mm) else extent_mm
+    half_w, half_h = (cast(float, extent_mm),) * 2 if np.isscalar(extent_mm) else cast(tuple[float, float], extent_mm)
     room_w, room_h = (view[2] - view[0]) / 2 - clear, (view[3] - view[1]) / 2 - clear
     if np.isscalar(extent_mm):  # a disc cam: a circle of radius extent in the square part of the view
         room_w = room_h = min(room_w, room_h)
@@ -137,7 +137,7 @@ def _layout_on(paper: str, extent_mm, n_rows: int, tpl: dict[str, Any]) -> Sheet
                        groups, rows, notes, view, bool(fits))
 
 
-def sheet_layout(extent_mm, n_rows: int, paper: str = "auto") -> SheetLayout:
+def sheet_layout(extent_mm: float | tuple[float, float], n_rows: int, paper: str = "auto") -> SheetLayout:
     """Choose paper and scale for a cam of outer radius ``extent_mm`` and a lift table of ``n_rows`` rows.
 
     Parameters
@@ -182,7 +182,7 @@ def _rect(msp, box, layer: str) -> None:
 
 def _place(loop: ArcChain, scale: float, centre) -> list[tuple[float, float, float, float, float]]:
     pts = loop.points * scale + np.asarray(centre)
-    return [(float(x), float(y), 0.0, 0.0, float(b)) for (x, y), b in zip(pts, loop.bulges)]
+    return [(float(x), float(y), 0.0, 0.0, float(b)) for (x, y), b in zip(pts, loop.bulges, strict=True)]
 
 
 def _fmt(v: float, dec: int = 3) -> str:

@@ -5,8 +5,8 @@ reads designs into :class:`DesignSpec` values.
 """
 from __future__ import annotations
 
-from .laws import LAWS, Law, get_law, law_names
 from ..results import Finding, MotionReport
+from .laws import LAWS, Law, get_law, law_names
 from .motion_report import analyse_motion
 from .program import MotionProgram, Segment, SegmentInput, build_program
 from .spec import DesignSpec, design_from_dict

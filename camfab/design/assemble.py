@@ -8,7 +8,6 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from ..errors import SpecError
 from ..results import CheckReport, DynamicsReport, Finding
 from .checks import check
 from .dynamics import ContactDynamics, Loads, PairDynamics, analyse_dynamics, pair_of
@@ -56,6 +55,8 @@ def is_form_closed(spec: DesignSpec) -> bool:
 
 def dynamics_model(spec: DesignSpec, geometry: CamGeometry) -> ContactDynamics | PairDynamics:
     """The force model of a design with a ``[dynamics]`` section (``evaluate(x)`` → forces at x)."""
+    if spec.dynamics is None:
+        raise ValueError(f"{spec.name} has no [dynamics] section")
     loads = loads_from_spec(spec.dynamics)
     if is_form_closed(spec):
         return pair_of(geometry, loads, spec.speed)

@@ -47,12 +47,12 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ..errors import Problem
+from ..numeric import extremum
 from .faces import OscillatingFlat, OscillatingFlatContact, TranslatingFlat, TranslatingFlatContact
 from .kinds import CamKind, FollowerMotion, FollowerType
 from .mechanism import Mechanism, finite_fields, require_rotation
 from .profile import CamGeometry, Contact, MotionLike, ProfileSample
 from .rollers import OscillatingRoller, OscillatingRollerContact, TranslatingRoller, TranslatingRollerContact
-from ..numeric import extremum
 
 __all__ = [
     "ConjugateTranslatingFlat", "ConjugateTranslatingRoller", "ConjugateOscillatingFlat", "ConjugateOscillatingRoller",
@@ -102,8 +102,8 @@ def lift_of(program) -> float:
 
 def _mirror(s: ProfileSample) -> ProfileSample:
     m = lambda v: None if v is None else v * _MX  # noqa: E731
-    return replace(s, point=m(s.point), point_d1=m(s.point_d1), normal=m(s.normal), tangent=m(s.tangent),
-                   pitch=m(s.pitch), arm_angle=None if s.arm_angle is None else -s.arm_angle)
+    return replace(s, point=s.point * _MX, point_d1=s.point_d1 * _MX, normal=s.normal * _MX,
+                   tangent=s.tangent * _MX, pitch=m(s.pitch), arm_angle=None if s.arm_angle is None else -s.arm_angle)
 
 
 class _Second:
@@ -210,6 +210,11 @@ class _Desmodromic(FormClosed):
     cam_kind: ClassVar[CamKind] = CamKind.CONJUGATE
     #: the free parameter bounded by the minimum follower distance (angle)
     _free_field = "follower_distance_mm"
+
+    # fields every conjugate pair has (declared by each subclass's dataclass; annotations only here:
+    # this base is not a dataclass, so they add no fields)
+    base_radius_mm: float
+    rotation: str
 
     @property
     def second_roller_mm(self) -> float:

@@ -183,7 +183,7 @@ class ContactDynamics:
         return (L.inertia * (k * S[2] * rate * rate) + L.preload + L.spring_rate * (k * S[0])
                 + L.damping * (k * S[1] * rate) + L.external)
 
-    def _transmit(self, N, s, vhat, u):
+    def _transmit(self, N, s, vhat, u) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(friction μN, bearing force, drive, power) when the cam pushes with N (newtons) along n."""
         n = s.normal
         with np.errstate(invalid="ignore"):  # N = ±inf where wedged
@@ -217,6 +217,8 @@ class ContactDynamics:
         D ≤ 0).  (N − F_s)·D = a·ṡ² + b·ṡ + e, and D does not depend on the speed ṡ: the smallest
         positive root of that quadratic."""
         L, k, S, D = self.loads, self.q_per_s, s.motion, s.lever
+        if S is None:  # evaluate() always fills it; a hand-made sample may not
+            raise ValueError("jump_speed needs the sample's motion (S, S′, S″); use ContactDynamics.evaluate")
         a = L.inertia * k * S[2]
         b = L.damping * k * S[1]
         e = L.preload + L.spring_rate * k * S[0] + L.external - L.safety_force_n * D

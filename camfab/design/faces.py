@@ -25,7 +25,7 @@ import numpy as np
 from ..errors import Problem
 from .kinds import ContactKind, FollowerMotion, FollowerType
 from .mechanism import Mechanism, finite_fields, lift_range, require_positive, require_rotation
-from .profile import DEG, CHUNK, Contact, MotionLike, ProfileSample, block, rot_into
+from .profile import CHUNK, DEG, Contact, MotionLike, ProfileSample, block, rot_into
 from .trig import cos_sin
 
 __all__ = ["DiscFlatContact", "TranslatingFlatContact", "OscillatingFlatContact", "TranslatingFlat",

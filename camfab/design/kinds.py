@@ -62,8 +62,9 @@ class FollowerType(StrEnum):
     #: a convex circular face (mushroom or finger follower)
     CURVED = "curved"
 
+    # shadows str.title() on purpose (a name in words, not a capitalised value); no compatible override exists
     @property
-    def title(self) -> str:
+    def title(self) -> str:  # type: ignore[override]
         """The follower's name in words: "roller", "flat-face", "knife-edge" or "curved-face"."""
         return {"roller": "roller", "flat": "flat-face", "knife": "knife-edge", "curved": "curved-face"}[self.value]
 

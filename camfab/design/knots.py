@@ -172,7 +172,7 @@ class KnotTable:
     @classmethod
     def from_rows(cls, rows: Sequence[Sequence[float]], *, units: Mapping[str, str] | None = None,
                   speed_rpm: float | None = None, degree: int = 5, path: str = "motion_table",
-                  source: str | None = None) -> "KnotTable":
+                  source: str | None = None) -> KnotTable:
         """Validate rows ``(angle, s, v, a[, j])`` and build the table.
 
         Raises
@@ -297,6 +297,7 @@ class KnotTable:
 
 def _extremes(seg: Segment, nu: int) -> tuple[float, float, float, float]:
     """Exact (min, max, u_min, u_max) of S⁽ⁿᵘ⁾ (per radian) over one polynomial segment."""
+    assert seg.coeffs is not None  # a knot table's segments are Hermite polynomials (KnotTable.segments)
     p = np.polynomial.Polynomial(seg.coeffs).deriv(nu)
     r = p.deriv().roots() if p.degree() > 0 else np.array([])
     r = r.real[(np.abs(r.imag) <= 1e-12) & (r.real > 0.0) & (r.real < 1.0)]

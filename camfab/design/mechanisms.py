@@ -15,8 +15,14 @@ from __future__ import annotations
 from typing import Any
 
 from ..errors import Problem, SpecError
-from .conjugate import (ConjugateOscillatingFlat, ConjugateOscillatingRoller, ConjugateTranslatingFlat,
-                        ConjugateTranslatingRoller, DesmodromicGeometry, FormClosed)
+from .conjugate import (
+    ConjugateOscillatingFlat,
+    ConjugateOscillatingRoller,
+    ConjugateTranslatingFlat,
+    ConjugateTranslatingRoller,
+    DesmodromicGeometry,
+    FormClosed,
+)
 from .curved import OscillatingCurved, TranslatingCurved
 from .faces import OscillatingFlat, TranslatingFlat
 from .kinds import CamKind, FollowerMotion, FollowerType

@@ -54,15 +54,16 @@ with their families: :mod:`~camfab.design.rollers`, :mod:`~camfab.design.faces`,
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Protocol, Sequence
+from typing import Any, Protocol
 
 import numpy as np
 
 from ..errors import SpecError
-from .kinds import Axis, ContactKind
 from ..geom2d import cross, dot
 from ..numeric import extrema, integrate
+from .kinds import Axis, ContactKind
 
 __all__ = [
     "MotionLike",
@@ -84,10 +85,17 @@ DEG = math.pi / 180.0
 
 
 class MotionLike(Protocol):
-    """What a contact needs from a motion: S and derivatives, breakpoints, period, axis."""
+    """What a contact needs from a motion: S and derivatives, breakpoints, period, axis.
 
-    period: float
-    axis: Axis
+    Read-only members: motions are immutable (frozen dataclasses such as
+    :class:`~camfab.design.program.MotionProgram` satisfy the protocol).
+    """
+
+    @property
+    def period(self) -> float: ...
+
+    @property
+    def axis(self) -> Axis: ...
 
     @property
     def breakpoints(self) -> np.ndarray: ...
@@ -317,7 +325,7 @@ class CamGeometry:
         self.profiles: tuple[Contact, ...] = tuple(mechanism.contacts(program))
 
     @classmethod
-    def from_contacts(cls, contacts: Sequence[Contact], mechanism=None, program=None) -> "CamGeometry":
+    def from_contacts(cls, contacts: Sequence[Contact], mechanism=None, program=None) -> CamGeometry:
         """A geometry made of ready-built contacts (conjugate cams and the like)."""
         self = cls.__new__(cls)
         self.mechanism, self.program, self.profiles = mechanism, program, tuple(contacts)

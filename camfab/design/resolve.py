@@ -112,8 +112,8 @@ def _span_problems(i: int, s: SegmentInput, ctx: _Context) -> list[Problem]:
 
 def _shape_problems(i: int, s: SegmentInput, ctx: _Context) -> list[Problem]:
     if s.shape is not None and (s.law != "double_harmonic" or s.shape not in ("rise", "return")):
-        return [Problem(f"{ctx.path}[{i}].shape", s.shape, "shape applies to double_harmonic only, as 'rise' or 'return'",
-                        "remove it or fix its value")]
+        return [Problem(f"{ctx.path}[{i}].shape", s.shape,
+                        "shape applies to double_harmonic only, as 'rise' or 'return'", "remove it or fix its value")]
     return []
 
 

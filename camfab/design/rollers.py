@@ -20,9 +20,8 @@ import numpy as np
 
 from ..errors import Problem
 from .kinds import FollowerMotion, FollowerType
-from .mechanism import (Mechanism, finite_fields, lift_range, require_non_negative, require_positive,
-                        require_rotation)
-from .profile import DEG, CHUNK, Contact, MotionLike, ProfileSample, block, rot_into, xy
+from .mechanism import Mechanism, finite_fields, lift_range, require_non_negative, require_positive, require_rotation
+from .profile import CHUNK, DEG, Contact, MotionLike, ProfileSample, block, rot_into
 from .trig import cos_sin
 
 __all__ = ["DiscRollerContact", "TranslatingRollerContact", "OscillatingRollerContact", "TranslatingRoller",
@@ -241,7 +240,8 @@ def arm_swing_problems(xi0: float, program: MotionLike, *, hi_limit: float = mat
                     f"the {what} would swing to {math.degrees(hi):.6g}° (from ξ0 = {math.degrees(xi0):.6g}°); "
                     f"it must stay strictly between {math.degrees(lo_limit):g}° and {math.degrees(hi_limit):g}° "
                     "from the line of centres",
-                    f"keep the total lift below {math.degrees(hi_limit) - math.degrees(xi0):.6g}° or change the arm geometry")]
+                    f"keep the total lift below {math.degrees(hi_limit) - math.degrees(xi0):.6g}° "
+                    "or change the arm geometry")]
 
 
 @dataclass(frozen=True)

@@ -95,7 +95,7 @@ class Segment:
 
 
 def hermite_coefficients(
-    start: Sequence[float], end: Sequence[float], span: float
+    start: Sequence[float] | np.ndarray, end: Sequence[float] | np.ndarray, span: float
 ) -> tuple[float, ...]:
     """Polynomial (in u) through end conditions given per unit x.
 

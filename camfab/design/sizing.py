@@ -28,7 +28,7 @@ from ..errors import SpecError
 from ..numeric import extremum, root
 from .checks import DEFAULT_PRESSURE_LIMIT_DEG
 from .mechanisms import Mechanism, OscillatingFlat, OscillatingRoller, TranslatingFlat, TranslatingRoller
-from .profile import CamGeometry, MotionLike
+from .profile import CamGeometry, Contact, MotionLike
 
 __all__ = [
     "peak_pressure_angle_deg",
@@ -40,19 +40,30 @@ __all__ = [
 
 _TINY = 1e-9
 
+#: the families these helpers size (each has a ``base_radius_mm``)
+_Sized = TranslatingRoller | OscillatingRoller | TranslatingFlat | OscillatingFlat
+
+
+def _abs_pressure_angle(c: Contact, x) -> np.ndarray:
+    """|δ| of contact ``c`` at parameters x (radians)."""
+    pa = c.evaluate(x).pressure_angle
+    if pa is None:
+        raise TypeError(f"{type(c).__name__} has no pressure angle")
+    return np.abs(pa)
+
 
 def peak_pressure_angle_deg(mechanism: Mechanism, program: MotionLike) -> float:
     """max |δ| over the cycle in degrees (roller followers)."""
     c = CamGeometry(mechanism, program).profiles[0]
-    f = lambda x: np.abs(c.evaluate(x).pressure_angle)  # noqa: E731
+    f = lambda x: _abs_pressure_angle(c, x)  # noqa: E731
     return math.degrees(extremum(f, c.breakpoints, maximize=True)[1])
 
 
-def _with_rb(mech: Mechanism, rb: float) -> Mechanism:
+def _with_rb(mech: _Sized, rb: float) -> _Sized:
     return dataclasses.replace(mech, base_radius_mm=rb)
 
 
-def _measure(mech: Mechanism, program: MotionLike, rb: float, fn: Callable) -> float:
+def _measure(mech: _Sized, program: MotionLike, rb: float, fn: Callable) -> float:
     """fn(contact) at base radius rb; +inf where the geometry cannot be built."""
     try:
         g = CamGeometry(_with_rb(mech, rb), program)
@@ -83,7 +94,7 @@ def _smallest(f: Callable[[float], float], lo: float, hi: float, n: int = 40) ->
     return root(_each(f), float(rs[i - 1]), float(rs[i]), fa=vals[i - 1], fb=vals[i])
 
 
-def _upper(mech: Mechanism, program: MotionLike, f: Callable[[float], float], start: float) -> float:
+def _upper(mech: _Sized, program: MotionLike, f: Callable[[float], float], start: float) -> float:
     """A base radius at which f <= 0, found by doubling from ``start``."""
     hi = max(start, 1.0)
     for _ in range(60):
@@ -98,7 +109,7 @@ def _lift(program: MotionLike) -> float:
     return float(np.max(program.evaluate(x, (0,))[0]))
 
 
-def _osc_bounds(mech: Mechanism) -> tuple[float, float]:
+def _osc_bounds(mech: OscillatingRoller | OscillatingFlat) -> tuple[float, float]:
     if isinstance(mech, OscillatingRoller):
         a, m, rr = mech.arm_length_mm, mech.pivot_distance_mm, mech.roller_radius_mm
         return max(abs(a - m) - rr, 0.0) * (1 + _TINY) + _TINY, (a + m - rr) * (1 - _TINY)
@@ -136,7 +147,7 @@ def min_base_radius_for_pressure_angle(mechanism: Mechanism, program: MotionLike
 
         def f(rb):
             def peak(c):
-                g = lambda x: np.abs(c.evaluate(x).pressure_angle)  # noqa: E731
+                g = lambda x: _abs_pressure_angle(c, x)  # noqa: E731
                 return math.degrees(extremum(g, c.breakpoints, maximize=True)[1]) - lim
             return _measure(mechanism, program, rb, peak)
 

@@ -23,8 +23,15 @@ from .knots import KnotFile, KnotTable, build_knot_table
 from .laws import law_names
 from .mechanisms import MECHANISMS, mechanism_class
 from .program import TWO_PI, MotionProgram, SegmentInput, build_program
-from .shop import (POSTS, MachiningSpec, ManufacturingSpec, OutputsSpec, machining_section, manufacturing_section,
-                   outputs_section)
+from .shop import (
+    POSTS,
+    MachiningSpec,
+    ManufacturingSpec,
+    OutputsSpec,
+    machining_section,
+    manufacturing_section,
+    outputs_section,
+)
 from .validator import Validator
 
 __all__ = [

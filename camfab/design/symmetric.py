@@ -34,9 +34,12 @@ __all__ = ["ConstantWidthCam", "ConstantDiameterCam"]
 class _Symmetric(FormClosed):
     """Constant-width / constant-diameter cam: one profile, S(θ) + S(θ + π) = h."""
 
+    # fields of both families (declared by each subclass's dataclass; annotations only here: this base is
+    # not a dataclass, so they add no fields)
     base_radius_mm: float
     width_mm: float
     rise_deg: float
+    rotation: str
 
     def validate(self) -> list[Problem]:
         p: list[Problem] = []
@@ -53,11 +56,11 @@ class _Symmetric(FormClosed):
         if not isinstance(r, (int, float)) or not 0.0 < r <= 180.0:
             p.append(Problem("follower.rise_deg", r, "the rise (and return) must span more than 0° and at most 180°",
                              "use rise_deg in (0, 180]; 120 is the CAM-DAS law"))
-        if not p and getattr(self, "roller_radius_mm", 0.0) < 0:
-            p.append(Problem("follower.roller_radius_mm", self.roller_radius_mm, "must be >= 0 mm",
+        if not p and (rr := getattr(self, "roller_radius_mm", 0.0)) < 0:
+            p.append(Problem("follower.roller_radius_mm", rr, "must be >= 0 mm",
                              "give roller_radius_mm >= 0"))
-        if not p and getattr(self, "offset_mm", 0.0) != 0:
-            p.append(Problem("follower.offset_mm", self.offset_mm,
+        if not p and (offset := getattr(self, "offset_mm", 0.0)) != 0:
+            p.append(Problem("follower.offset_mm", offset,
                              "a constant-diameter cam needs offset 0: with an offset the lower roller would need a "
                              "second, different profile", "set offset_mm = 0, or use ConjugateTranslatingRoller"))
         return p

@@ -3,11 +3,12 @@
 The profile evaluates cos/sin of the cam angle (and of an arm angle) at every sample.  numpy's float64
 ``sin``/``cos`` are not one function: numpy picks an implementation by build and CPU at run time (SIMD kernels
 such as SVML on AVX-512 machines, the C library elsewhere), and these differ in the last bits — so a profile,
-and every exported file's bytes, would depend on the machine.  These kernels are fdlibm's (``k_sin.c``, ``k_cos.c``: Cody–Waite reduction by π/2, minimax
-polynomials on [−π/4, π/4], quadrant selection), written as ~40 elementwise IEEE operations on numpy arrays:
-accurate to ~1 ulp (tested against the library), deterministic everywhere, and on a CPU without AVX-512 twice
-as fast as numpy's scalar library calls (``benchmarks/bench_profile.py``).  The decision and its measurement are
-recorded in ``docs/decisions.md`` ("cos/sin kernels").
+and every exported file's bytes, would depend on the machine.  These kernels are fdlibm's (``k_sin.c``,
+``k_cos.c``: Cody–Waite reduction by π/2, minimax polynomials on [−π/4, π/4], quadrant selection), written as
+~40 elementwise IEEE operations on numpy arrays: accurate to ~1 ulp (tested against the library),
+deterministic everywhere, and on a CPU without AVX-512 twice as fast as numpy's scalar library calls
+(``benchmarks/bench_profile.py``).  The decision and its measurement are recorded in ``docs/decisions.md``
+("cos/sin kernels").
 """
 from __future__ import annotations
 

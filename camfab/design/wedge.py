@@ -13,9 +13,9 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..errors import Problem
+from ..geom2d import J, cross
 from .kinds import CamKind, Direction
 from .mechanism import Mechanism, finite_fields, require_non_negative
-from ..geom2d import J, cross
 from .profile import Contact, MotionLike, ProfileSample, inverse, pressure_angle, xy
 
 __all__ = ["TranslatingCamContact", "TranslatingCamRoller"]

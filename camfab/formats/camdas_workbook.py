@@ -74,14 +74,12 @@ import io
 import math
 import re
 import zipfile
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from ..design.kinds import ContactKind, FollowerType
 from ..design.tables import LiftTable, intervals, lift_table, sample_params
-from ..errors import Problem, SpecError
 from ..results import JUMP_CODES, IssueCode, Severity, Verdict
 
 __all__ = ["CAMDAS_COLUMNS", "FIXED_DATE", "LiftTable", "camdas_workbook", "camdas_columns", "conclusions",
@@ -485,7 +483,7 @@ def _lift_sheet(ws, table: LiftTable, geometry) -> None:
              table.radius_label)
     for col, text in enumerate(heads, 1):
         ws.cell(1, col, text).font = bold
-    for i, (a, s, r) in enumerate(zip(table.angle, table.lift, table.radius)):
+    for i, (a, s, r) in enumerate(zip(table.angle, table.lift, table.radius, strict=True)):
         ws.cell(2 + i, 1, float(a)), ws.cell(2 + i, 2, float(s)), ws.cell(2 + i, 3, float(r))
     ws.freeze_panes = "A2"
 

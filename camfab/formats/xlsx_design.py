@@ -48,8 +48,8 @@ from typing import Any
 from ..design.knots import KnotFile
 from ..design.spec import CamSpec, DesignSpec, FollowerSpec, ManufacturingSpec, OutputsSpec, dynamics_items
 from ..errors import Problem, SpecError
-from .camdas_workbook import FIXED_DATE, fixed_zip
 from ..units import RPM
+from .camdas_workbook import FIXED_DATE, fixed_zip
 from .toml_design import design_from_data
 
 __all__ = ["load_design_xlsx", "design_to_xlsx", "design_rows", "SEGMENT_COLUMNS", "KNOT_COLUMNS"]

@@ -4,8 +4,8 @@ Flow: a closed tool-centre contour (lines and arcs, from :mod:`camfab.offset`) a
 -> :func:`contour_toolpath` -> :class:`Program` (common model, mm) -> :func:`dumps` / :func:`write_gcode`
 with a post-processor (``linuxcnc``, ``fanuc``, ``grbl``) -> G-code text -> :func:`parse` (back-plot)
 -> :func:`verify` against the exact curves (programs under G41/G42 are first run through
-:func:`simulate_compensation`, the controller's offset of the part contour).  :func:`lift_table_csv` writes the polar lift table for cam
-grinders.
+:func:`simulate_compensation`, the controller's offset of the part contour).  :func:`lift_table_csv` writes
+the polar lift table for cam grinders.
 """
 from camfab.gcode.compensation import simulate_compensation
 from camfab.gcode.contour import ContourDistance, Segment, as_contour, offset_contour, orient_contour

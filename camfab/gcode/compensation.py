@@ -38,11 +38,12 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
+from typing import Literal
 
 import numpy as np
 
-from camfab.geom2d import TWO_PI, arc_sweep
 from camfab.gcode.parse import Move
+from camfab.geom2d import TWO_PI, arc_sweep
 from camfab.results import Finding, IssueCode
 
 __all__ = ["CompensatedPath", "simulate_compensation", "move_lengths"]
@@ -281,7 +282,7 @@ def _has_xy(m: Move) -> bool:
 
 
 class _Sim:
-    def __init__(self, moves, r, swap, join_tol):
+    def __init__(self, moves, r, swap, join_tol) -> None:
         self.m, self.r, self.swap, self.join_tol = moves, float(r), swap, join_tol
         self.out: list[Move] = []
         self.src: list[int] = []
@@ -290,7 +291,7 @@ class _Sim:
         self.runs: list[CompRun] = []
         self.problems: list[Finding] = []
         self.corners = {"rolling": 0, "trimmed": 0, "failed": 0}
-        self.tool = None  # tool XY when it differs from the programmed position (after compensation)
+        self.tool: tuple[float, float] | None = None  # tool XY where it differs from the programmed one
         self.last_run = -1
 
     def report(self, code: IssueCode, message: str, line: int | None) -> None:
@@ -487,7 +488,7 @@ class _Sim:
         Sq = q.point(q.t0)
         gap = float(np.hypot(*(Sq - Ep)))
         corner = p.p_end if p.p_end is not None else q.p_start
-        connector = None  # ("corner", P) | ("bridge",)
+        connector: tuple[Literal["corner"], np.ndarray] | tuple[Literal["bridge"]] | None = None
         if gap > JOIN_EPS_MM:
             if not (p.exact and q.exact) or corner is None:
                 connector = ("bridge",)

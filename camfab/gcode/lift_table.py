@@ -7,8 +7,8 @@ a final newline; ``-0.000000`` is written ``0.000000``.  Deterministic.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
@@ -78,11 +78,12 @@ def lift_table_csv(angles_deg, lift_mm, *, lift_unit: str = "mm") -> str:
         problems.append(Problem("lift_unit", lift_unit, "is not a valid option", "must be one of: mm, deg"))
     if problems:
         raise SpecError(problems)
-    rows = [f"angle_deg,lift_{lift_unit}"] + [f"{_f6(x)},{_f6(y)}" for x, y in zip(a.tolist(), lift.tolist())]
+    rows = [f"angle_deg,lift_{lift_unit}"]
+    rows += [f"{_f6(x)},{_f6(y)}" for x, y in zip(a.tolist(), lift.tolist(), strict=True)]
     return "\n".join(rows) + "\n"
 
 
-def write_lift_table(path: str | Path, angles_deg, lift_mm: "np.ndarray | Callable", *,
+def write_lift_table(path: str | Path, angles_deg, lift_mm: np.ndarray | Callable, *,
                      lift_unit: str = "mm") -> Path:
     """Write :func:`lift_table_csv` atomically to ``path``."""
     return atomic_write(path, lift_table_csv(angles_deg, lift_mm, lift_unit=lift_unit))

@@ -20,8 +20,8 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 
@@ -481,6 +481,7 @@ def _move_points(m: Move, step: float) -> np.ndarray:
         k = max(1, int(math.ceil(L / step)))
         u = np.linspace(0.0, 1.0, k + 1)
         return s + u[:, None] * (e - s)
+    assert m.center is not None  # an arc always carries its centre (_State.arc)
     cx, cy = m.center
     L = abs(m.sweep) * max(m.radius_start, m.radius_end)
     k = max(2, int(math.ceil(L / step)))

@@ -16,8 +16,15 @@ from __future__ import annotations
 
 from .compare import render_comparison
 from .html import render_report, write_files
-from .plots import (curvature_figure, face_position_figure, figure_bytes, pressure_angle_figure, profile_figure,
-                    report_figures, svaj_figure)
+from .plots import (
+    curvature_figure,
+    face_position_figure,
+    figure_bytes,
+    pressure_angle_figure,
+    profile_figure,
+    report_figures,
+    svaj_figure,
+)
 
 __all__ = ["render_report", "render_comparison", "write_files", "figure_bytes", "svaj_figure", "profile_figure",
            "curvature_figure", "pressure_angle_figure", "face_position_figure", "report_figures"]

@@ -8,7 +8,8 @@ units (mm or degrees of lift; degrees of cam angle or mm of travel).
 from __future__ import annotations
 
 import math
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -22,7 +23,8 @@ __all__ = ["render_comparison", "comparison_rows", "compare_svaj_figure", "compa
 
 def design_labels(items) -> list[str]:
     """Design names, made unique ("Cam", "Cam (2)") for legends and column heads."""
-    out, seen = [], {}
+    out: list[str] = []
+    seen: dict[str, int] = {}
     for spec, _, _ in items:
         n = seen.get(spec.name, 0) + 1
         seen[spec.name] = n
@@ -65,7 +67,7 @@ def compare_svaj_figure(items, labels: Sequence[str] | None = None):
             vals = prog.evaluate(x) * (spec.speed ** np.arange(4))[:, None]
             for k, ax in enumerate(axes):
                 ax.plot(x * axis.scale, vals[k], color=f"C{i}", lw=1.3, label=labels[i] if k == 0 else None)
-        for q, ax in zip("SVAJ", axes):
+        for q, ax in zip("SVAJ", axes, strict=True):
             ax.axhline(0.0, color="0.2", lw=0.6)
             ax.set_ylabel(f"{q} ({' | '.join(SVAJ_UNITS[q].format(u=u) for u in units)})")
             ax.margins(y=0.1)

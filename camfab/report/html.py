@@ -15,16 +15,27 @@ import base64
 import dataclasses
 import json
 import math
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
 from ..assets import read_template
 from ..errors import MissingDependencyError
 from ..results import DynamicsSummary, IssueCode, Severity
-from ._common import (VERDICT_CLASS, VERDICT_TEXT, _cell, axis_of, conclusions_rows, fmt, fmt_at, key_values,
-                      mechanism_text, range_text)
+from ._common import (
+    VERDICT_CLASS,
+    VERDICT_TEXT,
+    _cell,
+    axis_of,
+    conclusions_rows,
+    fmt,
+    fmt_at,
+    key_values,
+    mechanism_text,
+    range_text,
+)
 
 __all__ = ["render_report", "write_files", "template_environment", "report_context", "dynamics_rows", "PLOT_TEXT",
            "CURVED_PLOT_TEXT", "plot_text", "require_report_dependencies"]
@@ -207,7 +218,9 @@ def dynamics_rows(spec, report) -> list[dict[str, Any]]:
 def _pair_rows(dyn: DynamicsSummary, report, xu: str) -> list[dict[str, Any]]:
     """The dynamics table of a form-closed follower: both contact forces and the load reversals."""
     none, rows = _cell(None), []
-    for k, cf in ((1, dyn.contact_force), (2, dyn.second_contact_force)):
+    second = dyn.second_contact_force
+    assert second is not None  # a form-closed summary carries follower 2's contact force
+    for k, cf in ((1, dyn.contact_force), (2, second)):
         rows.append(_row(f"Contact force, follower {k} (N)", _cell(cf.max, cf.at_max, xu),
                          _cell(cf.min, cf.at_min, xu),
                          "Form closure: the follower cannot leave the cam" if k == 1 else
@@ -240,6 +253,8 @@ def _drive_rows(dyn: DynamicsSummary, report, xu: str) -> list[dict[str, Any]]:
 def _limit_rows(spec, dyn: DynamicsSummary, xu: str) -> list[dict[str, Any]]:
     """The preload-needed and jump-speed rows of :func:`dynamics_rows` (bad when the design misses them)."""
     fs, none, rows = dyn.safety_force_n, _cell(None), []
+    # a spring-loaded (not form-closed) summary carries both
+    assert dyn.preload_needed is not None and dyn.jump_speed is not None
     pre, have = dyn.preload_needed, spec.dynamics.spring_preload if spec.dynamics is not None else None
     short = have is not None and not have >= pre.value - 1e-9 * max(1.0, abs(pre.value))
     rows.append(_row(f"Preload needed ({pre.unit})", _cell(pre.value, pre.at, xu), none,
@@ -286,7 +301,7 @@ def _inputs(spec) -> list[dict[str, Any]]:
     return groups
 
 
-def _segments(prog) -> list[dict[str, str]]:
+def _segments(prog) -> list[dict[str, Any]]:
     ax = axis_of(prog)
     starts = np.array([s.start for s in prog.segments])
     ends = np.array([s.start + s.span for s in prog.segments])

@@ -152,7 +152,7 @@ def svaj_figure(spec, prog, *, n: int = _N):
     with plot_style():
         fig = new_figure(9.0, 8.6)
         axes = fig.subplots(4, 1, sharex=True)
-        for k, ((q, colour), ax) in enumerate(zip(_SVAJ, axes)):
+        for k, ((q, colour), ax) in enumerate(zip(_SVAJ, axes, strict=True)):
             ax.plot(x * axis.scale, vals[k], color=colour)
             ax.axhline(0.0, color="0.2", lw=0.6)
             boundaries(ax, prog, axis)
@@ -249,7 +249,7 @@ def _angle_marks(ax, c, col) -> None:
     s = c.evaluate(np.radians(deg))
     p, nrm = s.point, s.normal
     ax.plot(p[:, 0], p[:, 1], "o", ms=2.5, color=col)
-    for a, q, v in zip(deg, p, nrm):
+    for a, q, v in zip(deg, p, nrm, strict=True):
         if a % 90 == 0:
             ax.annotate(f"{a}°", q, xytext=(q + 0.08 * np.hypot(*q) * v), fontsize=7, color=col,
                         ha="center", va="center")
@@ -351,7 +351,7 @@ def pressure_angle_figure(spec, geometry, report, *, n: int = _N):
     with plot_style():
         fig = new_figure(9.0, 4.2)
         ax = fig.subplots()
-        for k, (c, x, s) in enumerate(_profile_samples(geometry, n)):
+        for k, (_c, x, s) in enumerate(_profile_samples(geometry, n)):
             if s.pressure_angle is None:
                 continue
             xu, delta = x * axis.scale, np.degrees(s.pressure_angle)
@@ -400,7 +400,7 @@ def face_position_figure(spec, geometry, report, *, n: int = _N):
     with plot_style():
         fig = new_figure(9.0, 4.0)
         ax = fig.subplots()
-        for k, (c, x, s) in enumerate(_profile_samples(geometry, n)):
+        for k, (_c, x, s) in enumerate(_profile_samples(geometry, n)):
             if s.face_position is None:
                 continue
             ax.plot(x * axis.scale, s.face_position, color=f"C{k}",

@@ -12,11 +12,11 @@ from camfab.cad.plate import PlateSpec, plate_volume
 from camfab.cli import main
 from camfab.design.assemble import geometry_from_spec
 from camfab.design.spec import design_from_dict
+from camfab.discretize import Chain, arcs, measure_deviation, polyline
 from camfab.errors import GeometryError, SpecError
 from camfab.formats import load_design
 from camfab.gcode import Job, dumps, parse, verify
 from camfab.gcode.cam import cam_program, signed_distance
-from camfab.discretize import Chain, arcs, measure_deviation, polyline
 from camfab.offset.cutter import offset_curve, pitch_curve, profile_curve, tool_centre_path
 from camfab.offset.outline import translating_outline
 from tests.conftest import EXAMPLES, base_design

@@ -8,8 +8,13 @@ import numpy as np
 import pytest
 
 from camfab.design.checks import CUSP_TOL_MM, check
-from camfab.design.mechanisms import (OscillatingFlat, OscillatingRoller, TranslatingCamRoller, TranslatingFlat,
-                                      TranslatingRoller)
+from camfab.design.mechanisms import (
+    OscillatingFlat,
+    OscillatingRoller,
+    TranslatingCamRoller,
+    TranslatingFlat,
+    TranslatingRoller,
+)
 from camfab.design.profile import CamGeometry
 from camfab.design.program import MotionProgram
 from camfab.numeric import extremum

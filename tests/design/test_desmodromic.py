@@ -13,13 +13,19 @@ from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 
 from camfab.design.checks import check
-from camfab.design.conjugate import (ComplementMotion, ConjugateOscillatingFlat, ConjugateOscillatingRoller,
-                                     ConjugateTranslatingFlat, ConjugateTranslatingRoller, follower_limits, lift_of,
-                                     minimum_follower_distance)
-from camfab.design.mechanisms import TranslatingFlat
-from camfab.design.symmetric import ConstantDiameterCam, ConstantWidthCam
+from camfab.design.conjugate import (
+    ComplementMotion,
+    ConjugateOscillatingFlat,
+    ConjugateOscillatingRoller,
+    ConjugateTranslatingFlat,
+    ConjugateTranslatingRoller,
+    follower_limits,
+    lift_of,
+    minimum_follower_distance,
+)
 from camfab.design.profile import CamGeometry
 from camfab.design.program import MotionProgram
+from camfab.design.symmetric import ConstantDiameterCam, ConstantWidthCam
 from camfab.errors import SpecError
 from camfab.results import IssueCode
 

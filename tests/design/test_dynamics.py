@@ -11,8 +11,15 @@ from hypothesis import strategies as st
 
 from camfab.design.assemble import check_design, dynamics_of, geometry_from_spec, loads_from_spec
 from camfab.design.dynamics import ContactDynamics, Loads, analyse_dynamics
-from camfab.design.mechanisms import OscillatingCurved, OscillatingFlat, OscillatingRoller, TranslatingCamRoller, \
-    TranslatingCurved, TranslatingFlat, TranslatingRoller
+from camfab.design.mechanisms import (
+    OscillatingCurved,
+    OscillatingFlat,
+    OscillatingRoller,
+    TranslatingCamRoller,
+    TranslatingCurved,
+    TranslatingFlat,
+    TranslatingRoller,
+)
 from camfab.design.profile import CamGeometry
 from camfab.design.program import MotionProgram
 from camfab.design.spec import design_from_dict
@@ -412,10 +419,15 @@ def test_examples_with_dynamics_hold_their_safety_force(name):
 
 # ---------------------------------------------------------------------------
 # form-closed followers: conjugate pairs, constant width and constant diameter
-from camfab.design.mechanisms import (ConjugateOscillatingFlat, ConjugateOscillatingRoller,  # noqa: E402
-                                      ConjugateTranslatingFlat, ConjugateTranslatingRoller, ConstantDiameterCam,
-                                      ConstantWidthCam)
 from camfab.design.dynamics import pair_of  # noqa: E402
+from camfab.design.mechanisms import (  # noqa: E402
+    ConjugateOscillatingFlat,
+    ConjugateOscillatingRoller,
+    ConjugateTranslatingFlat,
+    ConjugateTranslatingRoller,
+    ConstantDiameterCam,
+    ConstantWidthCam,
+)
 
 E9 = MotionProgram.from_segments([("modified_sine", 10, 50), ("dwell", 0, 40), ("cycloidal", -10, 50),
                                   ("dwell", 0, 40), ("poly345", 10, 50), ("dwell", 0, 40), ("poly4567", -10, 50),

@@ -127,7 +127,7 @@ def test_boundary_values_table(name, lift, span_deg):
     seg = Segment(name, lift, beta, 0.0, max(0.0, -lift))
     got = _ends(seg)
     want = BOUNDARY[name]
-    for k, (g, w) in enumerate(zip(got, want)):
+    for k, (g, w) in enumerate(zip(got, want, strict=True)):
         order = k % 3 + 1
         scale = lift / beta**order
         assert g / scale == pytest.approx(w, abs=1e-9), f"{name} end value #{k}"
@@ -140,7 +140,7 @@ def test_boundary_values_double_harmonic(name, h, span_deg):
     sign, want = BOUNDARY_DH[name]
     beta = span_deg * DEG
     seg = Segment(name, sign * h, beta, 0.0, h if sign < 0 else 0.0)
-    for k, (g, w) in enumerate(zip(_ends(seg), want)):
+    for k, (g, w) in enumerate(zip(_ends(seg), want, strict=True)):
         order = k % 3 + 1
         assert g / (h / beta**order) == pytest.approx(w, abs=1e-9), f"{name} end value #{k}"
 
@@ -200,7 +200,7 @@ def test_peak_coefficients_exact(name):
     lift, beta = 1.0, 1.0
     peaks = _single(name, lift, beta).peaks("exact")
     got = (peaks[1].max, peaks[1].min, peaks[2].max, peaks[2].min, peaks[3].max, peaks[3].min)
-    for k, (g, w) in enumerate(zip(got, COEFFS[name])):
+    for k, (g, w) in enumerate(zip(got, COEFFS[name], strict=True)):
         tol = 1e-3 if (name, k) in LOOSE else 1e-9
         assert g == pytest.approx(w, abs=tol), f"{name} coefficient #{k}"
 

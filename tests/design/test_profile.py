@@ -9,8 +9,13 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from camfab.design.mechanisms import (OscillatingFlat, OscillatingRoller, TranslatingCamRoller, TranslatingFlat,
-                                      TranslatingRoller)
+from camfab.design.mechanisms import (
+    OscillatingFlat,
+    OscillatingRoller,
+    TranslatingCamRoller,
+    TranslatingFlat,
+    TranslatingRoller,
+)
 from camfab.design.profile import CamGeometry
 from camfab.design.program import MotionProgram
 from camfab.errors import SpecError
@@ -406,7 +411,8 @@ def test_analytic_geometry_matches_finite_differences(design):
 def test_cos_sin_kernels_match_the_library_to_an_ulp():
     """The profile's own cos/sin (fdlibm kernels on numpy arrays) agree with numpy's to ~1 ulp, and
     fall back to the library beyond their reduction range and for NaN/inf."""
-    from camfab.design.trig import SINCOS_MAX as _SINCOS_MAX, cos_sin as _cos_sin
+    from camfab.design.trig import SINCOS_MAX as _SINCOS_MAX
+    from camfab.design.trig import cos_sin as _cos_sin
 
     rng = np.random.default_rng(7)
     x = np.concatenate([rng.uniform(-20, 20, 200_000), rng.uniform(-_SINCOS_MAX, _SINCOS_MAX, 50_000),
@@ -431,7 +437,7 @@ def test_fixed_frame_sample_is_the_cam_frame_sample_turned_back(name):
     x = np.linspace(0.0, g.period, 1001) if not g.closed else np.linspace(-1.0, 7.5, 1001)
     for c in g.profiles:
         cam, fix = c.evaluate(x), c.evaluate_fixed(x)
-        turn = (lambda v: v) if not c.closed else (lambda v: _rot(v, -c.sense * x))  # noqa: E731
+        turn = (lambda v: v) if not c.closed else (lambda v, c=c: _rot(v, -c.sense * x))  # noqa: E731
         for f in ("point", "point_d1", "normal", "tangent", "pitch"):
             a, b = getattr(cam, f), getattr(fix, f)
             if a is None:

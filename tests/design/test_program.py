@@ -172,7 +172,7 @@ def test_camdas_step_is_one_degree_and_includes_360():
     assert pk[3].min == pytest.approx(-4 * PI**2 * 10 / PI**3, rel=1e-12)
     # step keyword: coarser sampling can only lower the magnitudes
     coarse = p.peaks("camdas", step=5 * DEG)
-    for c, f in zip(coarse, pk):
+    for c, f in zip(coarse, pk, strict=True):
         assert c.max <= f.max + 1e-12 and c.min >= f.min - 1e-12
 
 

@@ -51,7 +51,7 @@ def programs(draw):
         levels[j] = 0.0
         j -= 1
     lifts = [levels[i + 1] - levels[i] for i in range(n)]
-    return [(law, lift, span) for law, lift, span in zip(laws, lifts, spans)]
+    return [(law, lift, span) for law, lift, span in zip(laws, lifts, spans, strict=True)]
 
 
 def _build(rows) -> MotionProgram:
@@ -112,11 +112,11 @@ def test_displacement_never_below_zero(rows):
     p = _build(rows)
     x = np.linspace(0.0, TWO_PI, 20001)
     s = p(x, 0)
-    top = max(abs(l) for _, l, _ in rows) or 1.0
+    top = max(abs(h) for _, h, _ in rows) or 1.0
     assert s.min() >= -1e-9 * top
     assert p.peaks("exact")[0].min >= -1e-9 * top
     # the program visits its junction ordinates
-    levels = np.concatenate([[0.0], np.cumsum([l for _, l, _ in rows])[:-1]])
+    levels = np.concatenate([[0.0], np.cumsum([h for _, h, _ in rows])[:-1]])
     starts = np.concatenate([[0.0], np.cumsum([sp for _, _, sp in rows])[:-1]]) * math.pi / 180
     assert np.allclose(p(starts, 0), levels, atol=1e-9 * top)
 
@@ -153,7 +153,7 @@ def test_junctions_at_least_c2(rows):
     p = _build(rows)
     js = p.junctions()
     assert len(js) == len(rows)
-    for j, (law, _, _) in zip(js, rows):
+    for j in js:
         assert j.order >= 2, (j, rows)
     # a generic 7th-degree polynomial is jerk-continuous at both ends
     n = len(rows)

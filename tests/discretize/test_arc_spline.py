@@ -37,10 +37,7 @@ _CACHE: dict = {}
 
 def example(name):
     if name not in _CACHE:
-        if name == "typical12":
-            g = typical12()
-        else:
-            g = geometry_from_spec(load_design(f"camfab/examples/{name}.toml"))
+        g = typical12() if name == "typical12" else geometry_from_spec(load_design(f"camfab/examples/{name}.toml"))
         c = profile_curve(g.profiles[0])
         _CACHE[name] = (g, c, Dense(c))
     return _CACHE[name]
@@ -113,7 +110,7 @@ def test_free_spline_at_fine_tolerances(tol, bounds):
     # long pieces are cut into spans (G1 joints with the curve's tangent): the free spline still
     # covers 0.1 µm and 10 nm (120 / 84 / 173 and 243 / 180 / 365 arcs; biarcs gave 176 / 130 / 278
     # and 360 / 262 / 546)
-    for name, bound in zip(("ejemplo9rt", "indexing_packaging", "typical12"), bounds):
+    for name, bound in zip(("ejemplo9rt", "indexing_packaging", "typical12"), bounds, strict=True):
         _, curve, dense = example(name)
         res = arcs(curve, tol=tol)
         assert res.params.size - 1 <= max(curve.breakpoints.size, res.n_entities // 3)  # the free spline, not biarcs

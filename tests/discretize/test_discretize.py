@@ -486,7 +486,7 @@ def cam_programs(draw):
     laws = [draw(st.sampled_from(RISE_LAWS)) for _ in range(n_rise + 1)]
     moves = [(laws[i], lifts[i]) for i in range(n_rise)] + [(laws[-1], -sum(lifts))]
     rows = []
-    for (law, lift), (a_move, a_dwell) in zip(moves, zip(angles[0::2], angles[1::2] + [last])):
+    for (law, lift), a_move, a_dwell in zip(moves, angles[0::2], angles[1::2] + [last], strict=True):
         rows += [(law, lift, a_move), ("dwell", 0, a_dwell)]
     base = draw(st.floats(25.0, 60.0))
     tol = draw(st.sampled_from([1e-2, 1e-3, 1e-4]))

@@ -6,6 +6,7 @@ right program line.
 """
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import re
@@ -13,11 +14,21 @@ import re
 import numpy as np
 import pytest
 
-from camfab.gcode import (ContourDistance, Segment, contour_toolpath, dumps, offset_contour, parse, sample,
-                          verify)
+from camfab.gcode import ContourDistance, Segment, contour_toolpath, dumps, offset_contour, parse, sample, verify
 from camfab.gcode.compensation import move_lengths, simulate_compensation
-from tests.gcode.parts import (HALF, PART, RP, R_TOOL, SAFE_Z, TOL, job, notched_disc, stadium,
-                               stadium_distance, stadium_points)
+from tests.gcode.parts import (
+    HALF,
+    PART,
+    R_TOOL,
+    RP,
+    SAFE_Z,
+    TOL,
+    job,
+    notched_disc,
+    stadium,
+    stadium_distance,
+    stadium_points,
+)
 
 FINISH = "FINISH CONTOUR"
 
@@ -26,7 +37,7 @@ FINISH = "FINISH CONTOUR"
 
 def polygon(pts) -> list[Segment]:
     pts = [tuple(map(float, p)) for p in pts]
-    return [Segment(a, b) for a, b in zip(pts, pts[1:] + pts[:1])]
+    return [Segment(a, b) for a, b in zip(pts, pts[1:] + pts[:1], strict=True)]
 
 
 def square(a=40.0):
@@ -60,10 +71,8 @@ def comp_text(part, comp="G41", post="linuxcnc", **over):
 def check(text, part_segments, centre_segments=None, **kw):
     """verify() against exact contour distances (the tool-centre curve: the part offset by r)."""
     part = ContourDistance(part_segments)
-    if centre_segments is None:
-        centre = lambda p: part(p) - R_TOOL  # noqa: E731 - exact for convex parts
-    else:
-        centre = ContourDistance(centre_segments)
+    # without centre segments: the part distance less the tool radius (exact for convex parts)
+    centre = (lambda p: part(p) - R_TOOL) if centre_segments is None else ContourDistance(centre_segments)
     args = dict(exact_curve_distance=centre, part_distance=part, tool_radius=R_TOOL, tol=TOL, safe_z=SAFE_Z)
     args.update(kw)
     return verify(parse(text), **args)
@@ -71,7 +80,7 @@ def check(text, part_segments, centre_segments=None, **kw):
 
 def finish_moves(path):
     """Simulated moves of the finishing contour at final depth, and their kinds."""
-    moves = [(m, k) for m, k in zip(path.moves, path.kind) if (m.label or "").startswith(FINISH)]
+    moves = [(m, k) for m, k in zip(path.moves, path.kind, strict=True) if (m.label or "").startswith(FINISH)]
     zf = min(min(m.start[2], m.end[2]) for m, _ in moves)
     return [(m, k) for m, k in moves if abs(m.start[2] - zf) < 1e-9 and abs(m.end[2] - zf) < 1e-9]
 
@@ -108,7 +117,7 @@ def test_stadium_compensated_program_is_the_exact_tool_centre_path(post, comp):
     path = simulate_compensation(parse(text).moves, R_TOOL)
     fin = finish_moves(path)
     L = sum(move_lengths([m for m, _ in fin]))
-    assert L == pytest.approx(4 * HALF + 2 * math.pi * (RP + R_TOOL), abs=1e-6)
+    assert pytest.approx(4 * HALF + 2 * math.pi * (RP + R_TOOL), abs=1e-6) == L
     pts = sample([m for m, _ in fin], 0.02).points[:, :2]
     assert np.abs(centre(pts)).max() < 1e-9
 
@@ -219,7 +228,7 @@ def test_convex_polygon_gets_rolling_arcs_perimeter_plus_2_pi_r(shape, comp):
     L = float(move_lengths([m for m, _ in fin]).sum())
     # exact for the square; the pentagon's written (rounded) vertices leave kinks of ~3 microradians at
     # the lead-in/out junctions, which belong to the leads: r * 3e-6 ~ 1e-5 mm
-    assert L == pytest.approx(perimeter + 2 * math.pi * R_TOOL, abs=1e-9 if shape is square else 1e-4)
+    assert pytest.approx(perimeter + 2 * math.pi * R_TOOL, abs=1e-9 if shape is square else 1e-4) == L
     assert sum(abs(m.sweep) for m in corners) == pytest.approx(2 * math.pi, abs=1e-4)
     rep = check(text, part, offset_contour(part, R_TOOL))
     assert rep.ok, rep.to_dict()["problems"]
@@ -238,7 +247,7 @@ def test_rounded_rectangle_with_fillets_smaller_than_the_tool_is_fine_on_the_out
     fin = finish_moves(path)
     assert not [k for _, k in fin if k == "corner"]  # tangent joins: nothing inserted
     L = float(move_lengths([m for m, _ in fin]).sum())
-    assert L == pytest.approx(programmed_finish_length(text) + 2 * math.pi * R_TOOL, abs=1e-6)
+    assert pytest.approx(programmed_finish_length(text) + 2 * math.pi * R_TOOL, abs=1e-6) == L
     assert check(text, segs, offset_contour(segs, R_TOOL)).ok
 
 
@@ -251,7 +260,7 @@ def test_concave_corner_is_trimmed_to_the_exact_offset(comp):
     assert sum(k == "corner" for _, k in fin) == 5 and path.corners["trimmed"] >= 1
     # closed form: perimeter + r * (5 convex quarter turns) - 2 r tan(45 deg) at the concave corner
     L = float(move_lengths([m for m, _ in fin]).sum())
-    assert L == pytest.approx(160.0 + R_TOOL * 5 * math.pi / 2 - 2 * R_TOOL, abs=1e-9)
+    assert pytest.approx(160.0 + R_TOOL * 5 * math.pi / 2 - 2 * R_TOOL, abs=1e-9) == L
     # the trimmed corner sits on the bisector, r from both walls
     ends = np.array([m.end[:2] for m, _ in fin])
     assert np.min(np.hypot(*(ends - [R_TOOL, R_TOOL]).T)) < 1e-9
@@ -367,17 +376,17 @@ def test_linuxcnc_entry_is_tangent_to_the_circle_about_the_programmed_point():
     # G41 travelling +X, then a right turn: a convex corner after the entry
     text = "G21 G90\nG0 X0 Y0 Z-1\nG1 G41 D1 X10 Y0 F100\nG1 X10 Y-10\nG1 G40 X0 Y-10\nM2\n"
     path = simulate_compensation(parse(text).moves, 2.0)
-    entry = next(m for m, k in zip(path.moves, path.kind) if k == "entry")
+    entry = next(m for m, k in zip(path.moves, path.kind, strict=True) if k == "entry")
     E, C, P = np.array(entry.end[:2]), np.array(entry.start[:2]), np.array([10.0, 0.0])
     assert C.tolist() == [0.0, 0.0]
     assert np.hypot(*(E - P)) == pytest.approx(2.0)
     assert float((E - C) @ (E - P)) == pytest.approx(0.0, abs=1e-12)  # tangent: the cutter touches P
     assert E[1] > 0  # G41: left of travel (+X)
-    corner = next(m for m, k in zip(path.moves, path.kind) if k == "corner")
+    corner = next(m for m, k in zip(path.moves, path.kind, strict=True) if k == "corner")
     assert corner.center == (10.0, 0.0) and corner.clockwise and corner.end[:2] == pytest.approx((12.0, 0.0))
     # the rolling arc turns from the entry's direction to -Y: 90 deg + asin(r / d)
     assert abs(corner.sweep) == pytest.approx(math.pi / 2 + math.asin(2.0 / 10.0))
-    ex = next(m for m, k in zip(path.moves, path.kind) if k == "exit")
+    ex = next(m for m, k in zip(path.moves, path.kind, strict=True) if k == "exit")
     assert ex.start[:2] == pytest.approx((12.0, -10.0)) and ex.end[:2] == (0.0, -10.0)
 
 
@@ -386,18 +395,18 @@ def test_entry_into_a_concave_corner_is_trimmed():
     text = "G21 G90\nG0 X0 Y0 Z-1\nG1 G41 D1 X10 Y0 F100\nG1 X10 Y10\nG1 G40 X0 Y10\nM2\n"
     path = simulate_compensation(parse(text).moves, 2.0)
     assert "corner" not in path.kind and path.corners["trimmed"] == 1
-    entry = next(m for m, k in zip(path.moves, path.kind) if k == "entry")
-    off = next(m for m, k in zip(path.moves, path.kind) if k == "offset")
+    entry = next(m for m, k in zip(path.moves, path.kind, strict=True) if k == "entry")
+    off = next(m for m, k in zip(path.moves, path.kind, strict=True) if k == "offset")
     assert entry.end[0] == pytest.approx(8.0) and off.start[:2] == pytest.approx(entry.end[:2])
     assert off.end[:2] == pytest.approx((8.0, 10.0))
-    ex = next(m for m, k in zip(path.moves, path.kind) if k == "exit")
+    ex = next(m for m, k in zip(path.moves, path.kind, strict=True) if k == "exit")
     assert ex.start[:2] == pytest.approx((8.0, 10.0)) and ex.end[:2] == (0.0, 10.0)
 
 
 def test_reversal_rolls_half_a_turn_round_the_end():
     text = "G21 G90\nG0 X-20 Y0 Z-1\nG1 G41 D1 X0 Y0 F100\nG1 X20\nG1 X0\nG1 G40 X-20\nM2\n"
     path = simulate_compensation(parse(text).moves, 2.0)
-    c = [m for m, k in zip(path.moves, path.kind) if k == "corner" and m.line == 5]
+    c = [m for m, k in zip(path.moves, path.kind, strict=True) if k == "corner" and m.line == 5]
     assert len(c) == 1 and c[0].center == (20.0, 0.0) and c[0].sweep == pytest.approx(-math.pi)
     assert c[0].start[:2] == pytest.approx((20.0, 2.0)) and c[0].end[:2] == pytest.approx((20.0, -2.0))
 
@@ -413,19 +422,19 @@ def test_z_only_moves_keep_the_compensated_position():
     text = ("G21 G90\nG0 X0 Y-10 Z5\nG1 G41 D1 X0 Y0 F100\nG1 Z-1\nG1 X20\nG1 Z5\nG1 G40 X20 Y-10\n"
             "G0 Z25\nM2\n")
     path = simulate_compensation(parse(text).moves, 2.0)
-    z = [m for m, k in zip(path.moves, path.kind) if k == "z"]
+    z = [m for m, k in zip(path.moves, path.kind, strict=True) if k == "z"]
     assert len(z) == 2
     assert z[0].start[:2] == z[0].end[:2] and z[1].start[:2] == z[1].end[:2]
     assert z[1].end[:2] == pytest.approx((20.0, 2.0))  # left of +X travel, before the exit
     # and the sequence is continuous in XY
-    for a, b in zip(path.moves[1:], path.moves[2:]):
+    for a, b in itertools.pairwise(path.moves[1:]):
         assert np.allclose(a.end[:2], b.start[:2], atol=1e-12), (a, b)
 
 
 def test_compensated_path_is_continuous_for_a_cam(cam_case):
     path = simulate_compensation(parse(cam_case["texts"]["G41"]).moves, R_TOOL)
     ms = [m for m in path.moves if np.all(np.isfinite(m.start))]
-    gaps = [math.dist(a.end, b.start) for a, b in zip(ms, ms[1:])]
+    gaps = [math.dist(a.end, b.start) for a, b in itertools.pairwise(ms)]
     assert max(gaps) < 1e-9
     assert path.corners["failed"] == 0 and not path.problems
 

@@ -8,12 +8,26 @@ import math
 import re
 
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from camfab.errors import ExportError
 from camfab.gcode import POSTS, contour_toolpath, dumps, parse, verify, write_gcode
-from tests.gcode.parts import (CENTRE_CURVE, HALF, PART, RP, R_TOOL, SAFE_Z, TOL, centre_path, circle,
-                               circle_distance, job, stadium, stadium_points)
+from tests.gcode.parts import (
+    CENTRE_CURVE,
+    HALF,
+    PART,
+    R_TOOL,
+    RP,
+    SAFE_Z,
+    TOL,
+    centre_path,
+    circle,
+    circle_distance,
+    job,
+    stadium,
+    stadium_points,
+)
 
 CASES = [("linuxcnc", {}), ("fanuc", {}), ("fanuc", {"arc_format": "r"}), ("grbl", {})]
 IDS = ["linuxcnc", "fanuc-ij", "fanuc-r", "grbl"]
@@ -89,7 +103,7 @@ def test_linuxcnc_syntax():
     text = dumps(_program(), "linuxcnc")
     lines = _code_lines(text)
     for raw, words in lines:
-        assert "".join(l + v for l, v in words) == re.sub(r"\([^()]*\)|\s", "", raw), raw
+        assert "".join(letter + v for letter, v in words) == re.sub(r"\([^()]*\)|\s", "", raw), raw
         for letter, v in words:
             assert letter in "GMTSFXYZIJHD", raw
             if letter == "G":
@@ -97,7 +111,7 @@ def test_linuxcnc_syntax():
             if letter == "M":
                 assert f"{float(v):g}" in LINUXCNC_M, raw
             assert letter != "R"
-    flat = [" ".join(l + v for l, v in w) for _, w in lines]
+    flat = [" ".join(letter + v for letter, v in w) for _, w in lines]
     assert "T1 M6" in flat and any("G43 H1" in f for f in flat)
     assert flat[-1] == "M2" and "%" not in text
     for raw in text.splitlines():
@@ -142,8 +156,8 @@ def test_r_mode_splits_arcs_over_180_degrees():
     fin = lambda bp: [m for m in bp.moves if m.kind == "arc" and m.label == "FINISH CONTOUR"]  # noqa: E731
     assert [round(abs(m.sweep), 9) for m in fin(ij)] == [round(math.pi, 9)] * 2
     assert len(fin(r)) == 4 and all(abs(m.sweep) <= math.pi / 2 + 1e-9 for m in fin(r))
-    radii = [float(m.group(1)) for l in dumps(prog, "fanuc", arc_format="r").splitlines()
-             if not l.startswith("(") and (m := re.search(r" R(-?[\d.]+)", l))]
+    radii = [float(m.group(1)) for line in dumps(prog, "fanuc", arc_format="r").splitlines()
+             if not line.startswith("(") and (m := re.search(r" R(-?[\d.]+)", line))]
     assert len(radii) == 6 and all(v > 0 for v in radii)  # 4 contour pieces + 2 lead arcs
     for bp in (ij, r):
         rep = verify(bp, exact_curve_distance=circle_distance(20.0), part_distance=circle_distance(17.0),
@@ -173,9 +187,9 @@ def test_grbl_syntax(opts):
                 assert f"{float(v):g}" in GRBL_G, raw
             if letter == "M":
                 assert f"{float(v):g}" in GRBL_M, raw
-    flat = [" ".join(l + v for l, v in w) for _, w in _code_lines(text)]
+    flat = [" ".join(letter + v for letter, v in w) for _, w in _code_lines(text)]
     assert not any("M6" in f.split() for f in flat)
-    assert any("load T1" in l for l in text.splitlines())
+    assert any("load T1" in line for line in text.splitlines())
     assert ("M8" in flat) == (opts.get("coolant", True))
 
 

@@ -7,10 +7,31 @@ import numpy as np
 import pytest
 
 from camfab.errors import GeometryError, SpecError
-from camfab.gcode import (Arc, Comment, Feed, Job, Rapid, Segment, ToolChange, as_contour, contour_toolpath,
-                          offset_contour)
-from tests.gcode.parts import (CENTRE_CURVE, HALF, PART, RP, R_TOOL, SAFE_Z, centre_path, circle, job,
-                               stadium, stadium_distance)
+from camfab.gcode import (
+    Arc,
+    Comment,
+    Feed,
+    Job,
+    Rapid,
+    Segment,
+    ToolChange,
+    as_contour,
+    contour_toolpath,
+    offset_contour,
+)
+from tests.gcode.parts import (
+    CENTRE_CURVE,
+    HALF,
+    PART,
+    R_TOOL,
+    RP,
+    SAFE_Z,
+    centre_path,
+    circle,
+    job,
+    stadium,
+    stadium_distance,
+)
 
 
 def test_job_collects_every_problem_with_field_paths():

@@ -6,9 +6,21 @@ import re
 import numpy as np
 import pytest
 
-from camfab.gcode import (ContourDistance, Segment, contour_toolpath, dumps, parse, verify)
-from tests.gcode.parts import (CENTRE_CURVE, HALF, PART, RP, R_TOOL, SAFE_Z, TOL, centre_path, job,
-                               notched_disc, notched_disc_distance, stadium_points)
+from camfab.gcode import ContourDistance, Segment, contour_toolpath, dumps, parse, verify
+from tests.gcode.parts import (
+    CENTRE_CURVE,
+    HALF,
+    PART,
+    R_TOOL,
+    RP,
+    SAFE_Z,
+    TOL,
+    centre_path,
+    job,
+    notched_disc,
+    notched_disc_distance,
+    stadium_points,
+)
 
 POSTS = [("linuxcnc", {}), ("fanuc", {}), ("grbl", {})]
 
@@ -91,7 +103,7 @@ def test_rapid_plunge_into_stock_is_caught():
 @pytest.mark.parametrize("post,opts", POSTS)
 def test_missing_feed_before_first_cut_is_caught(post, opts):
     lines = _lines(_text(post, opts))
-    k = next(i for i, l in enumerate(lines) if re.search(r"\bG0?1\b", l))
+    k = next(i for i, line in enumerate(lines) if re.search(r"\bG0?1\b", line))
     assert " F" in lines[k]
     lines[k] = re.sub(r" F[\d.]+", "", lines[k])
     rep = _verify("\n".join(lines) + "\n")

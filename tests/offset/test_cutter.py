@@ -5,11 +5,16 @@ import numpy as np
 import pytest
 
 from camfab.design.assemble import geometry_from_spec
-from camfab.errors import GeometryError
 from camfab.discretize import measure_deviation
+from camfab.errors import GeometryError
 from camfab.formats import load_design
-from camfab.offset.cutter import (concave_limit, offset_curve, roller_envelope_deviation,
-                                  shapely_offset, tool_centre_path)
+from camfab.offset.cutter import (
+    concave_limit,
+    offset_curve,
+    roller_envelope_deviation,
+    shapely_offset,
+    tool_centre_path,
+)
 from tests.conftest import EXAMPLES
 
 

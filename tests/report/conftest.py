@@ -7,8 +7,8 @@ import pytest
 
 from camfab.design.spec import design_from_dict
 from camfab.formats import load_design
-from tests.report.designs import checked_design
 from camfab.report.html import render_report, write_files
+from tests.report.designs import checked_design
 
 from ..conftest import EXAMPLES
 from .designs import DESIGNS

@@ -19,10 +19,10 @@ from camfab.design.dynamics import ContactDynamics
 from camfab.design.spec import design_from_dict
 from camfab.errors import SpecError
 from camfab.formats import design_from_data, design_rows, design_to_xlsx, load_design, load_design_xlsx
-from camfab.report._common import sample_grid
-from tests.report.designs import checked_design
-from camfab.report.html import render_report
 from camfab.formats.camdas_workbook import camdas_workbook
+from camfab.report._common import sample_grid
+from camfab.report.html import render_report
+from tests.report.designs import checked_design
 
 from ..conftest import EXAMPLES
 from .designs import DESIGNS

@@ -17,8 +17,8 @@ from camfab.assets import templates
 from camfab.design.spec import design_from_dict
 from camfab.report._common import VERDICT_TEXT, conclusions_rows
 from camfab.report.animation import animation_data
-from tests.report.designs import checked_design
 from camfab.report.html import render_report
+from tests.report.designs import checked_design
 
 from ..conftest import base_design
 from .designs import DESIGNS

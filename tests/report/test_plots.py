@@ -11,8 +11,8 @@ import pytest
 
 from camfab.design.spec import design_from_dict
 from camfab.report._common import axis_of, finding_spans, sample_grid
-from tests.report.designs import checked_design
 from camfab.report.plots import figure_bytes, pressure_angle_figure, report_figures, svaj_figure
+from tests.report.designs import checked_design
 
 from .designs import DESIGNS
 

@@ -21,7 +21,7 @@ openpyxl = pytest.importorskip("openpyxl")
 OSC_ROLLER = base_design(
     follower={"type": "roller", "motion": "oscillating", "base_radius_mm": 40.0, "roller_radius_mm": 8.0,
               "pivot_distance_mm": 110.0, "arm_length_mm": 90.0},
-    motion=[{"law": law, "lift": float(l), "angle_deg": float(b)} for law, l, b in EJEMPLO11RO])
+    motion=[{"law": law, "lift": float(h), "angle_deg": float(b)} for law, h, b in EJEMPLO11RO])
 FLAT_TR = base_design(follower={"type": "flat", "motion": "translating", "base_radius_mm": 100.0},
                       cam={"kind": "disc", "rotation": "cw", "speed_rpm": 60.0})
 FLAT_OSC = base_design(
@@ -205,7 +205,7 @@ def test_checks_sheet(e9_book):
     assert rows[fhead][:4] == ("Code", "Severity", "From (deg)", "To (deg)")
     found = [r for r in rows[fhead + 1:] if r[0]]
     assert len(found) == len(report.findings)
-    for r, f in zip(found, report.findings):
+    for r, f in zip(found, report.findings, strict=True):
         assert r[:4] == (f.code, f.severity, pytest.approx(f.from_deg), pytest.approx(f.to_deg))
         assert r[6] == f.message
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Sequence
 from typing import Any
 
 from camfab.errors import ExportError
@@ -281,7 +282,7 @@ class _Writer:
         else:
             self.comment(f"coolant {it.mode} - switch by hand")
 
-    def _axis_words(self, target: list[float | None], axes=(0, 1, 2), force=()) -> list[str]:
+    def _axis_words(self, target: Sequence[float | None], axes=(0, 1, 2), force=()) -> list[str]:
         words = []
         for i in axes:
             v = target[i]
@@ -359,8 +360,10 @@ class _Writer:
         if self.arc_format == "r":
             words.append("R" + _fmt(r * self.k, self.d))
         else:
-            i = _fmt(cx * self.k - float(self.out[0]), self.d)
-            j = _fmt(cy * self.k - float(self.out[1]), self.d)
+            ox, oy = self.out[0], self.out[1]
+            assert ox is not None and oy is not None  # arc() starts only from a known position
+            i = _fmt(cx * self.k - float(ox), self.d)
+            j = _fmt(cy * self.k - float(oy), self.d)
             words += [f"I{i}", f"J{j}"]
         self.block(["G2" if clockwise else "G3"] + self.take_pending() + words + self.feed_word(feed))
         self._commit(target)
