@@ -129,3 +129,14 @@ def test_code_shape_limits():
     sys.modules["shape"] = shape
     spec.loader.exec_module(shape)
     assert shape.violations() == []
+
+
+def test_no_private_name_crosses_a_module():
+    """A name with a leading underscore is its module's own: no camfab module imports one from another."""
+    bad = []
+    for path in _modules():
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.ImportFrom):
+                bad += [f"{path.relative_to(ROOT)}:{node.lineno} {a.name}" for a in node.names
+                        if a.name.startswith("_") and not a.name.startswith("__")]
+    assert not bad, "private names imported across modules: " + "; ".join(bad)

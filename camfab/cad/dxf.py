@@ -55,7 +55,8 @@ class DxfContent:
     extra_circles: tuple[tuple[str, float], ...] = field(default_factory=tuple)
 
 
-def _ezdxf():
+def ezdxf_module():
+    """The ezdxf module, or a MissingDependencyError naming the install command."""
     try:
         import ezdxf
     except ImportError as exc:  # pragma: no cover
@@ -122,7 +123,7 @@ def build_document(content: DxfContent, *, flavour: str = "lwpolyline"):
     """An ezdxf document holding ``content`` (see the module docstring)."""
     if flavour not in FLAVOURS:
         raise ValueError(f"'{flavour}' is not a valid DXF flavour, must be one of: {', '.join(FLAVOURS)}")
-    ezdxf = _ezdxf()
+    ezdxf = ezdxf_module()
     doc = ezdxf.new("R12" if flavour == "r12" else "R2010", setup=False)
     if flavour != "r12":  # R12 headers have no unit variables: the R12 flavour is mm by contract
         doc.header["$INSUNITS"] = 4
@@ -163,7 +164,7 @@ def write_deterministic(doc) -> str:
     ezdxf stamps the write time into its metadata and emits the CLASSES section in
     hash-seed order (it differs between processes); both are normalised here.
     """
-    ezdxf = _ezdxf()
+    ezdxf = ezdxf_module()
     old = ezdxf.options.write_fixed_meta_data_for_testing
     ezdxf.options.write_fixed_meta_data_for_testing = True
     try:

@@ -16,7 +16,7 @@ from ..results import CURVATURE_CODES, JUMP_CODES, IssueCode, Severity, Verdict
 
 __all__ = ["Axis", "axis_of", "sample_grid", "finding_spans", "fmt", "fmt_at", "range_text",
            "conclusions_rows", "VERDICT_TEXT", "VERDICT_CLASS", "mechanism_text", "key_values",
-           "CURVATURE_CODES"]
+           "CURVATURE_CODES", "table_cell"]
 
 #: verdict → headline (same words as ``camfab check``)
 VERDICT_TEXT = {Verdict.ACCEPTABLE: "Cam OK (acceptable)",
@@ -144,7 +144,8 @@ def mechanism_text(spec) -> str:
     return f"{kind} cam ({sense}), {double}{f.motion} {ftype} follower"
 
 
-def _cell(value, at=None, unit="°") -> dict[str, Any]:
+def table_cell(value, at=None, unit="°") -> dict[str, Any]:
+    """A cell of the conclusions table: the value as text and as a number, and where it is reached."""
     return {"text": fmt(value), "value": None if value is None else float(value),
             "at": fmt_at(at, unit) if value is not None else "", "at_value": None if at is None else float(at)}
 
@@ -164,41 +165,42 @@ def conclusions_rows(spec, report) -> list[dict[str, Any]]:
     for q, p in report.motion.peaks.items() if report.motion is not None else ():
         jump = q in JUMP_CODES and JUMP_CODES[q] in codes
         sev = {f.severity for f in report.findings if q in JUMP_CODES and f.code == JUMP_CODES[q]}
-        rows.append({"concept": names[q], "max": _cell(p.max, p.at_max, xu), "min": _cell(p.min, p.at_min, xu),
+        rows.append({"concept": names[q], "max": table_cell(p.max, p.at_max, xu),
+                     "min": table_cell(p.min, p.at_min, xu),
                      "comment": "Discontinuous" if jump else "Continuous",
                      "status": ("bad" if Severity.ERROR in sev else "warn") if jump else "ok"})
     roc = report.curvature
     if roc is not None:
         bad = codes & {IssueCode.UNDERCUT, IssueCode.CUSP}
-        rows.append({"concept": "Convex radius of curvature (mm)", "max": _cell(None),
-                     "min": _cell(roc.min_convex, roc.at_min_convex, xu),
+        rows.append({"concept": "Convex radius of curvature (mm)", "max": table_cell(None),
+                     "min": table_cell(roc.min_convex, roc.at_min_convex, xu),
                      "comment": "Undercut or cusp: see the findings" if bad
                      else "The profile is free of cusps and undercuts", "status": "bad" if bad else "ok"})
         if roc.min_concave is not None:
             tight = IssueCode.CONCAVE_RADIUS_BELOW_ROLLER in codes
-            rows.append({"concept": "Concave radius of curvature (mm)", "max": _cell(None),
-                         "min": _cell(roc.min_concave, roc.at_min_concave, xu),
+            rows.append({"concept": "Concave radius of curvature (mm)", "max": table_cell(None),
+                         "min": table_cell(roc.min_concave, roc.at_min_concave, xu),
                          "comment": "Tighter than the cutter: see the findings" if tight
                          else "Smallest concave radius (the cutter must be smaller)",
                          "status": "warn" if tight else "ok"})
     pa = report.pressure_angle
     if pa is not None:
         ok = IssueCode.PRESSURE_ANGLE_EXCEEDED not in codes
-        rows.append({"concept": "Pressure angle (°)", "max": _cell(pa.max, pa.at_max, xu),
-                     "min": _cell(pa.min, pa.at_min, xu),
+        rows.append({"concept": "Pressure angle (°)", "max": table_cell(pa.max, pa.at_max, xu),
+                     "min": table_cell(pa.min, pa.at_min, xu),
                      "comment": (f"Acceptable (limit ±{pa.limit:g}°)" if ok
                                  else f"High pressure angle (> {pa.limit:g}°)"),
                      "status": "ok" if ok else "bad"})
     face = report.face_length
     if face is not None:
         if face.left is not None:
-            rows.append({"concept": "Face length left / right (mm)", "max": _cell(face.left),
-                         "min": _cell(face.right),
+            rows.append({"concept": "Face length left / right (mm)", "max": table_cell(face.left),
+                         "min": table_cell(face.right),
                          "comment": "Minimum face length on each side of the stem to keep contact",
                          "status": "ok"})
         else:
-            rows.append({"concept": "Contact along the face (mm)", "max": _cell(face.max),
-                         "min": _cell(face.min), "comment": "Distance of the contact from the face vertex",
+            rows.append({"concept": "Contact along the face (mm)", "max": table_cell(face.max),
+                         "min": table_cell(face.min), "comment": "Distance of the contact from the face vertex",
                          "status": "ok"})
     return rows
 

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..results import Severity
 from ._common import VERDICT_CLASS, VERDICT_TEXT, axis_of, fmt, mechanism_text, sample_grid
-from .plots import SVAJ_UNITS, _off_view, new_figure, plot_style
+from .plots import SVAJ_UNITS, new_figure, off_view, plot_style
 
 __all__ = ["render_comparison", "comparison_rows", "compare_svaj_figure", "compare_curvature_figure",
            "compare_pressure_angle_figure", "design_labels"]
@@ -90,7 +90,7 @@ def compare_curvature_figure(items, labels: Sequence[str] | None = None):
             axis = axis_of(spec.program())
             for k, c in enumerate(geom.profiles):
                 x = sample_grid(c.period, c.breakpoints)
-                rho = _off_view(c.evaluate(x).rho, lim)
+                rho = off_view(c.evaluate(x).rho, lim)
                 ax.plot(x * axis.scale, rho, color=f"C{i}", ls="-" if k == 0 else "--",
                         label=labels[i] + (f" cam {k + 1}" if len(geom.profiles) > 1 else ""))
                 lo, hi = min(lo, np.nanmin(rho, initial=0.0)), max(hi, np.nanmax(rho, initial=0.0))

@@ -27,7 +27,6 @@ from ..results import DynamicsSummary, IssueCode, Severity
 from ._common import (
     VERDICT_CLASS,
     VERDICT_TEXT,
-    _cell,
     axis_of,
     conclusions_rows,
     fmt,
@@ -35,6 +34,7 @@ from ._common import (
     key_values,
     mechanism_text,
     range_text,
+    table_cell,
 )
 
 __all__ = ["render_report", "write_files", "template_environment", "report_context", "dynamics_rows", "PLOT_TEXT",
@@ -205,24 +205,24 @@ def dynamics_rows(spec, report) -> list[dict[str, Any]]:
     xu = "°" if report.x_unit == "deg" else "mm"
     if dyn.form_closed:
         return _pair_rows(dyn, report, xu)
-    fs, codes, none = dyn.safety_force_n, report.codes(), _cell(None)
+    fs, codes, none = dyn.safety_force_n, report.codes(), table_cell(None)
     cf = dyn.contact_force
     bad = next((text.format(fs=fs) for code, text in _DYNAMICS_CODES if code in codes), None)
     ok_text = f"Never below the safety force {fs:g} N" if fs > 0 else "The follower stays on the cam"
-    rows = [_row("Contact force (N)", _cell(cf.max, cf.at_max, xu), _cell(cf.min, cf.at_min, xu),
+    rows = [_row("Contact force (N)", table_cell(cf.max, cf.at_max, xu), table_cell(cf.min, cf.at_min, xu),
                  bad or ok_text, "bad" if bad else "ok"),
-            _row("Safety force (N)", _cell(fs), none, "Smallest acceptable contact force (design input)")]
+            _row("Safety force (N)", table_cell(fs), none, "Smallest acceptable contact force (design input)")]
     return rows + _drive_rows(dyn, report, xu) + _limit_rows(spec, dyn, xu)
 
 
 def _pair_rows(dyn: DynamicsSummary, report, xu: str) -> list[dict[str, Any]]:
     """The dynamics table of a form-closed follower: both contact forces and the load reversals."""
-    none, rows = _cell(None), []
+    none, rows = table_cell(None), []
     second = dyn.second_contact_force
     assert second is not None  # a form-closed summary carries follower 2's contact force
     for k, cf in ((1, dyn.contact_force), (2, second)):
-        rows.append(_row(f"Contact force, follower {k} (N)", _cell(cf.max, cf.at_max, xu),
-                         _cell(cf.min, cf.at_min, xu),
+        rows.append(_row(f"Contact force, follower {k} (N)", table_cell(cf.max, cf.at_max, xu),
+                         table_cell(cf.min, cf.at_min, xu),
                          "Form closure: the follower cannot leave the cam" if k == 1 else
                          "Pushes where follower 1 cannot (the load has changed sides)"))
     rev = dyn.load_reversals or ()
@@ -234,36 +234,36 @@ def _pair_rows(dyn: DynamicsSummary, report, xu: str) -> list[dict[str, Any]]:
 
 def _drive_rows(dyn: DynamicsSummary, report, xu: str) -> list[dict[str, Any]]:
     """Bearing force, drive torque (force), work per cycle and mean power rows."""
-    none, rows = _cell(None), []
+    none, rows = table_cell(None), []
     b = dyn.bearing_force
-    rows.append(_row("Bearing force (N)", _cell(b.max, b.at_max, xu), none,
+    rows.append(_row("Bearing force (N)", table_cell(b.max, b.at_max, xu), none,
                      "Largest load on the camshaft bearings" if report.x_unit == "deg"
                      else "Largest load on the plate's guides"))
     torque, t = dyn.torque, dyn.drive
-    rows.append(_row("Drive torque (N·m)" if torque else "Drive force (N)", _cell(t.max, t.at_max, xu),
-                     _cell(t.min, t.at_min, xu),
+    rows.append(_row("Drive torque (N·m)" if torque else "Drive force (N)", table_cell(t.max, t.at_max, xu),
+                     table_cell(t.min, t.at_min, xu),
                      f"{'Torque' if torque else 'Force'} that keeps the speed constant (negative: the follower "
                      "drives the cam)"))
-    rows.append(_row("Work per cycle (J)", _cell(dyn.work_per_cycle_j), none,
+    rows.append(_row("Work per cycle (J)", table_cell(dyn.work_per_cycle_j), none,
                      "Energy lost to damping and friction in one cycle"))
-    rows.append(_row("Mean power (W)", _cell(dyn.mean_power_w), none, "Mean drive power at the design speed"))
+    rows.append(_row("Mean power (W)", table_cell(dyn.mean_power_w), none, "Mean drive power at the design speed"))
     return rows
 
 
 def _limit_rows(spec, dyn: DynamicsSummary, xu: str) -> list[dict[str, Any]]:
     """The preload-needed and jump-speed rows of :func:`dynamics_rows` (bad when the design misses them)."""
-    fs, none, rows = dyn.safety_force_n, _cell(None), []
+    fs, none, rows = dyn.safety_force_n, table_cell(None), []
     # a spring-loaded (not form-closed) summary carries both
     assert dyn.preload_needed is not None and dyn.jump_speed is not None
     pre, have = dyn.preload_needed, spec.dynamics.spring_preload if spec.dynamics is not None else None
     short = have is not None and not have >= pre.value - 1e-9 * max(1.0, abs(pre.value))
-    rows.append(_row(f"Preload needed ({pre.unit})", _cell(pre.value, pre.at, xu), none,
+    rows.append(_row(f"Preload needed ({pre.unit})", table_cell(pre.value, pre.at, xu), none,
                      f"Spring preload that keeps the contact force ≥ {fs:g} N"
                      + (f" (the design has {have:g} {pre.unit})" if have is not None else ""),
                      "bad" if short else "ok"))
     js = dyn.jump_speed
     design = spec.speed * 30 / math.pi if xu == "°" else spec.speed
-    cell = _cell(js.value, js.at, xu) if js.value is not None else {**none, "text": "never"}
+    cell = table_cell(js.value, js.at, xu) if js.value is not None else {**none, "text": "never"}
     slow = js.value is not None and js.value <= design
     rows.append(_row(f"Jump speed ({js.unit})", cell, none,
                      f"Speed at which the contact force first falls to {fs:g} N (design: {design:.6g} "

@@ -28,7 +28,8 @@ from ..results import Extreme, IssueCode
 from ._common import CURVATURE_CODES, Axis, axis_of, finding_spans, fmt, fmt_at, sample_grid
 
 __all__ = ["svaj_figure", "profile_figure", "curvature_figure", "pressure_angle_figure", "face_position_figure",
-           "dynamics_figure", "report_figures", "figure_bytes", "new_figure", "plot_style", "SVAJ_UNITS"]
+           "dynamics_figure", "report_figures", "figure_bytes", "new_figure", "plot_style", "SVAJ_UNITS",
+           "off_view"]
 
 #: (quantity, colour) of the four motion diagrams
 _SVAJ = (("S", "#1f77b4"), ("V", "#2ca02c"), ("A", "#ff7f0e"), ("J", "#d62728"))
@@ -302,11 +303,11 @@ def curvature_figure(spec, geometry, report, *, n: int = _N):
         lo, hi = 0.0, 0.0
         for k, (c, x, s) in enumerate(_profile_samples(geometry, n)):
             tag = f"cam {k + 1}: " if multi else ""
-            rho = _off_view(s.rho, lim)
+            rho = off_view(s.rho, lim)
             ax.plot(x * axis.scale, rho, color=f"C{k}", label=f"{tag}profile ρ")
             lo, hi = min(lo, np.nanmin(rho, initial=0.0)), max(hi, np.nanmax(rho, initial=0.0))
             if s.rho_pitch is not None and c.roller_radius > 0 and not c.curved_face:
-                ax.plot(x * axis.scale, _off_view(s.rho_pitch, lim), color=f"C{k}", lw=0.8, ls="--",
+                ax.plot(x * axis.scale, off_view(s.rho_pitch, lim), color=f"C{k}", lw=0.8, ls="--",
                         label=f"{tag}pitch curve ρₚ")
         ax.axhline(0.0, color="0.1", lw=0.9, label="ρ = 0 (cusp limit)")
         rr = max((c.roller_radius for c in geometry.profiles if c.kind == "roller" and not c.curved_face),
@@ -329,7 +330,7 @@ def curvature_figure(spec, geometry, report, *, n: int = _N):
     return fig
 
 
-def _off_view(rho: np.ndarray, lim: float) -> np.ndarray:
+def off_view(rho: np.ndarray, lim: float) -> np.ndarray:
     """ρ with the values far outside ±lim blanked, so the curve leaves the view at an
     inflection (ρ → ±∞) instead of drawing a vertical line across it."""
     out = np.array(rho, dtype=float)

@@ -18,25 +18,25 @@ pytest.importorskip("matplotlib", reason="report plots need matplotlib")
 class _Table(HTMLParser):
     def __init__(self):
         super().__init__()
-        self.rows, self._row, self._cell, self.imgs = [], None, None, []
+        self.rows, self._row, self.table_cell, self.imgs = [], None, None, []
 
     def handle_starttag(self, tag, attrs):
         a = dict(attrs)
         if tag == "tr":
             self._row = []
         elif tag in ("td", "th") and self._row is not None:
-            self._cell = {"text": "", "value": a.get("data-value")}
+            self.table_cell = {"text": "", "value": a.get("data-value")}
         elif tag == "img":
             self.imgs.append(a)
 
     def handle_data(self, data):
-        if self._cell is not None:
-            self._cell["text"] += data
+        if self.table_cell is not None:
+            self.table_cell["text"] += data
 
     def handle_endtag(self, tag):
-        if tag in ("td", "th") and self._cell is not None:
-            self._row.append(self._cell)
-            self._cell = None
+        if tag in ("td", "th") and self.table_cell is not None:
+            self._row.append(self.table_cell)
+            self.table_cell = None
         elif tag == "tr" and self._row is not None:
             self.rows.append(self._row)
             self._row = None

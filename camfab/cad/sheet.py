@@ -1,0 +1,273 @@
+"""The drawing sheet's frame: paper and scale, layers, the title block, the lift table and the notes column.
+
+Sizes come from the title-block template ``templates/drawing/title_block.toml`` (shipped in the wheel, found
+by :mod:`camfab.assets`).  Everything is in paper millimetres, origin at the sheet's lower-left corner;
+:mod:`camfab.cad.drawing` places the cam's views and notes in the boxes of a :class:`SheetLayout`.
+"""
+from __future__ import annotations
+
+import functools
+import math
+import tomllib
+from dataclasses import dataclass
+from typing import Any, cast
+
+import numpy as np
+
+from ..assets import read_template
+from ..errors import ExportError
+from ..geom2d import ArcChain
+from .dxf import ezdxf_module
+
+__all__ = ["PAPERS", "LAYERS", "SheetLayout", "load_template", "parse_scale", "sheet_layout", "put_text", "rect",
+           "place", "fmt", "title_block", "lift_table_block", "notes_column", "clipped_circle", "new_document"]
+
+PAPERS = ("A4", "A3")
+
+
+#: layer -> (ACI colour, linetype, lineweight in 1/100 mm)
+LAYERS = {
+    "FRAME": (7, "Continuous", 70), "TITLE_BLOCK": (7, "Continuous", 35), "PROFILE": (7, "Continuous", 50),
+    "BORE": (7, "Continuous", 50), "BASE_CIRCLE": (3, "PHANTOM", 18), "PRIME_CIRCLE": (1, "CENTER", 18),
+    "CENTRE_LINES": (8, "CENTER", 18), "CENTRE_MARKS": (8, "Continuous", 18), "DIMENSIONS": (4, "Continuous", 18),
+    "LIFT_TABLE": (7, "Continuous", 25), "NOTES": (7, "Continuous", 25), "ANNOTATION": (6, "Continuous", 25),
+}
+
+
+@functools.lru_cache(maxsize=1)
+def load_template() -> dict[str, Any]:
+    """The title-block template (``templates/drawing/title_block.toml``) as a dict."""
+    text = read_template("drawing", "title_block.toml")
+    return tomllib.loads(text)
+
+
+def parse_scale(label: str) -> float:
+    """``"1:2"`` → 0.5, ``"2:1"`` → 2.0 (drawing length per true length)."""
+    a, b = label.split(":")
+    return float(a) / float(b)
+
+
+@dataclass(frozen=True)
+class SheetLayout:
+    """Where everything goes on the sheet (paper mm, origin at the sheet's lower-left corner).
+
+    Boxes are ``(x0, y0, x1, y1)``.  ``fits`` is False when even the smallest
+    scale does not fit the view (the cam is then drawn at that scale anyway).
+    """
+
+    paper: str
+    size: tuple[float, float]
+    scale: float
+    scale_label: str
+    centre: tuple[float, float]
+    frame: tuple[float, float, float, float]
+    title: tuple[float, float, float, float]
+    table: tuple[float, float, float, float]
+    table_groups: int
+    table_rows: int
+    notes: tuple[float, float, float, float]
+    view: tuple[float, float, float, float]
+    fits: bool
+
+
+def _layout_on(paper: str, extent_mm: float | tuple[float, float], n_rows: int, tpl: dict[str, Any]) -> SheetLayout:
+    w, h = tpl["paper"][paper]["width_mm"], tpl["paper"][paper]["height_mm"]
+    fr, gap = tpl["frame"], tpl["frame"]["gap_mm"]
+    fx0, fy0, fx1, fy1 = fr["left_mm"], fr["bottom_mm"], w - fr["right_mm"], h - fr["top_mm"]
+    tb = tpl["title_block"]
+    title = (fx1 - tb["width_mm"], fy0, fx1, fy0 + tb["height_mm"])
+    lt = tpl["lift_table"]
+    rh, colw = lt["row_height_mm"], sum(lt["column_widths_mm"])
+    avail = fy1 - title[3] - gap
+    per_group = max(1, int(math.floor(avail / rh - 2.5)))
+    groups = max(1, math.ceil(n_rows / per_group))
+    rows = math.ceil(n_rows / groups)
+    table = (fx1 - groups * colw, fy1 - (rows + 2.5) * rh, fx1, fy1)
+    notes = (fx0, fy0, fx0 + tpl["notes"]["width_mm"], fy1)
+    view = (notes[2] + gap, title[3] + gap, table[0] - gap, fy1)
+    clear = tpl["view"]["clearance_mm"]
+    half_w, half_h = (cast(float, extent_mm),) * 2 if np.isscalar(extent_mm) else cast(tuple[float, float], extent_mm)
+    room_w, room_h = (view[2] - view[0]) / 2 - clear, (view[3] - view[1]) / 2 - clear
+    if np.isscalar(extent_mm):  # a disc cam: a circle of radius extent in the square part of the view
+        room_w = room_h = min(room_w, room_h)
+    labels = tpl["view"]["scales"]
+    fits = [s for s in labels if half_w * parse_scale(s) <= room_w and half_h * parse_scale(s) <= room_h]
+    label = fits[0] if fits else labels[-1]
+    centre = ((view[0] + view[2]) / 2, (view[1] + view[3]) / 2)
+    return SheetLayout(paper, (w, h), parse_scale(label), label, centre, (fx0, fy0, fx1, fy1), title, table,
+                       groups, rows, notes, view, bool(fits))
+
+
+def sheet_layout(extent_mm: float | tuple[float, float], n_rows: int, paper: str = "auto") -> SheetLayout:
+    """Choose paper and scale for a cam of outer radius ``extent_mm`` and a lift table of ``n_rows`` rows.
+
+    Parameters
+    ----------
+    extent_mm : float or (float, float)
+        Largest distance of the cam outline from its centre (true mm), or the half width and
+        half height of a translating cam's plate.
+    n_rows : int
+        Data rows of the lift table.
+    paper : {"auto", "A4", "A3"}
+
+    Raises
+    ------
+    ValueError
+        An unknown paper name.
+    """
+    if paper != "auto" and paper not in PAPERS:
+        raise ValueError(f"'{paper}' is not a valid paper, must be one of: auto, {', '.join(PAPERS)}")
+    tpl = load_template()
+    if paper != "auto":
+        return _layout_on(paper, extent_mm, n_rows, tpl)
+    options = [_layout_on(p, extent_mm, n_rows, tpl) for p in PAPERS]
+    return max(options, key=lambda lay: (lay.fits, min(lay.scale, 1.0), -PAPERS.index(lay.paper)))
+
+
+def put_text(msp, text: str, at, height: float, layer: str, align: str = "BOTTOM_LEFT", width: float | None = None):
+    """A TEXT entity at ``at`` (paper mm), shrunk to fit ``width`` when one is given (never below 1 mm)."""
+    from ezdxf.enums import TextEntityAlignment
+
+    tpl = load_template()
+    if width is not None and text:
+        height = max(1.0, min(height, width / (tpl["text"]["width_factor"] * len(text))))
+    t = msp.add_text(text, height=height, dxfattribs={"layer": layer})
+    t.set_placement((float(at[0]), float(at[1])), align=TextEntityAlignment[align])
+    return t
+
+
+def rect(msp, box, layer: str) -> None:
+    """A closed rectangle over the box ``(x0, y0, x1, y1)``."""
+    x0, y0, x1, y1 = box
+    msp.add_lwpolyline([(x0, y0), (x1, y0), (x1, y1), (x0, y1)], close=True, dxfattribs={"layer": layer})
+
+
+def place(loop: ArcChain, scale: float, centre) -> list[tuple[float, float, float, float, float]]:
+    """An arc chain scaled about the origin and moved to ``centre``, as LWPOLYLINE ``xyseb`` vertices."""
+    pts = loop.points * scale + np.asarray(centre)
+    return [(float(x), float(y), 0.0, 0.0, float(b)) for (x, y), b in zip(pts, loop.bulges, strict=True)]
+
+
+def fmt(v: float, dec: int = 3) -> str:
+    """``v`` with ``dec`` decimals, without a minus sign on a value that rounds to zero."""
+    s = f"{v:.{dec}f}"
+    return s[1:] if s.startswith("-") and float(s) == 0 else s
+
+
+def title_block(msp, layout: SheetLayout, fields: dict[str, str]) -> None:
+    """The title block's cells from the template, filled with ``fields`` (an unknown template field is an
+    :class:`~camfab.errors.ExportError`)."""
+    tpl = load_template()
+    x0, y0, x1, y1 = layout.title
+    rect(msp, layout.title, "TITLE_BLOCK")
+    th = tpl["text"]
+    for cell in tpl["title_block"]["cells"]:
+        if cell["field"] not in fields:
+            raise ExportError(f"title-block template field '{cell['field']}' is unknown; "
+                              f"use one of: {', '.join(fields)}")
+        cx, cy = x0 + cell["x_mm"], y0 + cell["y_mm"]
+        cw, ch = cell["width_mm"], cell["height_mm"]
+        rect(msp, (cx, cy, cx + cw, cy + ch), "TITLE_BLOCK")
+        put_text(msp, cell["label"], (cx + 1.0, cy + ch - 1.0), th["label_height_mm"], "TITLE_BLOCK", "TOP_LEFT")
+        value = fields[cell["field"]]
+        if value:
+            h = th["title_height_mm"] if cell.get("large") else th["value_height_mm"]
+            put_text(msp, value, (cx + 1.5, cy + 1.5), h, "TITLE_BLOCK", "BOTTOM_LEFT", width=cw - 3.0)
+
+
+def lift_table_block(msp, layout: SheetLayout, table, closed: bool) -> None:
+    """The lift table in ``layout.table``, split into side-by-side column groups when it is tall."""
+    tpl = load_template()["lift_table"]
+    rh, widths, h = tpl["row_height_mm"], tpl["column_widths_mm"], tpl["text_height_mm"]
+    x0, y0, x1, y1 = layout.table
+    rect(msp, layout.table, "LIFT_TABLE")
+    step = float(table.angle[1] - table.angle[0]) if len(table.angle) > 1 else 360.0
+    unit = "°" if table.lift_unit == "deg" else "mm"
+    put_text(msp, f"LIFT TABLE (step {step:g}{'°' if closed else ' mm'})", ((x0 + x1) / 2, y1 - 0.75 * rh),
+          h, "LIFT_TABLE", "MIDDLE_CENTER", width=x1 - x0 - 2)
+    msp.add_line((x0, y1 - 1.5 * rh), (x1, y1 - 1.5 * rh), dxfattribs={"layer": "LIFT_TABLE"})
+    heads = ("ANGLE °" if closed else "TRAVEL mm", f"LIFT {unit}", "RADIUS mm" if closed else "HEIGHT mm")
+    gw = sum(widths)
+    lift_dec = 4 if table.lift_unit == "deg" else 3
+    for g in range(layout.table_groups):
+        gx = x0 + g * gw
+        if g:
+            msp.add_line((gx, y0), (gx, y1 - 1.5 * rh), dxfattribs={"layer": "LIFT_TABLE"})
+        xs = np.cumsum([gx] + list(widths))
+        for k in range(1, 3):
+            msp.add_line((xs[k], y0), (xs[k], y1 - 1.5 * rh), dxfattribs={"layer": "LIFT_TABLE"})
+        ytop = y1 - 1.5 * rh
+        for k, text in enumerate(heads):
+            put_text(msp, text, ((xs[k] + xs[k + 1]) / 2, ytop - rh / 2), h, "LIFT_TABLE", "MIDDLE_CENTER",
+                  width=widths[k] - 1)
+        msp.add_line((gx, ytop - rh), (gx + gw, ytop - rh), dxfattribs={"layer": "LIFT_TABLE"})
+        rows = range(g * layout.table_rows, min(len(table.angle), (g + 1) * layout.table_rows))
+        for j, i in enumerate(rows):
+            yc = ytop - rh * (j + 1.5)
+            vals = (f"{table.angle[i]:g}", fmt(table.lift[i], lift_dec), fmt(table.radius[i]))
+            for k, text in enumerate(vals):
+                put_text(msp, text, ((xs[k] + xs[k + 1]) / 2, yc), h, "LIFT_TABLE", "MIDDLE_CENTER",
+                      width=widths[k] - 1)
+
+
+def notes_column(msp, layout: SheetLayout, notes: list[str]) -> None:
+    """The numbered notes in the left column."""
+    tpl = load_template()["notes"]
+    x0, y0, x1, y1 = layout.notes
+    h = tpl["text_height_mm"]
+    put_text(msp, "NOTES", (x0 + 2, y1 - 2), 3.5, "NOTES", "TOP_LEFT")
+    body = "\\P".join(f"{i}. {n}" for i, n in enumerate(notes, 1))
+    mt = msp.add_mtext(body, dxfattribs={"layer": "NOTES", "char_height": h, "width": x1 - x0 - 4,
+                                         "insert": (x0 + 2, y1 - 8), "attachment_point": 1})
+    mt.dxf.line_spacing_factor = 1.2
+
+
+def _dimstyle(doc, tpl) -> None:
+    d = tpl["dimensions"]
+    doc.dimstyles.new("CAMFAB", dxfattribs={
+        "dimtxt": d["text_height_mm"], "dimasz": d["arrow_size_mm"], "dimexe": 1.25, "dimexo": 0.625,
+        "dimgap": 0.625, "dimdec": d["decimals"], "dimtxsty": "Standard", "dimzin": 8, "dimdsep": ord("."),
+        "dimtad": 1, "dimtih": 0, "dimtoh": 0, "dimtofl": 1, "dimclrd": 4, "dimclre": 4, "dimclrt": 4})
+
+
+def clipped_circle(msp, centre, r: float, box, layer: str) -> None:
+    """A circle of radius ``r`` (paper mm) about ``centre``, drawn whole when it fits the box (x0, y0, x1, y1)
+    and otherwise as the arcs of it inside the box."""
+    cx, cy = centre
+    x0, y0, x1, y1 = box
+    hw, hh = min(cx - x0, x1 - cx), min(cy - y0, y1 - cy)
+    if r <= min(hw, hh):
+        msp.add_circle((cx, cy), r, dxfattribs={"layer": layer})
+        return
+    # inside where |cos t| ≤ hw/r and |sin t| ≤ hh/r: four arcs symmetric about the axes
+    a, b = math.degrees(math.acos(min(1.0, hw / r))), math.degrees(math.asin(min(1.0, hh / r)))
+    if a >= b:
+        return
+    for start, end in ((a, b), (180.0 - b, 180.0 - a), (180.0 + a, 180.0 + b), (360.0 - b, 360.0 - a)):
+        msp.add_arc((cx, cy), r, start, end, dxfattribs={"layer": layer})
+
+
+def new_document(spec, layout: SheetLayout, shapes, tpl):
+    """A new R2010 document with the header values, layers, dimension style and frame of the sheet; returns
+    ``(doc, modelspace)``."""
+    ezdxf = ezdxf_module()
+    doc = ezdxf.new("R2010", setup=["linetypes"], units=4)
+    doc.header["$INSUNITS"] = 4
+    doc.header["$MEASUREMENT"] = 1
+    doc.header["$LTSCALE"] = 1.0
+    doc.header["$LWDISPLAY"] = 1
+    doc.header["$EXTMIN"] = (0.0, 0.0, 0.0)
+    doc.header["$EXTMAX"] = (layout.size[0], layout.size[1], 0.0)
+    doc.header["$LIMMAX"] = layout.size
+    doc.header.custom_vars.append("CAMFAB_NAME", spec.name)
+    doc.header.custom_vars.append("CAMFAB_PAPER", layout.paper)
+    doc.header.custom_vars.append("CAMFAB_SCALE", f"{layout.scale!r}")
+    doc.header.custom_vars.append("CAMFAB_CENTRE", f"{layout.centre[0]!r},{layout.centre[1]!r}")
+    doc.header.custom_vars.append("CAMFAB_TOL_MM", f"{shapes.tol:g}")
+    for name, (colour, ltype, lw) in LAYERS.items():
+        doc.layers.add(name, color=colour, linetype=ltype, lineweight=lw)
+    _dimstyle(doc, tpl)
+    msp = doc.modelspace()
+    rect(msp, (0.0, 0.0, *layout.size), "FRAME")
+    rect(msp, layout.frame, "FRAME")
+    return doc, msp
