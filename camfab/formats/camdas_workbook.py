@@ -356,7 +356,7 @@ def fixed_zip(raw: bytes) -> bytes:
     return out.getvalue()
 
 
-def table_cell(v: float) -> float | None:
+def _finite_or_none(v: float) -> float | None:
     return None if not math.isfinite(v) else float(v)
 
 
@@ -381,7 +381,7 @@ def _camdas_sheet(ws, spec, geometry, report, step_deg: float, profile: int) -> 
     for letter, values in cols.items():
         col = ws[letter + "1"].column
         for i in range(n):
-            ws.cell(FIRST_DATA_ROW + i, col, table_cell(values[i]))
+            ws.cell(FIRST_DATA_ROW + i, col, _finite_or_none(values[i]))
     ws.freeze_panes = "B10"
 
 
