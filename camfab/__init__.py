@@ -14,13 +14,26 @@ angle, its files::
 Import submodules only for what this façade does not offer.  ``import camfab`` stays light: the pipeline
 (and with it the exporters) is imported on first use of :func:`load`, :class:`Cam` or :func:`examples`, and
 heavy optional dependencies (cadquery, matplotlib) only by the artifacts that need them.
+
+Errors: everything camfab raises on purpose is a :class:`CamfabError` (see :mod:`camfab.errors`); the
+classes that replaced a builtin also derive from it (:class:`InputError` is a ``ValueError``).
 """
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
 from .design import LAWS, DesignSpec, MotionProgram, analyse_motion, build_program, design_from_dict
-from .errors import CamfabError, ExportError, GeometryError, MissingDependencyError, Problem, SpecError
+from .errors import (
+    ApiError,
+    CamfabError,
+    ExportError,
+    GeometryError,
+    InputError,
+    InternalError,
+    MissingDependencyError,
+    Problem,
+    SpecError,
+)
 from .formats import load_design
 from .version import __version__
 
@@ -37,6 +50,9 @@ __all__ = [
     "GeometryError",
     "ExportError",
     "MissingDependencyError",
+    "InputError",
+    "ApiError",
+    "InternalError",
     "Problem",
     "LAWS",
     "MotionProgram",

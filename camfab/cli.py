@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from . import pipeline
-from .errors import CamfabError, GeometryError, MissingDependencyError, SpecError
+from .errors import ApiError, CamfabError, InternalError, MissingDependencyError
 from .io import atomic_write
 from .pipeline import Cam, Output, Request
 from .results import Severity, Verdict
@@ -411,16 +411,21 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _guarded(args: argparse.Namespace) -> int:
-    """Run the command; the deliberate errors become their exit codes and a one-line message."""
+    """Run the command; the deliberate errors become their exit codes and a one-line message: a missing
+    optional dependency 3; every other :class:`~camfab.errors.CamfabError` (SpecError, UsageError,
+    GeometryError, InputError, ExportError, ...) is invalid input, 2.  ApiError and InternalError are bugs
+    of camfab, not of the input: they keep their traceback."""
     fn: Any = COMMANDS[args.command][0]
     try:
         return int(fn(args))
-    except (SpecError, UsageError, GeometryError) as exc:
-        print(f"camfab {args.command}: error: {exc}", file=sys.stderr)
-        return EXIT_INPUT
     except MissingDependencyError as exc:
         print(f"camfab {args.command}: error: {exc}", file=sys.stderr)
         return EXIT_IO
+    except (ApiError, InternalError):
+        raise
+    except CamfabError as exc:
+        print(f"camfab {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_INPUT
     except OSError as exc:
         print(f"camfab {args.command}: I/O error: {exc}", file=sys.stderr)
         return EXIT_IO

@@ -20,6 +20,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .errors import InputError
 from .quadrature import integrate
 
 __all__ = ["Grid", "Optimum", "Range", "dense_grid", "clear_caches", "search", "extremum", "extrema",
@@ -557,7 +558,8 @@ def root(f: Function, a: float, b: float, *, fa: float | None = None, fb: float 
     fa = float(np.asarray(f(np.array([a]))).ravel()[0]) if fa is None else float(fa)
     fb = float(np.asarray(f(np.array([b]))).ravel()[0]) if fb is None else float(fb)
     if (fa > 0) == (fb > 0):
-        raise ValueError(f"f > 0 must hold at one end of [{a:g}, {b:g}] only (f = {fa:g}, {fb:g})")
+        raise InputError(f"f > 0 must hold at one end of [{a:g}, {b:g}] only (f = {fa:g}, {fb:g}); give a, b "
+                         "that bracket a sign change")
     r = _Roots([(np.array([a]), np.array([fa]), np.array([b]), np.array([fb]), np.zeros(1), np.zeros(1))])
     _solve(f, None, r)
     return float(r.best()[0])

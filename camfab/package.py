@@ -98,7 +98,7 @@ def _read(path: Path) -> tuple[DesignSpec | None, tuple[str | Path, ...]]:
 def _build(args: tuple) -> dict:
     """Worker: build one design into its folder; never raises (errors go into the entry)."""
     path, out, options, key, spec = args
-    from .errors import CamfabError
+    from .errors import ApiError, CamfabError, InternalError
 
     t0 = time.perf_counter()
     entry = {"source": str(path), "key": key, "rebuilt": True}
@@ -114,18 +114,25 @@ def _build(args: tuple) -> dict:
                      tolerance_mm=res.tol, withheld=res.withheld, timings=res.timings,
                      folder=str(folder.relative_to(out)),
                      files=[_file_entry(p, Path(out), res.deviations.get(n)) for n, p in sorted(res.files.items())])
+    except (ApiError, InternalError) as exc:  # bugs of camfab: recorded as internal failures
+        _internal_error(entry, exc)
     except (CamfabError, OSError, ValueError) as exc:
         entry.update(status="error", verdict=None, error=str(exc), files=[],
                      error_type=type(exc).__name__)
     except Exception as exc:  # an internal failure on one design must not lose the others
-        import traceback
-
-        entry.update(status="error", verdict=None, files=[], error_type=type(exc).__name__,
-                     error=f"internal error ({type(exc).__name__}: {exc}); please report it with this design",
-                     traceback=traceback.format_exc())
+        _internal_error(entry, exc)
     entry.setdefault("name", Path(path).stem)
     entry["seconds"] = time.perf_counter() - t0
     return entry
+
+
+def _internal_error(entry: dict, exc: Exception) -> None:
+    """Record an internal failure of one design's build, with its traceback."""
+    import traceback
+
+    entry.update(status="error", verdict=None, files=[], error_type=type(exc).__name__,
+                 error=f"internal error ({type(exc).__name__}: {exc}); please report it with this design",
+                 traceback=traceback.format_exc())
 
 
 def _folder_name(name: str) -> str:
