@@ -17,9 +17,15 @@ heavy optional dependencies (cadquery, matplotlib) only by the artifacts that ne
 
 Errors: everything camfab raises on purpose is a :class:`CamfabError` (see :mod:`camfab.errors`); the
 classes that replaced a builtin also derive from it (:class:`InputError` is a ``ValueError``).
+
+Logging: camfab logs the fallbacks it takes (a slower fit, a capped iteration, an unreadable manifest) to
+the logger ``"camfab"`` — every module logs to ``logging.getLogger(__name__)``, a child such as
+``"camfab.cad.export"`` — and prints nothing itself.  The logger has a ``NullHandler``; configure
+``logging`` (or run ``camfab -v``) to see the records.
 """
 from __future__ import annotations
 
+import logging
 from typing import TYPE_CHECKING, Any
 
 from .design import LAWS, DesignSpec, MotionProgram, analyse_motion, build_program, design_from_dict
@@ -64,6 +70,8 @@ __all__ = [
 ]
 
 _LAZY = ("load", "examples", "Cam")
+
+logging.getLogger(__name__).addHandler(logging.NullHandler())
 
 
 def __getattr__(name: str) -> Any:

@@ -12,6 +12,7 @@ problem's trial points depend only on its batch: a search gives the same result 
 """
 from __future__ import annotations
 
+import logging
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -27,6 +28,7 @@ __all__ = ["Grid", "Optimum", "Range", "dense_grid", "clear_caches", "search", "
            "positive_ranges", "root", "integrate"]
 
 Function = Callable[[np.ndarray], np.ndarray]
+log = logging.getLogger(__name__)
 
 #: dense samples per period (the span of the edges) when no step is given
 SAMPLES_PER_PERIOD = 1440
@@ -229,6 +231,8 @@ def _solve(f: Function, mins: _Minima | None = None, roots: _Roots | None = None
         if roots is not None and rround < _ROOT_ROUNDS:
             ract = np.flatnonzero(roots.b - roots.a >= _XTOL + _RTOL * np.maximum(abs(roots.a), abs(roots.b)))
         if mact.size + ract.size == 0:
+            if mround >= _MIN_ROUNDS or rround >= _ROOT_ROUNDS:
+                _log_capped(mins, done, roots)
             return
         parts = []
         with np.errstate(all="ignore"):
@@ -253,6 +257,19 @@ def _solve(f: Function, mins: _Minima | None = None, roots: _Roots | None = None
         if ract.size:
             _root_step(roots, ract, pts[mact.size:], Y[mact.size:])  # type: ignore[arg-type]
             rround += 1
+
+
+def _log_capped(mins: _Minima | None, done: np.ndarray, roots: _Roots | None) -> None:
+    """A warning for the problems the round caps left open (their best estimates are used)."""
+    parts = [(mins.b - mins.a)[~done]] if mins is not None else []
+    if roots is not None:
+        rw = roots.b - roots.a
+        parts.append(rw[rw >= _XTOL + _RTOL * np.maximum(abs(roots.a), abs(roots.b))])
+    open_widths = np.concatenate(parts or [np.zeros(0)])
+    if open_widths.size:
+        log.warning("search: %d bracket(s) still open at the round cap (%d rounds for minima, %d for roots; widest "
+                    "%.3g); the best estimates are used", open_widths.size, _MIN_ROUNDS, _ROOT_ROUNDS,
+                    float(open_widths.max()))
 
 
 # ---------------------------------------------------------------------------
@@ -563,4 +580,3 @@ def root(f: Function, a: float, b: float, *, fa: float | None = None, fb: float 
     r = _Roots([(np.array([a]), np.array([fa]), np.array([b]), np.array([fb]), np.zeros(1), np.zeros(1))])
     _solve(f, None, r)
     return float(r.best()[0])
-

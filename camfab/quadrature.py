@@ -2,11 +2,14 @@
 :mod:`camfab.numeric`, whose conventions it shares (a vectorised ``f(x)``, smooth between increasing ``edges``)."""
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable
 
 import numpy as np
 
 __all__ = ["integrate"]
+
+log = logging.getLogger(__name__)
 
 _GAUSS20 = np.polynomial.legendre.leggauss(20)
 
@@ -45,4 +48,7 @@ def integrate(f: Callable[[np.ndarray], np.ndarray], edges, *, rtol: float = 1e-
         total += float((ql + qr)[ok].sum())
         todo = np.concatenate([left[~ok], right[~ok]])
         whole = np.concatenate([ql[~ok], qr[~ok]])
+    if len(todo):
+        log.warning("integrate over [%g, %g]: %d interval(s) not converged to rtol = %g, atol = %g after the pass or "
+                    "interval cap; their last estimate is used", edges[0], edges[-1], len(todo), rtol, atol)
     return total + float(whole.sum())
