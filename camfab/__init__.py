@@ -14,13 +14,32 @@ angle, its files::
 Import submodules only for what this façade does not offer.  ``import camfab`` stays light: the pipeline
 (and with it the exporters) is imported on first use of :func:`load`, :class:`Cam` or :func:`examples`, and
 heavy optional dependencies (cadquery, matplotlib) only by the artifacts that need them.
+
+Errors: everything camfab raises on purpose is a :class:`CamfabError` (see :mod:`camfab.errors`); the
+classes that replaced a builtin also derive from it (:class:`InputError` is a ``ValueError``).
+
+Logging: camfab logs the fallbacks it takes (a slower fit, a capped iteration, an unreadable manifest) to
+the logger ``"camfab"`` — every module logs to ``logging.getLogger(__name__)``, a child such as
+``"camfab.cad.export"`` — and prints nothing itself.  The logger has a ``NullHandler``; configure
+``logging`` (or run ``camfab -v``) to see the records.
 """
 from __future__ import annotations
 
+import logging
 from typing import TYPE_CHECKING, Any
 
 from .design import LAWS, DesignSpec, MotionProgram, analyse_motion, build_program, design_from_dict
-from .errors import CamfabError, ExportError, GeometryError, MissingDependencyError, Problem, SpecError
+from .errors import (
+    ApiError,
+    CamfabError,
+    ExportError,
+    GeometryError,
+    InputError,
+    InternalError,
+    MissingDependencyError,
+    Problem,
+    SpecError,
+)
 from .formats import load_design
 from .version import __version__
 
@@ -37,6 +56,9 @@ __all__ = [
     "GeometryError",
     "ExportError",
     "MissingDependencyError",
+    "InputError",
+    "ApiError",
+    "InternalError",
     "Problem",
     "LAWS",
     "MotionProgram",
@@ -48,6 +70,8 @@ __all__ = [
 ]
 
 _LAZY = ("load", "examples", "Cam")
+
+logging.getLogger(__name__).addHandler(logging.NullHandler())
 
 
 def __getattr__(name: str) -> Any:

@@ -2,12 +2,16 @@
 
 Exit codes (the user-facing contract, ``docs/decisions.md``, "The user-facing contract"): 0 success; 1 computed
 but fails its checks; 2 invalid input (design file, options); 3 I/O error or a missing optional dependency.
+``-v`` / ``--verbose`` shows the ``camfab`` logger's INFO records (the fallbacks taken) on stderr; its warnings
+are shown always.
 """
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import json
+import logging
 import math
 import sys
 from collections.abc import Callable
@@ -15,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from . import pipeline
-from .errors import CamfabError, GeometryError, MissingDependencyError, SpecError
+from .errors import ApiError, CamfabError, InternalError, MissingDependencyError
 from .io import atomic_write
 from .pipeline import Cam, Output, Request
 from .results import Severity, Verdict
@@ -391,10 +395,34 @@ def cmd_compare(args: argparse.Namespace) -> int:
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="camfab", description="Cam design, checks and manufacturing files.")
     parser.add_argument("--version", action="version", version=f"camfab {__version__}")
+    parser.add_argument("-v", "--verbose", action="store_true", help=_VERBOSE_HELP)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name, (_, arguments, help_text) in COMMANDS.items():
-        arguments(sub.add_parser(name, help=help_text, description=help_text))
+        p = sub.add_parser(name, help=help_text, description=help_text)
+        arguments(p)
+        p.add_argument("-v", "--verbose", action="store_true", default=argparse.SUPPRESS, help=_VERBOSE_HELP)
     return parser
+
+
+_VERBOSE_HELP = "also log the fallbacks camfab takes (logger 'camfab', INFO) on stderr"
+
+
+@contextlib.contextmanager
+def _log_to_stderr(verbose: bool):
+    """The ``camfab`` logger's records on stderr while a command runs: WARNING and above, INFO too if ``verbose``."""
+    logger = logging.getLogger("camfab")
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("camfab: %(levelname)s: %(message)s [%(name)s]"))
+    handler.setLevel(logging.INFO if verbose else logging.WARNING)
+    level = logger.level
+    if verbose:
+        logger.setLevel(logging.INFO)
+    logger.addHandler(handler)
+    try:
+        yield
+    finally:
+        logger.removeHandler(handler)
+        logger.setLevel(level)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -407,20 +435,26 @@ def main(argv: list[str] | None = None) -> int:
     if not args.command:
         parser.print_help(sys.stderr)
         return EXIT_INPUT
-    return _guarded(args)
+    with _log_to_stderr(args.verbose):
+        return _guarded(args)
 
 
 def _guarded(args: argparse.Namespace) -> int:
-    """Run the command; the deliberate errors become their exit codes and a one-line message."""
+    """Run the command; the deliberate errors become their exit codes and a one-line message: a missing
+    optional dependency 3; every other :class:`~camfab.errors.CamfabError` (SpecError, UsageError,
+    GeometryError, InputError, ExportError, ...) is invalid input, 2.  ApiError and InternalError are bugs
+    of camfab, not of the input: they keep their traceback."""
     fn: Any = COMMANDS[args.command][0]
     try:
         return int(fn(args))
-    except (SpecError, UsageError, GeometryError) as exc:
-        print(f"camfab {args.command}: error: {exc}", file=sys.stderr)
-        return EXIT_INPUT
     except MissingDependencyError as exc:
         print(f"camfab {args.command}: error: {exc}", file=sys.stderr)
         return EXIT_IO
+    except (ApiError, InternalError):
+        raise
+    except CamfabError as exc:
+        print(f"camfab {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_INPUT
     except OSError as exc:
         print(f"camfab {args.command}: I/O error: {exc}", file=sys.stderr)
         return EXIT_IO

@@ -3,6 +3,14 @@
 Exceptions are for inputs that cannot be computed at all.  A design that *can*
 be computed but fails its checks produces a coded report instead (see
 :mod:`camfab.design.checks`).
+
+Every error camfab raises on purpose derives from :class:`CamfabError`; a class that
+replaced a builtin exception also derives from that builtin (``InputError`` is a
+``ValueError``, ``ApiError`` a ``TypeError``, ...), so ``except ValueError`` keeps
+working.  The command line maps them to its exit codes: ``MissingDependencyError``
+→ 3; ``ApiError`` and ``InternalError`` are bugs and keep their traceback; every
+other ``CamfabError`` → 2 (invalid input, nothing written).  ``tests/test_errors.py``
+fails on a ``raise`` of a builtin exception anywhere in the package.
 """
 from __future__ import annotations
 
@@ -16,6 +24,9 @@ __all__ = [
     "GeometryError",
     "ExportError",
     "MissingDependencyError",
+    "InputError",
+    "ApiError",
+    "InternalError",
 ]
 
 
@@ -62,3 +73,18 @@ class ExportError(CamfabError):
 
 class MissingDependencyError(CamfabError, ImportError):
     """An optional dependency needed for the requested job is not installed."""
+
+
+class InputError(CamfabError, ValueError):
+    """A bad argument value given to an API function (a tolerance, a speed, a post-processor name or option,
+    a mode string...); the message names the argument, its value and what is accepted.  Design-file input is
+    reported as :class:`SpecError` instead."""
+
+
+class ApiError(CamfabError, TypeError):
+    """An object of the wrong kind given to an API function (e.g. pressure-angle sizing of a flat-face
+    follower, or a program that is not a :class:`camfab.gcode.Program`): a mistake in the calling code."""
+
+
+class InternalError(CamfabError, RuntimeError):
+    """An invariant of camfab broken: a bug in camfab, to be reported with the input that caused it."""

@@ -1,5 +1,6 @@
 """Vectorised one-dimensional searches between breakpoints: global extrema, the ranges where a
-function is positive, roots and integrals — one implementation of each; nothing here knows cams.
+function is positive, roots and integrals (:mod:`camfab.quadrature`) — one implementation of each; nothing here
+knows cams.
 
 A searched function is a vectorised ``f(x)``, smooth between breakpoints ``edges`` (increasing; for
 a closed curve the first and last are the ends of one period).  A search samples every interval
@@ -11,6 +12,7 @@ problem's trial points depend only on its batch: a search gives the same result 
 """
 from __future__ import annotations
 
+import logging
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -19,10 +21,14 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .errors import InputError
+from .quadrature import integrate
+
 __all__ = ["Grid", "Optimum", "Range", "dense_grid", "clear_caches", "search", "extremum", "extrema",
            "positive_ranges", "root", "integrate"]
 
 Function = Callable[[np.ndarray], np.ndarray]
+log = logging.getLogger(__name__)
 
 #: dense samples per period (the span of the edges) when no step is given
 SAMPLES_PER_PERIOD = 1440
@@ -225,6 +231,8 @@ def _solve(f: Function, mins: _Minima | None = None, roots: _Roots | None = None
         if roots is not None and rround < _ROOT_ROUNDS:
             ract = np.flatnonzero(roots.b - roots.a >= _XTOL + _RTOL * np.maximum(abs(roots.a), abs(roots.b)))
         if mact.size + ract.size == 0:
+            if mround >= _MIN_ROUNDS or rround >= _ROOT_ROUNDS:
+                _log_capped(mins, done, roots)
             return
         parts = []
         with np.errstate(all="ignore"):
@@ -249,6 +257,19 @@ def _solve(f: Function, mins: _Minima | None = None, roots: _Roots | None = None
         if ract.size:
             _root_step(roots, ract, pts[mact.size:], Y[mact.size:])  # type: ignore[arg-type]
             rround += 1
+
+
+def _log_capped(mins: _Minima | None, done: np.ndarray, roots: _Roots | None) -> None:
+    """A warning for the problems the round caps left open (their best estimates are used)."""
+    parts = [(mins.b - mins.a)[~done]] if mins is not None else []
+    if roots is not None:
+        rw = roots.b - roots.a
+        parts.append(rw[rw >= _XTOL + _RTOL * np.maximum(abs(roots.a), abs(roots.b))])
+    open_widths = np.concatenate(parts or [np.zeros(0)])
+    if open_widths.size:
+        log.warning("search: %d bracket(s) still open at the round cap (%d rounds for minima, %d for roots; widest "
+                    "%.3g); the best estimates are used", open_widths.size, _MIN_ROUNDS, _ROOT_ROUNDS,
+                    float(open_widths.max()))
 
 
 # ---------------------------------------------------------------------------
@@ -554,47 +575,8 @@ def root(f: Function, a: float, b: float, *, fa: float | None = None, fb: float 
     fa = float(np.asarray(f(np.array([a]))).ravel()[0]) if fa is None else float(fa)
     fb = float(np.asarray(f(np.array([b]))).ravel()[0]) if fb is None else float(fb)
     if (fa > 0) == (fb > 0):
-        raise ValueError(f"f > 0 must hold at one end of [{a:g}, {b:g}] only (f = {fa:g}, {fb:g})")
+        raise InputError(f"f > 0 must hold at one end of [{a:g}, {b:g}] only (f = {fa:g}, {fb:g}); give a, b "
+                         "that bracket a sign change")
     r = _Roots([(np.array([a]), np.array([fa]), np.array([b]), np.array([fb]), np.zeros(1), np.zeros(1))])
     _solve(f, None, r)
     return float(r.best()[0])
-
-
-_GAUSS20 = np.polynomial.legendre.leggauss(20)
-
-
-def _gauss_nodes(iv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """20-point Gauss–Legendre nodes (k, 20) of the intervals ``iv`` (k, 2), and their half widths."""
-    mid, half = (iv[:, 0] + iv[:, 1]) / 2, (iv[:, 1] - iv[:, 0]) / 2
-    return mid[:, None] + half[:, None] * _GAUSS20[0][None, :], half
-
-
-def integrate(f: Function, edges, *, rtol: float = 1e-11, atol: float = 0.0) -> float:
-    """∫ f between breakpoints by adaptive 20-point Gauss–Legendre, vectorised (one call of f per pass):
-    every interval is halved until its halves agree with it to ``(rtol·|∫f| + atol)`` times its share
-    of the span (at most 40 passes, 2¹⁶ open intervals; a non-finite half is not split again, so a
-    non-integrable f gives inf or NaN).  Give ``atol`` where the integral may cancel to ~0."""
-    wg = _GAUSS20[1]
-    edges = np.asarray(edges, dtype=float)
-    todo = np.stack([edges[:-1], edges[1:]], axis=1)
-    todo = todo[todo[:, 1] > todo[:, 0]]
-    pts, half = _gauss_nodes(todo)
-    whole = half * (np.asarray(f(pts.ravel()), dtype=float).reshape(pts.shape) @ wg)
-    total, scale = 0.0, max(abs(whole.sum()), 1e-300)
-    span = edges[-1] - edges[0]
-    for _ in range(40):
-        if not 0 < len(todo) <= 2**16:
-            break
-        mid = (todo[:, 0] + todo[:, 1]) / 2
-        left, right = np.stack([todo[:, 0], mid], 1), np.stack([mid, todo[:, 1]], 1)
-        pl, hl = _gauss_nodes(left)
-        pr, hr = _gauss_nodes(right)
-        v = np.asarray(f(np.concatenate([pl.ravel(), pr.ravel()])), dtype=float)
-        ql = hl * (v[:pl.size].reshape(pl.shape) @ wg)
-        qr = hr * (v[pl.size:].reshape(pr.shape) @ wg)
-        ok = np.abs(ql + qr - whole) <= (rtol * scale + atol) * (todo[:, 1] - todo[:, 0]) / span + 1e-300
-        ok |= ~np.isfinite(ql + qr)
-        total += float((ql + qr)[ok].sum())
-        todo = np.concatenate([left[~ok], right[~ok]])
-        whole = np.concatenate([ql[~ok], qr[~ok]])
-    return total + float(whole.sum())

@@ -18,6 +18,7 @@ from __future__ import annotations
 import hashlib
 import html
 import json
+import logging
 import multiprocessing
 import os
 import time
@@ -37,6 +38,8 @@ __all__ = ["discover", "input_key", "package", "exit_status", "MANIFEST", "INDEX
 
 MANIFEST = "manifest.json"
 INDEX = "index.html"
+
+log = logging.getLogger(__name__)
 
 
 def discover(paths: Iterable[str | Path]) -> list[Path]:
@@ -90,7 +93,8 @@ def _read(path: Path) -> tuple[DesignSpec | None, tuple[str | Path, ...]]:
     (the build then records why)."""
     try:
         spec = load_design(path)
-    except Exception:  # any failure is reported by the build of this design, with the others kept
+    except Exception as exc:  # any failure is reported by the build of this design, with the others kept
+        log.info("%s cannot be read (%s: %s); its key hashes the file alone", path, type(exc).__name__, exc)
         return None, (path,)
     return spec, spec.sources
 
@@ -98,7 +102,7 @@ def _read(path: Path) -> tuple[DesignSpec | None, tuple[str | Path, ...]]:
 def _build(args: tuple) -> dict:
     """Worker: build one design into its folder; never raises (errors go into the entry)."""
     path, out, options, key, spec = args
-    from .errors import CamfabError
+    from .errors import ApiError, CamfabError, InternalError
 
     t0 = time.perf_counter()
     entry = {"source": str(path), "key": key, "rebuilt": True}
@@ -114,18 +118,26 @@ def _build(args: tuple) -> dict:
                      tolerance_mm=res.tol, withheld=res.withheld, timings=res.timings,
                      folder=str(folder.relative_to(out)),
                      files=[_file_entry(p, Path(out), res.deviations.get(n)) for n, p in sorted(res.files.items())])
+    except (ApiError, InternalError) as exc:  # bugs of camfab: recorded as internal failures
+        _internal_error(entry, exc)
     except (CamfabError, OSError, ValueError) as exc:
         entry.update(status="error", verdict=None, error=str(exc), files=[],
                      error_type=type(exc).__name__)
     except Exception as exc:  # an internal failure on one design must not lose the others
-        import traceback
-
-        entry.update(status="error", verdict=None, files=[], error_type=type(exc).__name__,
-                     error=f"internal error ({type(exc).__name__}: {exc}); please report it with this design",
-                     traceback=traceback.format_exc())
+        _internal_error(entry, exc)
     entry.setdefault("name", Path(path).stem)
     entry["seconds"] = time.perf_counter() - t0
     return entry
+
+
+def _internal_error(entry: dict, exc: Exception) -> None:
+    """Record (and log) an internal failure of one design's build, with its traceback."""
+    import traceback
+
+    log.error("%s: internal error (%s: %s)", entry["source"], type(exc).__name__, exc, exc_info=exc)
+    entry.update(status="error", verdict=None, files=[], error_type=type(exc).__name__,
+                 error=f"internal error ({type(exc).__name__}: {exc}); please report it with this design",
+                 traceback=traceback.format_exc())
 
 
 def _folder_name(name: str) -> str:
@@ -206,7 +218,10 @@ def _old_entries(out: Path) -> dict:
     try:
         data = json.loads((out / MANIFEST).read_text(encoding="utf-8"))
         return {e["source"]: e for e in data.get("cams", []) if "source" in e}
-    except (OSError, ValueError, KeyError, TypeError):
+    except FileNotFoundError:
+        return {}
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        log.warning("%s cannot be read (%s: %s); every design is rebuilt", out / MANIFEST, type(exc).__name__, exc)
         return {}
 
 

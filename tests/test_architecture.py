@@ -24,7 +24,8 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "camfab.io": ("camfab.errors",),
     "camfab.assets": ("camfab.errors",),
     "camfab.results": ("camfab.errors",),
-    "camfab.numeric": ("camfab.errors",),
+    "camfab.numeric": ("camfab.errors", "camfab.quadrature"),
+    "camfab.quadrature": (),
     "camfab.geom2d": ("camfab.errors", "camfab.tolerances"),
     "camfab.design": BASE + ("camfab.design",),
     "camfab.discretize": BASE + ("camfab.discretize",),
@@ -110,6 +111,7 @@ def test_imports_only_go_down(path):
 
 @pytest.mark.parametrize("path", [p for p in _modules() if _module_name(p).startswith(("camfab.design",
                                                                                        "camfab.numeric",
+                                                                                       "camfab.quadrature",
                                                                                        "camfab.discretize"))],
                          ids=lambda p: str(p.relative_to(ROOT)))
 def test_core_does_no_io_and_loads_nothing_heavy(path):

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import MissingDependencyError
+from ..errors import InputError, MissingDependencyError
 from ..geom2d import ArcChain, bulge_centre
 
 __all__ = ["DxfContent", "LAYERS", "FLAVOURS", "dumps", "build_document", "loop_nurbs", "write_deterministic"]
@@ -122,7 +122,7 @@ def _add_loop(msp, loop: ArcChain, layer: str, flavour: str) -> None:
 def build_document(content: DxfContent, *, flavour: str = "lwpolyline"):
     """An ezdxf document holding ``content`` (see the module docstring)."""
     if flavour not in FLAVOURS:
-        raise ValueError(f"'{flavour}' is not a valid DXF flavour, must be one of: {', '.join(FLAVOURS)}")
+        raise InputError(f"'{flavour}' is not a valid DXF flavour, must be one of: {', '.join(FLAVOURS)}")
     ezdxf = ezdxf_module()
     doc = ezdxf.new("R12" if flavour == "r12" else "R2010", setup=False)
     if flavour != "r12":  # R12 headers have no unit variables: the R12 flavour is mm by contract

@@ -8,6 +8,7 @@ writer takes the profiles as :class:`~camfab.geom2d.ArcChain` values.
 """
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,6 +25,8 @@ from .plate import PlateSpec, bore_loop
 __all__ = ["Artifact", "CamShapes", "cam_shapes", "build_artifacts", "write_artifacts", "FORMATS"]
 
 FORMATS = ("dxf", "step", "stl")
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -76,6 +79,11 @@ def _pitch_loop(profile: ArcChain, roller_radius: float, pitch, tol: float) -> A
         dev = float(measure_deviation(loop, pitch).max)
         if dev <= tol:
             return loop.with_deviation(dev)
+        log.info("pitch curve: the profile's arcs offset by the roller radius %g mm deviate %.3g mm > tol = %g mm "
+                 "from it; falling back to a fit of its own", roller_radius, dev, tol)
+    else:
+        log.info("pitch curve: the profile's arc chain has a corner or an arc below the roller radius %g mm, so "
+                 "it has no exact offset; falling back to a fit of its own", roller_radius)
     return arcs(pitch, tol=tol)
 
 

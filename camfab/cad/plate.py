@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import GeometryError
+from ..errors import GeometryError, InternalError
 from ..geom2d import ArcChain
 
 __all__ = ["PlateSpec", "keyway_size", "bore_loop", "circle_loop", "plate_volume"]
@@ -41,7 +41,7 @@ def keyway_size(bore_mm: float) -> tuple[float, float]:
     for dmax, b, t2 in _KEYWAYS:
         if bore_mm <= dmax:
             return float(b), float(t2)
-    raise AssertionError("unreachable")
+    raise InternalError(f"DIN 6885 table has no key for bore {bore_mm:g} mm inside 6 … 230 mm")
 
 
 def circle_loop(radius: float, centre=(0.0, 0.0)) -> ArcChain:

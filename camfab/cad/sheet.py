@@ -15,7 +15,7 @@ from typing import Any, cast
 import numpy as np
 
 from ..assets import read_template
-from ..errors import ExportError
+from ..errors import ExportError, InputError
 from ..geom2d import ArcChain
 from .dxf import ezdxf_module
 
@@ -112,11 +112,11 @@ def sheet_layout(extent_mm: float | tuple[float, float], n_rows: int, paper: str
 
     Raises
     ------
-    ValueError
-        An unknown paper name.
+    InputError
+        An unknown paper name (a ``ValueError``).
     """
     if paper != "auto" and paper not in PAPERS:
-        raise ValueError(f"'{paper}' is not a valid paper, must be one of: auto, {', '.join(PAPERS)}")
+        raise InputError(f"'{paper}' is not a valid paper, must be one of: auto, {', '.join(PAPERS)}")
     tpl = load_template()
     if paper != "auto":
         return _layout_on(paper, extent_mm, n_rows, tpl)

@@ -8,6 +8,7 @@ from __future__ import annotations
 import dataclasses
 import math
 
+from ..errors import InputError
 from ..results import CheckReport, DynamicsReport, Finding
 from .checks import check
 from .dynamics import ContactDynamics, Loads, PairDynamics, analyse_dynamics, pair_of
@@ -56,7 +57,8 @@ def is_form_closed(spec: DesignSpec) -> bool:
 def dynamics_model(spec: DesignSpec, geometry: CamGeometry) -> ContactDynamics | PairDynamics:
     """The force model of a design with a ``[dynamics]`` section (``evaluate(x)`` → forces at x)."""
     if spec.dynamics is None:
-        raise ValueError(f"{spec.name} has no [dynamics] section")
+        raise InputError(f"{spec.name} has no [dynamics] section: add one (mass_kg or inertia_kg_m2, spring, loads) "
+                         "for its force model")
     loads = loads_from_spec(spec.dynamics)
     if is_form_closed(spec):
         return pair_of(geometry, loads, spec.speed)
@@ -66,7 +68,8 @@ def dynamics_model(spec: DesignSpec, geometry: CamGeometry) -> ContactDynamics |
 def dynamics_of(spec: DesignSpec, geometry: CamGeometry | None = None) -> DynamicsReport:
     """Contact force, jump, drive torque and work of a design with a ``[dynamics]`` section."""
     if spec.dynamics is None:
-        raise ValueError(f"{spec.name} has no [dynamics] section")
+        raise InputError(f"{spec.name} has no [dynamics] section: add one (mass_kg or inertia_kg_m2, spring, loads) "
+                         "to analyse the forces")
     geom = geometry if geometry is not None else geometry_from_spec(spec)
     return analyse_dynamics(geom, loads_from_spec(spec.dynamics), spec.speed,
                             preload_unit=spec.dynamics.preload_unit,

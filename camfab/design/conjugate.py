@@ -46,7 +46,7 @@ from typing import Any, ClassVar
 import numpy as np
 from scipy.optimize import brentq
 
-from ..errors import Problem
+from ..errors import ApiError, Problem
 from ..numeric import extremum
 from .faces import OscillatingFlat, OscillatingFlatContact, TranslatingFlat, TranslatingFlatContact
 from .kinds import CamKind, FollowerMotion, FollowerType
@@ -172,7 +172,8 @@ class DesmodromicGeometry(CamGeometry):
         """Constant-width cam: distance between the parallel tangents at φ and φ + π;
         constant-diameter cam: roller-centre distance (pitch chord through the centre)."""
         if len(self.profiles) != 1:
-            raise TypeError("width() applies to constant-width and constant-diameter cams")
+            raise ApiError("width() applies to constant-width and constant-diameter cams (one profile), this pair has "
+                           f"{len(self.profiles)}; use follower_distance()")
         return self.follower_distance(phi)
 
     def contact_distance(self, phi) -> np.ndarray:

@@ -48,6 +48,7 @@ from typing import Any
 import numpy as np
 
 from .. import numeric
+from ..errors import InputError
 from ..results import (
     DynamicsReport,
     DynamicsSummary,
@@ -128,7 +129,7 @@ class ContactDynamics:
 
     def __init__(self, contact: Contact, loads: Loads, speed: float):
         if not speed > 0:
-            raise ValueError("speed must be > 0")
+            raise InputError(f"speed = {speed!r}: must be > 0 (ω in rad/s, or mm/s for a translating cam)")
         self.contact, self.loads, self.speed = contact, loads, float(speed)
         self.oscillating = contact.oscillating
         self.pivot = np.array([contact.m, 0.0]) if self.oscillating else None  # type: ignore[attr-defined]
@@ -218,7 +219,7 @@ class ContactDynamics:
         positive root of that quadratic."""
         L, k, S, D = self.loads, self.q_per_s, s.motion, s.lever
         if S is None:  # evaluate() always fills it; a hand-made sample may not
-            raise ValueError("jump_speed needs the sample's motion (S, S′, S″); use ContactDynamics.evaluate")
+            raise InputError("jump_speed needs the sample's motion (S, S′, S″); use ContactDynamics.evaluate")
         a = L.inertia * k * S[2]
         b = L.damping * k * S[1]
         e = L.preload + L.spring_rate * k * S[0] + L.external - L.safety_force_n * D
@@ -351,7 +352,8 @@ def analyse_dynamics(geometry: CamGeometry, loads: Loads, speed: float, *, prelo
     if form_closed is None:
         form_closed = isinstance(geometry, DesmodromicGeometry)
     if not form_closed and len(geometry.profiles) != 1:
-        raise ValueError("a force-closed cam has one follower")
+        raise InputError(f"form_closed=False needs one profile, the geometry has {len(geometry.profiles)}: "
+                         "a force-closed cam has one follower; pass form_closed=True for a conjugate pair")
     c = geometry.profiles[0]
     dyn = pair_of(geometry, loads, speed) if form_closed else ContactDynamics(c, loads, speed)
     edges = np.unique(np.concatenate([c.breakpoints, np.mod(c.breakpoints - math.pi, 2 * math.pi)])) \

@@ -60,7 +60,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from ..errors import SpecError
+from ..errors import ApiError, InputError, SpecError
 from ..geom2d import cross, dot
 from ..numeric import extrema, integrate
 from .kinds import Axis, ContactKind
@@ -219,7 +219,7 @@ class Contact:
 
     def __init__(self, motion: MotionLike, sense: int = 1):
         if sense not in (1, -1):
-            raise ValueError("sense must be +1 (cw) or -1 (ccw)")
+            raise InputError(f"sense = {sense!r}: must be +1 (cw) or -1 (ccw)")
         self.motion = motion
         self.sense = sense
 
@@ -315,7 +315,7 @@ class CamGeometry:
     def __init__(self, mechanism: Any, program: MotionLike, *, bore_mm: float | None = None):
         kind = getattr(mechanism, "geometry_class", None)
         if kind is None or not isinstance(self, kind):
-            raise TypeError(f"a {type(mechanism).__name__} builds its geometry with mechanism.geometry(program)")
+            raise ApiError(f"a {type(mechanism).__name__} builds its geometry with mechanism.geometry(program)")
         problems = mechanism.validate()
         if not problems:
             problems = mechanism.validate_motion(program, bore_mm=bore_mm)

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import InputError
 from ..tolerances import CONTINUITY_REL_TOL
 from .evaluation import Grouped, by_segment
 from .extrema import Junction, Peak, exact_peaks, junctions, sampled_peaks
@@ -167,7 +168,7 @@ class MotionProgram:
             if step is None:
                 step = math.pi / 180.0 if self.axis.rotating else 1.0
             return sampled_peaks(self, step)
-        raise ValueError(f"'{mode}' is not a valid peaks mode, must be one of: exact, camdas")
+        raise InputError(f"'{mode}' is not a valid peaks mode, must be one of: exact, camdas")
 
 
 def build_program(inputs: Sequence[SegmentInput], *, period: float = TWO_PI, unit: str = "rad",

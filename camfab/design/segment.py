@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import InputError
 from .laws import LAWS, Law, Polynomial
 
 __all__ = ["Segment", "hermite_coefficients", "solve_generic"]
@@ -106,7 +107,8 @@ def hermite_coefficients(
     """
     m = len(start)
     if m not in (3, 4) or len(end) != m:
-        raise ValueError("hermite_coefficients needs 3 (quintic) or 4 (7th degree) values per end")
+        raise InputError(f"hermite_coefficients needs 3 (quintic) or 4 (7th degree) values per end, got {len(start)} "
+                         f"and {len(end)}")
     fact = [1.0, 1.0, 2.0, 6.0]
     a = [start[k] * span**k / fact[k] for k in range(m)]  # C0..C(m-1)
     # Δk = S^(k)(1)·β^k − d^k/du^k of the known low-order part at u=1

@@ -24,7 +24,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ..errors import SpecError
+from ..errors import ApiError, InputError, SpecError
 from ..numeric import extremum, root
 from .checks import DEFAULT_PRESSURE_LIMIT_DEG
 from .mechanisms import Mechanism, OscillatingFlat, OscillatingRoller, TranslatingFlat, TranslatingRoller
@@ -48,7 +48,7 @@ def _abs_pressure_angle(c: Contact, x) -> np.ndarray:
     """|δ| of contact ``c`` at parameters x (radians)."""
     pa = c.evaluate(x).pressure_angle
     if pa is None:
-        raise TypeError(f"{type(c).__name__} has no pressure angle")
+        raise ApiError(f"{type(c).__name__} has no pressure angle: pressure-angle sizing applies to roller followers")
     return np.abs(pa)
 
 
@@ -87,7 +87,8 @@ def _smallest(f: Callable[[float], float], lo: float, hi: float, n: int = 40) ->
     vals = np.array([f(r) for r in rs])
     good = np.flatnonzero(vals <= 0)
     if good.size == 0:
-        raise ValueError(f"no base radius between {lo:.6g} and {hi:.6g} mm meets the constraint")
+        raise InputError(f"no base radius between {lo:.6g} and {hi:.6g} mm meets the constraint; relax the limit "
+                         "or change the follower (offset, pivot, arm)")
     i = int(good[0])
     if i == 0:
         return float(lo)
@@ -101,7 +102,8 @@ def _upper(mech: _Sized, program: MotionLike, f: Callable[[float], float], start
         if f(hi) <= 0:
             return hi
         hi *= 2.0
-    raise ValueError("no feasible base radius found")
+    raise InputError(f"no base radius up to {hi:.6g} mm meets the constraint; relax the limit or change the "
+                     "follower (offset, pivot, arm)")
 
 
 def _lift(program: MotionLike) -> float:
@@ -152,17 +154,18 @@ def min_base_radius_for_pressure_angle(mechanism: Mechanism, program: MotionLike
             return _measure(mechanism, program, rb, peak)
 
         return _smallest(f, *_osc_bounds(mechanism))
-    raise TypeError("pressure-angle sizing applies to translating and oscillating roller followers")
+    raise ApiError("pressure-angle sizing applies to translating and oscillating roller followers, not a "
+                   f"{type(mechanism).__name__}")
 
 
 def min_base_radius_no_undercut(mechanism: Mechanism, program: MotionLike) -> float:
     """Smallest R_b (mm) at which the smallest convex pitch radius equals the roller
     radius (no undercut above it).  Roller followers (translating or oscillating)."""
     if not isinstance(mechanism, (TranslatingRoller, OscillatingRoller)):
-        raise TypeError("undercut sizing applies to roller followers")
+        raise ApiError(f"undercut sizing applies to roller followers, not a {type(mechanism).__name__}")
     rr = mechanism.roller_radius_mm
     if rr <= 0:
-        raise ValueError("a knife edge (roller radius 0) cannot undercut")
+        raise InputError("roller_radius_mm = 0: a knife edge (roller radius 0) cannot undercut; no sizing needed")
 
     def f(rb):
         def worst(c):
@@ -189,7 +192,7 @@ def min_base_radius_no_cusp(mechanism: Mechanism, program: MotionLike) -> float:
             return _measure(mechanism, program, rb,
                             lambda c: -extremum(lambda x: c.evaluate(x).rho, c.breakpoints)[1])
         return _smallest(f, *_osc_bounds(mechanism))
-    raise TypeError("cusp sizing applies to flat-face followers")
+    raise ApiError(f"cusp sizing applies to flat-face followers, not a {type(mechanism).__name__}")
 
 
 def optimal_offset(mechanism: TranslatingRoller, program: MotionLike) -> float:
@@ -199,7 +202,7 @@ def optimal_offset(mechanism: TranslatingRoller, program: MotionLike) -> float:
     their bracket); the base and roller radii of ``mechanism`` are kept.
     """
     if not isinstance(mechanism, TranslatingRoller):
-        raise TypeError("optimal_offset applies to translating roller followers")
+        raise ApiError(f"optimal_offset applies to translating roller followers, not a {type(mechanism).__name__}")
     rp = mechanism.prime_radius_mm
 
     def peak(e):

@@ -35,6 +35,8 @@ Hermite surrogate of a few batched exact samples; only the verification calls th
 """
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 
 from ..tolerances import DEFAULT_EXPORT_TOL_MM
@@ -48,6 +50,8 @@ from .surrogate import fit_surrogate
 from .tolerance import validate_tol
 
 __all__ = ["polyline", "arcs"]
+
+log = logging.getLogger(__name__)
 
 
 def polyline(curve: ParametricCurve, *, tol: float = DEFAULT_EXPORT_TOL_MM) -> Discretisation:
@@ -138,10 +142,14 @@ def arcs(curve: ParametricCurve, *, tol: float = DEFAULT_EXPORT_TOL_MM) -> ArcDi
     sur = fit_surrogate(curve, tol)
     spline = fit_spline(curve, sur, tol)
     if spline is None:
+        log.info("arcs: the arc spline across the %d breakpoints misses tol = %g mm (or a dwell arc does); "
+                 "falling back to spans clamped at every breakpoint", len(curve.breakpoints), tol)
         spline = fit_spline(curve, sur, tol, anchored=False)
     if spline is not None:
         chain, measured, nodes = spline
     else:
+        log.info("arcs: the arc spline clamped at every breakpoint misses tol = %g mm too; falling back to "
+                 "interpolating biarcs (slower, more arcs)", tol)
         build = _BiarcGrids(curve, sur[0].as_curve(), tol)
         nodes, _ = fit_grid(curve, tol, "biarc", lambda nodes: build(nodes)[1], sur)
         chain, measured = build(nodes)

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import math
 
-from ..errors import CamfabError
+from ..errors import InputError
 from ..tolerances import DEFAULT_EXPORT_TOL_MM, MAX_EXPORT_TOL_MM, MIN_EXPORT_TOL_MM
 
 __all__ = ["MARGIN", "ToleranceError", "validate_tol"]
@@ -12,7 +12,7 @@ __all__ = ["MARGIN", "ToleranceError", "validate_tol"]
 MARGIN = 0.05
 
 
-class ToleranceError(CamfabError, ValueError):
+class ToleranceError(InputError):
     """A discretisation tolerance outside the accepted range."""
 
 

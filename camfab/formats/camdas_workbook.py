@@ -80,6 +80,7 @@ import numpy as np
 
 from ..design.kinds import ContactKind, FollowerType
 from ..design.tables import LiftTable, intervals, lift_table, sample_params
+from ..errors import InputError
 from ..results import JUMP_CODES, IssueCode, Severity, Verdict
 
 __all__ = ["CAMDAS_COLUMNS", "FIXED_DATE", "LiftTable", "camdas_workbook", "camdas_columns", "conclusions",
@@ -242,7 +243,8 @@ def dynamics_columns(spec, geometry, *, step_deg: float = 1.0) -> tuple[list[str
     from ..design.assemble import dynamics_model
 
     if spec.dynamics is None:
-        raise ValueError(f"{spec.name} has no [dynamics] section")
+        raise InputError(f"{spec.name} has no [dynamics] section: add one (mass_kg or inertia_kg_m2, spring, loads) "
+                         "for the force sheet")
     x = sample_params(geometry, step_deg)
     sm = dynamics_model(spec, geometry).evaluate(x)
     pair = sm.contact_force_2 is not None

@@ -34,7 +34,7 @@ from pathlib import Path
 from typing import Any, cast
 
 from ..design.knots import KnotFile, KnotTable, build_knot_table
-from ..errors import Problem, SpecError
+from ..errors import InputError, Problem, SpecError
 
 __all__ = [
     "TEXT_SUFFIXES",
@@ -155,7 +155,7 @@ def _number(tok: str, decimal_comma: bool) -> float:
     t = tok.strip()
     if decimal_comma and "," in t:
         if "." in t or t.count(",") > 1:
-            raise ValueError(t)
+            raise InputError(f"{t!r} is not a number")
         t = t.replace(",", ".")
     return float(t)
 
@@ -184,7 +184,7 @@ def _parse_rows(lines: list[tuple[int, str]], sep: str | None, dc: bool) -> list
         except ValueError:
             if i == 0 and len(lines) > 1:
                 continue  # header
-            raise ValueError(f"line {no}: {text.strip()!r} is not a row of numbers") from None
+            raise InputError(f"line {no}: {text.strip()!r} is not a row of numbers") from None
     return rows
 
 

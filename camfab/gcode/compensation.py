@@ -42,6 +42,7 @@ from typing import Literal
 
 import numpy as np
 
+from camfab.errors import InputError
 from camfab.gcode.parse import Move
 from camfab.geom2d import TWO_PI, arc_sweep
 from camfab.results import Finding, IssueCode
@@ -571,10 +572,9 @@ def simulate_compensation(moves: Sequence[Move], radius: float, *, swap_side: bo
     """
     moves = list(moves)
     if not math.isfinite(radius) or radius < 0:
-        raise ValueError(f"compensation radius must be finite and >= 0, got {radius!r}")
+        raise InputError(f"radius = {radius!r}: must be finite and >= 0 mm (the D register, usually the tool radius)")
     sim = _Sim(moves, radius, swap_side, join_tol)
-    i, n = 0, len(moves)
-    prev_side = "G40"
+    i, n, prev_side = 0, len(moves), "G40"
     while i < n:
         m = moves[i]
         if m.comp == "G40":

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from camfab.errors import CamfabError
+from camfab.errors import CamfabError, InputError
 from camfab.geom2d import arc_sweep
 
 __all__ = ["GcodeError", "Move", "Backplot", "Samples", "parse", "backplot", "sample"]
@@ -511,7 +511,7 @@ def sample(moves: Sequence[Move], step: float = 0.05) -> Samples:
     Samples
     """
     if step <= 0:
-        raise ValueError("step must be > 0")
+        raise InputError(f"step = {step!r}: must be > 0 (the largest distance between samples of a move, mm)")
     chunks, idx = [], []
     for i, m in enumerate(moves):
         p = _move_points(m, step)

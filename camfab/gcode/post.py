@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from camfab.errors import InputError
 from camfab.gcode.model import Program
 from camfab.gcode.posts.base import Post
 from camfab.gcode.posts.fanuc import POST as _FANUC
@@ -31,15 +32,15 @@ def get_post(post: str | Post) -> Post:
 
     Raises
     ------
-    ValueError
-        Unknown name; the message lists the valid ones.
+    InputError
+        Unknown name (a ``ValueError``); the message lists the valid ones.
     """
     if isinstance(post, Post):
         return post
     try:
         return POSTS[post]
     except (KeyError, TypeError):
-        raise ValueError(f"unknown post-processor {post!r}; valid: {', '.join(sorted(POSTS))}") from None
+        raise InputError(f"unknown post-processor {post!r}; valid: {', '.join(sorted(POSTS))}") from None
 
 
 def dumps(program: Program, post: str | Post, **options) -> str:

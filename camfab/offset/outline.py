@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..discretize import ParametricCurve
-from ..errors import GeometryError
+from ..errors import ApiError, GeometryError
 
 __all__ = ["Piece", "line_piece", "arc_piece", "chain_curve", "translating_outline"]
 
@@ -133,7 +133,8 @@ def translating_outline(contact, distance: float = 0.0) -> ParametricCurve:
         profile ends are not convex corners of the plate.
     """
     if contact.closed:
-        raise TypeError("translating_outline is for translating (open-profile) cams")
+        raise ApiError("translating_outline is for translating (open-profile) cams; a disc cam's outline is its "
+                       "closed profile")
     if not (math.isfinite(distance) and distance >= 0):
         raise GeometryError(f"the outline offset must be >= 0 mm, got {distance!r}")
     if not contact.base_height > 0:

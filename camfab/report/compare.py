@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import InputError
 from ..results import Severity
 from ._common import VERDICT_CLASS, VERDICT_TEXT, axis_of, fmt, mechanism_text, sample_grid
 from .plots import SVAJ_UNITS, new_figure, off_view, plot_style
@@ -238,7 +239,7 @@ def render_comparison(items, *, standalone: bool = False) -> dict[str, bytes]:
 
     items = list(items)
     if not items:
-        raise ValueError("render_comparison needs at least one (spec, geometry, report) item")
+        raise InputError("items is empty: render_comparison needs at least one (spec, geometry, report) item")
     labels = design_labels(items)
     figs = {"svaj": compare_svaj_figure(items, labels), "curvature": compare_curvature_figure(items, labels)}
     if any(c.kind == "roller" or c.oscillating for _, g, _ in items for c in g.profiles):

@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from ..design.kinds import ContactKind
+from ..errors import InputError
 from ..results import Extreme, IssueCode
 from ._common import CURVATURE_CODES, Axis, axis_of, finding_spans, fmt, fmt_at, sample_grid
 
@@ -85,7 +86,7 @@ def figure_bytes(fig, fmt: str = "png") -> bytes:
         elif fmt == "svg":
             fig.savefig(buf, format="svg", metadata={"Date": None})
         else:
-            raise ValueError(f"'{fmt}' is not a valid option, must be one of: png, svg")
+            raise InputError(f"'{fmt}' is not a valid option, must be one of: png, svg")
     return buf.getvalue()
 
 
@@ -479,7 +480,8 @@ def dynamics_figure(spec, geometry, report, *, n: int = _N):
     from ..design.assemble import dynamics_model
 
     if spec.dynamics is None:
-        raise ValueError(f"{spec.name} has no [dynamics] section")
+        raise InputError(f"{spec.name} has no [dynamics] section: add one (mass_kg or inertia_kg_m2, spring, loads) "
+                         "to plot the forces")
     prog = spec.program()
     axis = axis_of(prog)
     c = geometry.profiles[0]

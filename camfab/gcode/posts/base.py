@@ -16,7 +16,7 @@ import re
 from collections.abc import Sequence
 from typing import Any
 
-from camfab.errors import ExportError
+from camfab.errors import ApiError, ExportError, InputError
 from camfab.gcode.model import Arc, Comment, Coolant, CutterComp, Feed, Program, Rapid, Spindle, ToolChange
 from camfab.geom2d import arc_sweep
 
@@ -140,11 +140,11 @@ class Post:
         unknown = sorted(set(options) - set(self.defaults))
         if unknown:
             valid = ", ".join(sorted(self.defaults)) or "none"
-            raise ValueError(f"post {self.name!r}: unknown option(s) {', '.join(unknown)}; valid: {valid}")
+            raise InputError(f"post {self.name!r}: unknown option(s) {', '.join(unknown)}; valid: {valid}")
         opts = dict(self.defaults)
         opts.update(options)
         if "arc_format" in opts and opts["arc_format"] not in self.arc_formats:
-            raise ValueError(f"post {self.name!r}: arc_format must be one of {', '.join(self.arc_formats)}, "
+            raise InputError(f"post {self.name!r}: arc_format must be one of {', '.join(self.arc_formats)}, "
                              f"got {opts['arc_format']!r}")
         return opts
 
@@ -154,13 +154,14 @@ class Post:
 
         Raises
         ------
-        ValueError
-            Unknown or invalid options.
+        InputError
+            Unknown or invalid options (a ``ValueError``).
         ExportError
             The program needs something the controller lacks (e.g. G41/G42 on GRBL).
         """
         if not isinstance(program, Program):
-            raise TypeError("dumps() takes a camfab.gcode.Program")
+            raise ApiError(f"dumps() takes a camfab.gcode.Program, got {type(program).__name__}; build one with "
+                           "camfab.gcode.contour_toolpath")
         opts = self.check_options(options)
         if program.compensation and not self.compensation:
             raise ExportError(f"post {self.name!r}: the controller has no cutter radius compensation "

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import re
 
+from camfab.errors import InputError
 from camfab.gcode.posts.base import Post
 
 __all__ = ["FanucPost", "POST"]
@@ -37,10 +38,10 @@ class FanucPost(Post):
         opts = super().check_options(options)
         o = opts["program_number"]
         if isinstance(o, bool) or not isinstance(o, int) or not 1 <= o <= 9999:
-            raise ValueError(f"post 'fanuc': program_number must be an integer 1..9999, got {o!r}")
+            raise InputError(f"post 'fanuc': program_number must be an integer 1..9999, got {o!r}")
         s = opts["line_number_step"]
         if isinstance(s, bool) or not isinstance(s, int) or not 1 <= s <= 100:
-            raise ValueError(f"post 'fanuc': line_number_step must be an integer 1..100, got {s!r}")
+            raise InputError(f"post 'fanuc': line_number_step must be an integer 1..100, got {s!r}")
         return opts
 
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import re
 
+from camfab.errors import InputError
 from camfab.gcode.posts.base import Post
 
 __all__ = ["GrblPost", "POST"]
@@ -41,7 +42,7 @@ class GrblPost(Post):
         opts = super().check_options(options)
         for k in ("coolant", "mist"):
             if not isinstance(opts[k], bool):
-                raise ValueError(f"post 'grbl': {k} must be true or false, got {opts[k]!r}")
+                raise InputError(f"post 'grbl': {k} must be true or false, got {opts[k]!r}")
         return opts
 
     def coolant_code(self, mode: str, opts: dict) -> str:
