@@ -16,10 +16,10 @@ if os.environ.get("CI"):
 EXAMPLES = Path(__file__).resolve().parents[1] / "camfab" / "examples"
 SHARED = Path(__file__).resolve().parents[2] / "shared"
 
-#: Ejemplo9RT's segment list (spec camdas-reference §2.1)
+#: Ejemplo9RT's segment list (the CAM-DAS thesis, §7.4.9 Ejemplo9RT)
 EJEMPLO9RT = [("modified_sine", 10, 50), ("dwell", 0, 40), ("cycloidal", -10, 50), ("dwell", 0, 40),
               ("poly345", 10, 50), ("dwell", 0, 40), ("poly4567", -10, 50), ("dwell", 0, 40)]
-#: Ejemplo11RO's law (degrees; spec camdas-reference §2.1, reproduces Fig 7.19)
+#: Ejemplo11RO's law (degrees; the CAM-DAS thesis, §7.4.11 Ejemplo11RO; reproduces Fig 7.19)
 EJEMPLO11RO = [("dwell", 0, 90), ("poly4567", 25, 90), ("poly4567", -10, 45), ("poly4567", 10, 45),
                ("poly4567", -25, 90)]
 

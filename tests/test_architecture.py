@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import ast
 import importlib.util
+import re
 import sys
 from pathlib import Path
 
@@ -142,3 +143,37 @@ def test_no_private_name_crosses_a_module():
                 bad += [f"{path.relative_to(ROOT)}:{node.lineno} {a.name}" for a in node.names
                         if a.name.startswith("_") and not a.name.startswith("__")]
     assert not bad, "private names imported across modules: " + "; ".join(bad)
+
+
+#: citations of the team's private digests, which live outside the repository (written with character classes,
+#: so this file does not match itself); a parenthesis opening prose on spec, not a call or tuple of a variable
+_OUTSIDE = re.compile(
+    r"camdas[-]reference|motion[-]laws|profiles[.]md|textbook[.]md|valve[-]case|shared[/]spec"
+    r"|spec[/][a-z-]+[.]md|\bspec[ ](?:§|D[0-9])|\bspec['’]s\b"
+    r"|(?<![\w.])[(]spec\b(?!\s*(?:[,)\].:=]|$))")
+_SCANNED = ("camfab", "tests", "templates", "tools", "benchmarks", "docs", "README.md")
+
+
+def _text_files():
+    for top in _SCANNED:
+        base = ROOT / top
+        paths = [base] if base.is_file() else sorted(p for p in base.rglob("*") if p.is_file())
+        for path in paths:
+            rel = path.relative_to(ROOT)
+            if rel.parts[:2] == ("tests", "golden") or "__pycache__" in rel.parts:
+                continue
+            data = path.read_bytes()
+            if b"\0" in data:
+                continue
+            try:
+                yield rel, data.decode("utf-8")
+            except UnicodeDecodeError:
+                continue
+
+
+def test_no_reference_outside_the_repository():
+    """Code, tests, shipped data and docs cite ``docs/decisions.md`` or the original sources by name (the CAM-DAS
+    thesis, the textbook chapter, the valve case), never the team's digests outside the repository."""
+    bad = [f"{rel}:{n}: {line.strip()}" for rel, text in _text_files()
+           for n, line in enumerate(text.splitlines(), 1) if _OUTSIDE.search(line)]
+    assert not bad, "references outside the repository:\n" + "\n".join(bad)

@@ -35,7 +35,7 @@ def test_motion_json_contract(capsys):
     assert data["verdict"] in ("acceptable", "not_for_high_speed", "unacceptable")
     for q in "SVAJ":
         assert set(data["peaks"][q]) >= {"max", "min", "at_max_deg", "at_min_deg"}
-    # spec camdas-reference §2.5, 9RT row at 1° sampling, ω = 1
+    # the 9RT reference row derived from the thesis' inputs (§7.4.9), 1° sampling, ω = 1
     assert round(data["peaks"]["V"]["max"], 2) == 21.49
     assert round(data["peaks"]["V"]["min"], 2) == -25.07
     assert round(data["peaks"]["J"]["max"], 2) == 1045.28

@@ -1,4 +1,5 @@
-"""`camfab check`: conclusions table, JSON contract of design.md §6, exit codes, refusals."""
+"""`camfab check`: conclusions table, JSON contract (docs/decisions.md, "the user-facing contract"), exit codes,
+refusals."""
 from __future__ import annotations
 
 import json

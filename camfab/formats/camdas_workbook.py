@@ -37,7 +37,7 @@ O, P        pitch curve (roller centre; a curved face's centre of
 R, S        pitch curve, Cartesian: x, y — rollers and curved faces
 ==========  =================================================================
 
-The 361-vs-362-rows note of §1.11 is resolved as follows: the map's
+The 361-vs-362-rows mismatch of the thesis' map (§7.3.7) is resolved as follows: the map's
 ``A10:A371`` is the block CAM-DAS reserved, but the program stored 361
 points (0° … 360°, both ends included), so at the CAM-DAS step of 1° the data
 fill rows 10 … 370 and row 371 stays empty; row 9 holds the headings.  No row

@@ -1,5 +1,5 @@
 """Desmodromic cams: constant width/diameter invariants, conjugate pairs (rigid double
-follower kept exactly), the spec's Cardona–Clos formulas (= camfab ccw), CAM-DAS
+follower kept exactly), the thesis' Cardona–Clos formulas (= camfab ccw), CAM-DAS
 examples, minimum follower distance, refusals, and analytic curvature / pressure
 angle of BOTH profiles against finite differences (property-based)."""
 from __future__ import annotations
@@ -87,7 +87,8 @@ def test_constant_width_keeps_width(rb, w, rise, rot):
 
 
 def test_constant_width_is_its_own_conjugate():
-    """With d = W the conjugate construction gives R_b2 = R_b and P2(θ) = P1(θ+π) (spec §11)."""
+    """With d = W the conjugate construction gives R_b2 = R_b and P2(θ) = P1(θ+π) (thesis §4.2.9;
+    docs/decisions.md, "constant width")."""
     for rot in ("cw", "ccw"):
         cw = ConstantWidthCam(40, 100, 120, rot)
         one = cw.geometry()
@@ -105,7 +106,8 @@ def test_constant_width_is_its_own_conjugate():
 
 @pytest.mark.parametrize("rot", ["cw", "ccw"])
 def test_constant_diameter_roller_centre_distance(rot):
-    """Exact invariant: the roller-centre distance 2R_p + h = W + 2R_r (spec D9); the contact
+    """Exact invariant: the roller-centre distance 2R_p + h = W + 2R_r (docs/decisions.md,
+    "constant diameter"); the contact
     points are W apart only where S' = 0 (100.0 … 100.6 mm for R_b 40, R_r 10, h 20)."""
     mech = ConstantDiameterCam(40, 10, 100, 120, 0.0, rot)
     g = mech.geometry()
@@ -240,7 +242,8 @@ def test_oscillating_pair_keeps_follower_angle(mech, prog):
 
 
 # ---------------------------------------------------------------------------
-# the spec's (Cardona & Clos) formulas are camfab's ccw cams (D5)
+# the thesis' conjugate-cam formulas (§4.2.5–4.2.8, after Cardona & Clos) are camfab's ccw cams
+# (docs/decisions.md, "rotation sense and the cam frame")
 def _S_theta(v, th):
     """[S_θ] = [[cos, sin], [−sin, cos]] applied to (n, 2) vectors."""
     return _rot(v, -th)

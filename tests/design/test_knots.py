@@ -201,7 +201,7 @@ def test_closing_row_must_repeat_the_first():
 
 
 # ---------------------------------------------------------------------------
-# the valve case: the printed PUNTOS matrices (spec valve-case-and-textbook.md §3.4)
+# the valve case (CASO 3, LEVA TIPO 8): its printed PUNTOS matrices of Examples 1 and 2
 PRINTED_EJ1_ROW_30 = [30, 0.0005, 0.4744, 1017.9]
 PRINTED_EJ2_ROW_170 = [170, 0.0040, -2.0987, 277.2]
 
@@ -237,7 +237,7 @@ def test_printed_puntos_load_evaluate_and_warn(name, row):
     assert d["code"] == "KNOT_INCONSISTENT" and d["severity"] == "warning"
     assert {"code", "severity", "from_deg", "to_deg", "value", "limit", "message"} == set(d)
     assert "inconsistent" in d["message"]
-    # interpolated as printed the valve accelerates at > 10 000 m/s² (spec §3.6)
+    # interpolated as printed the valve accelerates at > 10 000 m/s² (docs/decisions.md, "knot tables")
     peak_a = max(abs(p) for p in (prog.peaks()[2].max, prog.peaks()[2].min)) * OMEGA_1500**2 / 1e3
     assert peak_a > 10_000
 
@@ -253,7 +253,8 @@ def test_printed_puntos_dip_below_the_base_circle(name):
 
 
 def test_full_precision_reconstruction_is_consistent():
-    # spec §3.6: minimum-jerk s values (mm) that round back to every printed value of Example 1
+    # minimum-jerk s values (mm) that round back to every printed value of Example 1
+    # (docs/decisions.md, "knot tables")
     rec = {22: 0.039, 24: 0.155, 26: 0.279, 28: 0.395, 140: 8.775, 150: 7.928, 160: 6.488,
            170: 4.530, 180: 2.122, 192: 0.395, 194: 0.279, 196: 0.155, 198: 0.039}
     printed = read_knots_csv(EXAMPLES / "valve_puntos_ej1.csv")
@@ -275,7 +276,8 @@ def test_shipped_toml_example_uses_the_consistent_reconstruction():
     # values are internal (s in mm, derivatives per radian): s rounds to the printed 0.1 mm
     np.testing.assert_allclose(np.round(t.values[:, 0], 1), printed[:, 0], atol=1e-9)
     np.testing.assert_array_equal(t.values[:, 1:], printed[:, 1:])
-    # spec §3.5: the single 30°→110° quintic peaks at v ≈ 1.66 m/s near 53.5°
+    # the valve case builds 30°→110° as one quintic; from its printed end conditions (derived) it
+    # peaks at v ≈ 1.66 m/s near 53.5°
     v = spec.program().peaks("exact")[1]
     assert v.max * spec.speed / 1e3 == pytest.approx(1.66, abs=0.005)
     assert np.degrees(v.at_max) == pytest.approx(53.5, abs=0.1)

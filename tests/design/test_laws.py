@@ -1,9 +1,11 @@
 """Tests of the normalised motion laws (camfab.design.laws).
 
-Oracles are the closed forms and tables of ``shared/spec/motion-laws.md``:
-§5 (formulas), §6 (boundary values), §7 (peak coefficients and the expected
-peaks for L = 50 mm, β = 100°, ω = 1 rad/s).  Every numeric oracle below is
-written from the spec (or from a closed form of it), never from camfab output.
+Oracles are the closed forms of the laws (the thesis §3.4 where it prints them,
+otherwise the standard forms chosen in docs/decisions.md), their boundary values,
+peak coefficients computed from them (the thesis prints none) and the expected
+peaks for the parameters of the thesis' Figs 3.5–3.22 (L = 50 mm, β = 100°,
+ω = 1 rad/s).  Every numeric oracle below is written from a closed form, never
+from camfab output.
 """
 from __future__ import annotations
 
@@ -91,7 +93,7 @@ def test_shapes_are_finite_and_vectorised(name, nu):
 
 
 # ---------------------------------------------------------------------------
-# §6 boundary values: S'(0), S''(0), S'''(0), S'(1), S''(1), S'''(1) in units of L/β^k
+# boundary values: S'(0), S''(0), S'''(0), S'(1), S''(1), S'''(1) in units of L/β^k
 # (double harmonic in units of h = |L|, rise with L = +h, return with L = −h)
 BOUNDARY = {
     "dwell": (0, 0, 0, 0, 0, 0),
@@ -157,7 +159,7 @@ def test_boundary_values_of_the_shape(name):
 
 
 def test_constant_acceleration_boundary_values():
-    # textbook parabolic law (not in motion-laws §6): f' = 0 at both ends, f'' = ±4
+    # the textbook chapter's parabolic ("gravity") law, not a CAM-DAS law: f' = 0 at both ends, f'' = ±4
     ends = np.array([0.0, 1.0])
     law = LAWS["constant_acceleration"]
     assert law(ends, 1) == pytest.approx([0.0, 0.0], abs=1e-12)
@@ -166,7 +168,7 @@ def test_constant_acceleration_boundary_values():
 
 
 # ---------------------------------------------------------------------------
-# §7 peak coefficients (rise, L > 0): (V max, V min, A max, A min, J max, J min) / (L/β^k)
+# peak coefficients (rise, L > 0): (V max, V min, A max, A min, J max, J min) / (L/β^k)
 SQ3, SQ5 = math.sqrt(3.0), math.sqrt(5.0)
 COEFFS = {
     "constant_velocity": (1.0, 1.0, 0.0, 0.0, 0.0, 0.0),
@@ -185,7 +187,7 @@ COEFFS = {
                       16 * PI**3 / K, -16 * PI**3 / (3 * K)),
     "modified_trapezoid": (2.0, 0.0, 8 * PI / Q, -8 * PI / Q, 32 * PI**2 / Q, -32 * PI**2 / Q),
 }
-#: coefficients the spec prints to 3 decimals only (±5e-4)
+#: coefficients written above to 3 decimals only (±5e-4)
 LOOSE = {("double_harmonic_rise", 4), ("double_harmonic_rise", 5),
          ("double_harmonic_return", 4), ("double_harmonic_return", 5)}
 
@@ -244,7 +246,7 @@ def test_law_attributes_match_peak_table(name):
 
 
 def test_constant_acceleration_coefficients():
-    # textbook coefficients (valve-case-and-textbook.md): V 2.0, A 4.0
+    # standard coefficients of the parabolic law (the textbook chapter prints none): V 2.0, A 4.0
     law = LAWS["constant_acceleration"]
     assert (law.cv, law.ca) == (pytest.approx(2.0), pytest.approx(4.0))
     assert _dense_peak("constant_acceleration", 1) == pytest.approx(2.0, abs=1e-9)
@@ -252,7 +254,7 @@ def test_constant_acceleration_coefficients():
 
 
 # ---------------------------------------------------------------------------
-# §7 expected peaks, L = 50 mm, β = 100° (DH: β = 180°), ω = 1 rad/s
+# expected peaks for the thesis' Figs 3.5–3.22 parameters, L = 50 mm, β = 100° (DH: β = 180°), ω = 1 rad/s
 # (law, β°, V max, A max, A min, J max, J min)
 EXPECTED_50_100 = [
     ("simple_harmonic", 100, 45.000, 81.000, -81.000, 0.0, -145.800),
@@ -353,11 +355,11 @@ def test_symmetric_laws_return_is_the_mirror_of_the_rise(name):
 
 @pytest.mark.parametrize("h", [50.0, 100.0])
 def test_double_harmonic_return_is_the_mirror_of_the_rise(h):
-    """Classical DH pair: return (L = −h from Li = h) is S_rise(1 − u) (spec §5.10)."""
+    """Classical DH pair: return (L = −h from Li = h) is S_rise(1 − u) (docs/decisions.md, "double harmonic")."""
     beta = 180.0 * DEG
     rise = Segment(get_law("double_harmonic", h).name, h, beta, 0.0, 0.0)
     ret = Segment(get_law("double_harmonic", -h).name, -h, beta, 0.0, h)
-    # spec closed form for Li = h: S = (h/2)[(1 + cos πu) − ¼(1 − cos 2πu)]
+    # closed form of the DH return for Li = h: S = (h/2)[(1 + cos πu) − ¼(1 − cos 2πu)]
     closed = (h / 2) * ((1 + np.cos(PI * U)) - 0.25 * (1 - np.cos(2 * PI * U)))
     assert ret.values(U, 0) == pytest.approx(closed, abs=1e-10 * h)
     for nu in range(4):
@@ -379,7 +381,7 @@ def test_half_period_variants_are_mirrors(pair):
 
 
 # ---------------------------------------------------------------------------
-# closed forms of §5 (a few spot checks independent of the engine's construction)
+# closed forms of the laws (a few spot checks independent of the engine's construction)
 CLOSED = {
     "simple_harmonic": lambda u: (1 - np.cos(PI * u)) / 2,
     "cycloidal": lambda u: u - np.sin(2 * PI * u) / (2 * PI),
@@ -413,7 +415,7 @@ def test_shape_matches_spec_closed_form(name):
 
 
 def test_modified_trapezoid_norton_decimals():
-    """Spec §5.12 decimal equivalents of pieces 2–5."""
+    """Norton's decimal form of the modified trapezoid, pieces 2–5."""
     law = LAWS["modified_trapezoid"]
     cases = [
         (np.linspace(0.13, 0.37, 7), lambda u: 2.4440619 * u**2 - 0.22203094 * u + 0.0072340616),
@@ -427,7 +429,7 @@ def test_modified_trapezoid_norton_decimals():
 
 # ---------------------------------------------------------------------------
 # piecewise laws: continuity at the internal breaks
-# NB spec §5.12 says the modified trapezoid's jerk jumps between its pieces, but its own
+# NB the written-out modified trapezoid is said to have jerk jumps between its pieces, but its own
 # formulas give S''' = 0 on both sides of every internal break (cos 4πu = 0 at u = k/8, and
 # the ramps have S''' = 0): the jerk is continuous inside the law and jumps only at the
 # segment ends (32π²/Q against a dwell).  The tests follow the formulas.
@@ -466,11 +468,11 @@ def test_piecewise_first_discontinuous_order_really_jumps(name):
 
 def test_modified_trapezoid_jerk_at_breaks_and_ends():
     law = LAWS["modified_trapezoid"]
-    for b in law.breaks:  # S''' is zero on both sides of every internal break (§5.12 formulas)
+    for b in law.breaks:  # S''' is zero on both sides of every internal break (Norton's formulas)
         lo, hi = _sides("modified_trapezoid", b, 3)
         assert lo == pytest.approx(0.0, abs=1e-9)
         assert hi == pytest.approx(0.0, abs=1e-9)
-    # ... and 32π²/Q at both ends, so a dwell next to it sees a jerk jump (spec §6)
+    # ... and 32π²/Q at both ends, so a dwell next to it sees a jerk jump (boundary values)
     assert law(np.array([0.0, 1.0]), 3) == pytest.approx([32 * PI**2 / Q] * 2, rel=1e-12)
 
 

@@ -131,13 +131,14 @@ def test_area_by_green_matches_polygon():
 
 
 # ---------------------------------------------------------------------------
-# the spec's own (cw) formulas
+# the thesis' own (cw) formulas, ch. 4–5 (as corrected in docs/decisions.md, "offset sign" and
+# "oscillating followers")
 def test_spec_formulas_translating_roller_offset():
     e, rb, rr = 8.0, 35.0, 7.0
     g = CamGeometry(TranslatingRoller(rb, rr, e), E9)
     phi = np.linspace(0.01, 2 * np.pi - 0.01, 997)
     s, (S, S1, S2) = g.evaluate(phi), E9.evaluate(phi, (0, 1, 2))
-    m = -e  # the spec's m is positive to the LEFT (90° ccw of the follower axis)
+    m = -e  # the thesis' m is positive to the LEFT (90° ccw of the follower axis)
     L = S + math.sqrt((rb + rr) ** 2 - m * m)
     rho_p = ((S1 - m) ** 2 + L**2) ** 1.5 / (L**2 + (S1 - m) * (2 * S1 - m) - L * S2)
     np.testing.assert_allclose(s.rho_pitch, rho_p, rtol=1e-10)

@@ -1,9 +1,10 @@
 """Tests of segment programs (camfab.design.program).
 
-Oracles: the CAM-DAS "Conclusiones" screens (motion-laws §8, camdas-reference
-§2.3), the derived reference rows of camdas-reference §2.5, the continuity
-consequences of motion-laws §3/§6, the half-period matching of §5.9 and the
-generic-polynomial systems of §5.4/§5.6.  No expected value is a snapshot of
+Oracles: the CAM-DAS "Conclusiones" screens of the thesis (Fig 7.19, §7.3.5, and
+Fig 7.45, §7.4.4 Ejemplo4PO), reference rows derived from the thesis' example inputs
+(docs/decisions.md, "peaks"), the continuity rules of the thesis §3.3.1 with the
+laws' boundary values, the half-period matching of §3.4.6 and the
+generic-polynomial systems of §3.4.3.1/§3.4.4.1.  No expected value is a snapshot of
 camfab output.
 """
 from __future__ import annotations
@@ -30,10 +31,11 @@ DEG = PI / 180.0
 OMEGA = 1.0  # rad/s, every thesis screen
 
 # ---------------------------------------------------------------------------
-# example programs (camdas-reference §2.1)
+# example programs (the thesis' example library, §7.4)
 EJ11RO = [("dwell", 0, 90), ("poly4567", 25, 90), ("poly4567", -10, 45), ("poly4567", 10, 45),
           ("poly4567", -25, 90)]
-# Ejemplo4PO as inferred in camdas-reference §2.1 (split unconfirmed, return confirmed)
+# Ejemplo4PO (thesis §7.4.4; its L/β are only in a figure): the 4-5-6-7 return −20°/45° is inferred from
+# Fig 7.45, which it reproduces exactly; the rise split below is one consistent guess (unconfirmed)
 EJ4PO = [("semicycloidal_vi0", 5, None), ("constant_velocity", 10, 90), ("semicycloidal_vf0", 5, None),
          ("dwell", 0, 45), ("poly4567", -20, 45)]
 EJ4PO_EXPLICIT = [("semicycloidal_vi0", 5, 90), ("constant_velocity", 10, 90),
@@ -120,7 +122,7 @@ def test_4567_return_of_20_over_45_in_any_program(rows):
 
 
 def test_fig_7_45_exact_peaks_are_the_continuous_ones():
-    # 4-5-6-7 return L = −20 over β = 45° (spec §5.7 closed forms)
+    # 4-5-6-7 return L = −20 over β = 45° (closed-form peaks of the 4-5-6-7 law)
     lift, beta = 20.0, PI / 4
     pk = prog(EJ4PO).peaks("exact")
     assert pk[1].min == pytest.approx(-2.1875 * lift / beta, rel=1e-12)
@@ -128,7 +130,7 @@ def test_fig_7_45_exact_peaks_are_the_continuous_ones():
     assert pk[2].min == pytest.approx(-84 * math.sqrt(5) / 25 * lift / beta**2, rel=1e-12)
     assert pk[3].max == pytest.approx(52.5 * lift / beta**3, rel=1e-12)
     assert pk[3].min == pytest.approx(-42.0 * lift / beta**3, rel=1e-12)
-    # the values printed in motion-laws §8 (one decimal; its "−1733.9" is 1733.84 misrounded)
+    # the exact peaks to one decimal, derived from the thesis' inputs ("−1733.9" is 1733.84 misrounded)
     assert pk[1].min == pytest.approx(-55.70, abs=0.005)
     assert pk[2].max == pytest.approx(243.6, abs=0.05)
     assert pk[3].max == pytest.approx(2167.3, abs=0.05)
@@ -136,7 +138,8 @@ def test_fig_7_45_exact_peaks_are_the_continuous_ones():
 
 
 def test_fig_7_19_exact_peaks_are_the_continuous_ones():
-    # camdas-reference §2.4: continuous A = 121.80, J = 1083.6 (truncated; 1083.65) for 11RO
+    # exact peaks of the Ejemplo11RO law, derived from the thesis' inputs: A = 121.80, J = 1083.6
+    # (truncated; 1083.65), where Fig 7.19 prints the 1° samples 121.51 and 1080.44
     lift, beta = 10.0, PI / 4  # the ±10 segments over 45° dominate A and J
     pk = prog(EJ11RO).peaks("exact")
     assert pk[2].max == pytest.approx(84 * math.sqrt(5) / 25 * lift / beta**2, rel=1e-12)
@@ -145,7 +148,8 @@ def test_fig_7_19_exact_peaks_are_the_continuous_ones():
     assert pk[3].max == pytest.approx(1083.6, abs=0.1)
 
 
-# camdas-reference §2.5 derived rows: (S max, S min, V max, V min, A max, A min, J max, J min)
+# reference rows derived from the thesis' example inputs at 1° sampling, ω = 1 (docs/decisions.md, "peaks"):
+# (S max, S min, V max, V min, A max, A min, J max, J min)
 DERIVED = {
     "1RT": (50, 0, 25.00, -25.00, 25.00, -25.00, 25.00, -25.00),
     "2RO": (10, 0, 10.44, -10.44, 17.13, -17.13, 57.15, -57.15),
@@ -295,7 +299,7 @@ def test_generic_polynomials_match_their_neighbours(name):
 
 
 def _spec_quintic(s0, s1, beta):
-    """The CAM-DAS 3×3 system of spec §5.4, solved numerically."""
+    """The CAM-DAS 3×3 system of the thesis §3.4.3.1 (generic 5th degree), solved numerically."""
     c0, c1, c2 = s0[0], s0[1] * beta, s0[2] * beta**2 / 2
     m = np.array([[1, 1, 1], [3, 4, 5], [6, 12, 20]], float)
     rhs = np.array([s1[0] - c0 - c1 - c2, s1[1] * beta - (c1 + 2 * c2), s1[2] * beta**2 - 2 * c2])
@@ -303,7 +307,7 @@ def _spec_quintic(s0, s1, beta):
 
 
 def _spec_septic(s0, s1, beta):
-    """The CAM-DAS 4×4 system of spec §5.6, solved numerically."""
+    """The CAM-DAS 4×4 system of the thesis §3.4.4.1 (generic 7th degree), solved numerically."""
     c0, c1, c2, c3 = s0[0], s0[1] * beta, s0[2] * beta**2 / 2, s0[3] * beta**3 / 6
     m = np.array([[1, 1, 1, 1], [4, 5, 6, 7], [12, 20, 30, 42], [24, 60, 120, 210]], float)
     rhs = np.array([s1[0] - c0 - c1 - c2 - c3, s1[1] * beta - (c1 + 2 * c2 + 3 * c3),
@@ -320,10 +324,10 @@ def test_hermite_coefficients_solve_the_spec_systems(seed):
     assert hermite_coefficients(a, b, beta) == pytest.approx(_spec_septic(a, b, beta), abs=1e-8)
     c5 = solve_generic(5, a[0], b[0] - a[0], beta, np.r_[0, a[1:]], np.r_[0, b[1:]])
     assert c5 == pytest.approx(_spec_quintic(a, b, beta), abs=1e-9)
-    # 4-5-6-7 is the septic with Δ0 = L and zero end derivatives (spec §5.7)
+    # 4-5-6-7 is the septic with Δ0 = L and zero end derivatives (thesis §3.4.4.2)
     c7 = solve_generic(7, 0.0, 1.0, beta, np.zeros(4), np.zeros(4))
     assert c7 == pytest.approx([0, 0, 0, 0, 35, -84, 70, -20], abs=1e-12)
-    # and 3-4-5 the quintic (spec §5.5)
+    # and 3-4-5 the quintic (thesis §3.4.3.2)
     c345 = solve_generic(5, 0.0, 1.0, beta, np.zeros(4), np.zeros(4))
     assert c345 == pytest.approx([0, 0, 0, 10, -15, 6], abs=1e-12)
 
@@ -334,7 +338,7 @@ def test_hermite_coefficients_rejects_bad_sizes():
 
 
 def test_generic_between_zero_derivative_neighbours_is_the_standard_polynomial():
-    """poly5 / poly7 between dwells reduce to 3-4-5 / 4-5-6-7 (spec §5.5, §5.7)."""
+    """poly5 / poly7 between dwells reduce to 3-4-5 / 4-5-6-7 (thesis §3.4.3.2, §3.4.4.2)."""
     for generic, standard in (("poly5", "poly345"), ("poly7", "poly4567")):
         a = prog([("dwell", 0, 90), (generic, 10, 90), ("dwell", 0, 90), ("poly4567", -10, 90)])
         b = prog([("dwell", 0, 90), (standard, 10, 90), ("dwell", 0, 90), ("poly4567", -10, 90)])
@@ -343,7 +347,7 @@ def test_generic_between_zero_derivative_neighbours_is_the_standard_polynomial()
 
 
 # ---------------------------------------------------------------------------
-# continuity classes without knots (spec §3, §6)
+# continuity classes without knots (thesis §3.3.1; the laws' boundary values)
 def _classes(rows) -> list[str]:
     return [j.continuity for j in prog(rows).junctions()]
 
@@ -357,16 +361,16 @@ def _classes(rows) -> list[str]:
      ["C2"] * 4),
     ([("dwell", 0, 90), ("modified_trapezoid", 10, 90), ("dwell", 0, 90),
       ("modified_trapezoid", -10, 90)], ["C2"] * 4),
-    # SHM rise 180 + SHM return 180 = one cosine: acceleration continuous (§5.2) and jerk 0 on both sides
+    # SHM rise 180 + SHM return 180 = one cosine: acceleration continuous (thesis §3.4.1) and jerk 0 on both sides
     ([("simple_harmonic", 50, 180), ("simple_harmonic", -50, 180)], ["C3", "C3"]),
-    # DH rise + return with equal β: continuous through jerk (§5.10)
+    # DH rise + return with equal β: continuous through jerk (thesis §3.4.7)
     ([("double_harmonic", 100, 180), ("double_harmonic", -100, 180)], ["C3", "C3"]),
-    # constant velocity next to a dwell: velocity jump (§5.8, L979)
+    # constant velocity next to a dwell: velocity jump (thesis §3.4.5)
     ([("dwell", 0, 90), ("constant_velocity", 10, 90), ("dwell", 0, 90), ("poly4567", -10, 90)],
      ["C3", "C0", "C0", "C3"]),
-    # constant-breadth law SHM/dwell/SHM/dwell: C1 only (§3 rule 6)
+    # constant-breadth law SHM/dwell/SHM/dwell: C1 only (thesis §3.3.1, the constant-width exception)
     (EXAMPLES["5ACRT"], ["C1"] * 4),
-    # cycloid + cycloid rise/return without dwell: C2, jerk jumps (§5.3)
+    # cycloid + cycloid rise/return without dwell: C2, jerk jumps (thesis §3.4.2)
     ([("cycloidal", 10, 180), ("cycloidal", -10, 180)], ["C2", "C2"]),
     # Ejemplo9RT: 4-5-6-7 junctions C3, the others C2
     (EXAMPLES["9RT"], ["C2", "C2", "C2", "C2", "C2", "C2", "C3", "C3"]),
@@ -409,11 +413,11 @@ def test_junction_records():
 
 
 # ---------------------------------------------------------------------------
-# half-period laws with solved spans (§5.9)
+# half-period laws with solved spans (thesis §3.4.6)
 @pytest.mark.parametrize("lift, cv_lift, cv_span", [(5, 10, 90), (3, 12, 60), (2.5, 7.5, 120)])
 def test_semicycloidal_auto_spans(lift, cv_lift, cv_span):
     slope = cv_lift / (cv_span * DEG)
-    beta = 2 * lift / slope  # spec §5.9.3/§5.9.4: 2L/β = neighbour slope
+    beta = 2 * lift / slope  # semicycloids: 2L/β = neighbour slope (docs/decisions.md, "half-period laws")
     ret_span = 45.0
     dwell = 360 - cv_span - 2 * math.degrees(beta) - ret_span
     total = 2 * lift + cv_lift
@@ -434,7 +438,7 @@ def test_semicycloidal_auto_spans(lift, cv_lift, cv_span):
 def test_semiharmonic_auto_spans():
     lift, cv_lift, cv_span = 5.0, 10.0, 90.0
     slope = cv_lift / (cv_span * DEG)
-    beta = (PI / 2) * lift / slope  # spec §5.9.1/§5.9.2: πL/(2β) = neighbour slope
+    beta = (PI / 2) * lift / slope  # thesis §3.4.6.1: πL/(2β) = neighbour slope
     assert math.degrees(beta) == pytest.approx(22.5 * PI)  # = π²/8 rad
     ret_span = 60.0
     dwell = 360 - cv_span - 2 * math.degrees(beta) - ret_span
@@ -447,7 +451,7 @@ def test_semiharmonic_auto_spans():
     # C2 at the constant-velocity junctions (A = 0 there, jerk jumps π³L/(8β³))
     assert js[2].continuity == "C2" and js[3].continuity == "C2"
     assert js[2].jumps[3] == pytest.approx(PI**3 * lift / (8 * beta**3), rel=1e-9)
-    # the zero-velocity ends carry |A| = π²L/(4β²): C1 against a dwell / a 4-5-6-7 (§6)
+    # the zero-velocity ends carry |A| = π²L/(4β²): C1 against a dwell / a 4-5-6-7 (boundary values)
     assert js[1].continuity == "C1" and js[4].continuity == "C1"
     assert js[1].jumps[2] == pytest.approx(PI**2 * lift / (4 * beta**2), rel=1e-9)
 
@@ -521,12 +525,12 @@ def test_periodicity(name):
 
 @pytest.mark.parametrize("name", sorted(ALL_PROGRAMS))
 def test_closes_the_cycle(name):
-    """S, S', S'' at 360° equal those at 0° (spec §3 rule 5) for every C2 program."""
+    """S, S', S'' at 360° equal those at 0° (thesis §3.3.1, cyclic closure) for every C2 program."""
     p = prog(ALL_PROGRAMS[name])
     first = p.segments[0].end_values(False)
     last = p.segments[-1].end_values(True)
     assert last[0] == pytest.approx(first[0], abs=1e-9)
-    if name != "5ACRT":  # the constant-breadth law is C1 only (spec §3 rule 6)
+    if name != "5ACRT":  # the constant-breadth law is C1 only (thesis §3.3.1)
         for k in (1, 2):
             assert last[k] == pytest.approx(first[k], abs=1e-9 * max(1.0, _scale(p, k)))
     assert p(np.array([0.0]))[0] == pytest.approx(0.0, abs=1e-12)
@@ -655,7 +659,7 @@ def test_s_below_zero_names_the_segment_where_the_minimum_lies():
 
 
 def test_generic_overshoot_above_zero_is_accepted():
-    # overshoot of a generic polynomial is the user's decision (spec §5.4); only S < 0 is refused
+    # overshoot of a generic polynomial is the user's decision (thesis §3.4.3.1); only S < 0 is refused
     p = prog([("poly345", 10, 90), ("constant_velocity", 10, 90), ("poly5", 0, 90), ("poly345", -20, 90)])
     assert p.peaks("exact")[0].max > 20.0
     assert p.peaks("exact")[0].min >= -1e-9

@@ -1,7 +1,7 @@
 """Property tests of motion programs (hypothesis).
 
 Random valid programs are chains of 2–12 dwell-compatible segments (zero S′ and
-S″ at both ends, spec §6) with optional generic 5th/7th-degree polynomials that
+S″ at both ends) with optional generic 5th/7th-degree polynomials that
 are never adjacent (cyclically included), random positive spans summing to 360°
 and lifts keeping the cumulative S ≥ 0 and closing at 0.
 """

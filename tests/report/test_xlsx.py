@@ -1,4 +1,5 @@
-"""CAM-DAS spreadsheet export: the §1.11 cell map, engine values, checks and lift-table sheets."""
+"""CAM-DAS spreadsheet export: the thesis' Exportar-Excel cell map (§7.3.7), engine values, checks and
+lift-table sheets."""
 from __future__ import annotations
 
 import io
