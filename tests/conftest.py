@@ -14,7 +14,6 @@ if os.environ.get("CI"):
     settings.load_profile("ci")
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "camfab" / "examples"
-SHARED = Path(__file__).resolve().parents[2] / "shared"
 
 #: Ejemplo9RT's segment list (the CAM-DAS thesis, §7.4.9 Ejemplo9RT)
 EJEMPLO9RT = [("modified_sine", 10, 50), ("dwell", 0, 40), ("cycloidal", -10, 50), ("dwell", 0, 40),

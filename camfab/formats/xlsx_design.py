@@ -20,10 +20,10 @@ Workbook format
     of text.  Units, speed and degree come from the ``motion_table.*`` keys of
     the ``design`` sheet, exactly as in TOML.
 
-The ``[dynamics]`` section is key/value rows of the ``design`` sheet too
+The ``[dynamics]`` and ``[machining]`` sections are key/value rows of the ``design`` sheet too
 (``dynamics.mass_kg``, ``dynamics.spring_rate_n_per_mm``, … or
-``dynamics.inertia_kg_m2``, … for an oscillating follower), validated like
-the TOML section.
+``dynamics.inertia_kg_m2``, … for an oscillating follower; ``machining.feed_mm_min``, …),
+validated like the TOML sections.
 
 Cell values: numbers, text and booleans as Excel stores them.  Text that
 reads as a number (``35`` or ``35,5``) or as a boolean (``true``/``false``,
@@ -46,6 +46,7 @@ from pathlib import Path
 from typing import Any
 
 from ..design.knots import KnotFile
+from ..design.shop import MachiningSpec
 from ..design.spec import CamSpec, DesignSpec, FollowerSpec, ManufacturingSpec, OutputsSpec, dynamics_items
 from ..errors import Problem, SpecError
 from ..units import RPM
@@ -309,6 +310,7 @@ def design_rows(spec: DesignSpec) -> tuple[list[tuple[str, Any]], list[dict[str,
     kv += _cam_rows(spec.cam, spec.is_translating_cam)
     kv += _follower_rows(spec.follower)
     kv += _manufacturing_rows(spec.manufacturing)
+    kv += _machining_rows(spec.machining)
     kv += _output_rows(spec.outputs)
     if spec.pressure_angle_limit_deg is not None:
         kv.append(("checks.pressure_angle_limit_deg", _num(spec.pressure_angle_limit_deg)))
@@ -362,6 +364,13 @@ def _manufacturing_rows(m: ManufacturingSpec) -> list[tuple[str, Any]]:
     if m.material:
         kv.append(("manufacturing.material", m.material))
     return kv
+
+
+def _machining_rows(m: MachiningSpec) -> list[tuple[str, Any]]:
+    """``machining.*``: every value that differs from the default (a design without the table writes none)."""
+    default = MachiningSpec()
+    return [(f"machining.{name}", _num(getattr(m, name))) for name in MachiningSpec.__dataclass_fields__
+            if getattr(m, name) != getattr(default, name)]
 
 
 def _output_rows(o: OutputsSpec) -> list[tuple[str, Any]]:
