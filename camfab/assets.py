@@ -18,7 +18,7 @@ from importlib import resources
 from importlib.resources.abc import Traversable
 from pathlib import Path
 
-from .errors import CamfabError
+from .errors import MissingDependencyError
 
 __all__ = ["read_template", "templates", "templates_hash"]
 
@@ -36,9 +36,9 @@ def templates() -> Traversable:
 
     Raises
     ------
-    CamfabError
+    MissingDependencyError
         When neither an installed ``camfab/templates/`` nor a checkout's ``templates/`` is there (a broken
-        install).
+        install: the command line exits 3, as for any missing part of the installation).
     """
     shipped = resources.files("camfab").joinpath("templates")
     if _complete(shipped):
@@ -46,7 +46,8 @@ def templates() -> Traversable:
     checkout = Path(__file__).resolve().parent.parent / "templates"
     if _complete(checkout):
         return checkout
-    raise CamfabError(f"camfab's templates are missing: neither {shipped} nor {checkout} exists; reinstall camfab")
+    raise MissingDependencyError(f"camfab's templates are missing: neither {shipped} nor {checkout} exists; "
+                                 "reinstall camfab")
 
 
 def read_template(*parts: str) -> str:

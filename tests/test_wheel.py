@@ -167,3 +167,17 @@ def test_the_wheel_installs_and_runs_from_another_folder(tmp_path):
     assert api["examples"] == sorted(p.stem for p in EXAMPLES_DIR.glob("*.toml"))
     assert {"report.html", "check.json", "Ejemplo9RT_drawing.dxf"} <= set(api["files"]) and not api["withheld"]
     assert (elsewhere / "api_out" / "report.html").is_file() and api["title_block"] and api["index"]
+
+
+def test_missing_templates_are_a_broken_install_exit_3_and_nothing_written(tmp_path, monkeypatch, capsys):
+    from camfab.cli import main
+
+    monkeypatch.setattr(assets, "_complete", lambda node: False)
+    assets.templates.cache_clear()
+    try:
+        out = tmp_path / "out"
+        assert main(["report", "ejemplo9rt", "-o", str(out)]) == 3
+        assert "templates are missing" in capsys.readouterr().err
+        assert not out.exists() or not any(out.rglob("*"))
+    finally:
+        assets.templates.cache_clear()
