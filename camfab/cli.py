@@ -20,7 +20,7 @@ from typing import Any
 
 from . import pipeline
 from .errors import ApiError, CamfabError, InternalError, MissingDependencyError
-from .io import atomic_write
+from .io import atomic_write, inside
 from .pipeline import Cam, Output, Request
 from .results import Severity, Verdict
 from .version import __version__
@@ -153,7 +153,8 @@ def cmd_export(args: argparse.Namespace) -> int:
     req = Request(frozenset(Output(f) for f in formats), tol=tol, dxf_flavour=args.dxf_flavour,
                   tool_paths=args.tool_path)
     arts = [a for out in pipeline.EXPORTERS if out in req.outputs for a in pipeline.EXPORTERS[out](cam, req)]
-    paths = [atomic_write(Path(args.output) / a.filename, a.data) for a in arts]
+    targets = [inside(Path(args.output), a.filename) for a in arts]  # all proved inside -o before any write
+    paths = [atomic_write(t, a.data) for t, a in zip(targets, arts, strict=True)]
     print(f"{cam.name}: verdict {cam.verdict}, tolerance {tol:g} mm")
     print(f"  {'file':<32}{'entities':>10}{'max deviation (mm)':>22}")
     for a, p in zip(arts, paths, strict=True):

@@ -29,7 +29,7 @@ from pathlib import Path
 from .assets import read_template, templates_hash
 from .design.spec import DesignSpec
 from .formats import load_design
-from .io import atomic_write
+from .io import atomic_write, inside, safe_stem
 from .pipeline import Cam, Request, run
 from .results import Verdict
 from .version import __version__
@@ -109,7 +109,7 @@ def _build(args: tuple) -> dict:
     try:
         spec = spec if spec is not None else load_design(Path(path))
         entry["name"] = spec.name
-        folder = Path(out) / _folder_name(spec.name)
+        folder = inside(out, safe_stem(spec.name))
         outputs = options.get("outputs")
         req = Request.from_design(spec, outputs, force=options.get("force") or None,
                                   post="linuxcnc" if outputs is not None else None)
@@ -138,10 +138,6 @@ def _internal_error(entry: dict, exc: Exception) -> None:
     entry.update(status="error", verdict=None, files=[], error_type=type(exc).__name__,
                  error=f"internal error ({type(exc).__name__}: {exc}); please report it with this design",
                  traceback=traceback.format_exc())
-
-
-def _folder_name(name: str) -> str:
-    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) or "cam"
 
 
 def _file_entry(p: Path, out: Path, dev) -> dict:

@@ -32,7 +32,7 @@ from .design.spec import DesignSpec
 from .discretize import validate_tol
 from .errors import GeometryError, Problem, SpecError
 from .formats import EXAMPLES_DIR, load_design, resolve_design_path
-from .io import atomic_write
+from .io import atomic_write, inside, safe_stem
 from .results import CheckReport, Verdict
 
 __all__ = ["Output", "SHOP_OUTPUTS", "Request", "RunResult", "Cam", "EXPORTERS", "gcode_job", "run", "load",
@@ -331,7 +331,7 @@ def _gcode(cam: Cam, req: Request) -> list[Artifact]:
     out = []
     for i, contact in enumerate(cam.geometry.profiles):
         cp = cam_program(contact, job, tol=tol, compensation=m.compensation, arcs_allowed=not m.lines_only)
-        out.append(Artifact(f"{cam.name}{_suffix(i, n)}.nc", dumps(cp.program, req.post).encode(), "gcode",
+        out.append(Artifact(f"{safe_stem(cam.name)}{_suffix(i, n)}.nc", dumps(cp.program, req.post).encode(), "gcode",
                             cp.entities, cp.deviation_mm, req.post))
     return out
 
@@ -344,14 +344,14 @@ def _lift_table(cam: Cam, req: Request) -> list[Artifact]:
         raise GeometryError("a polar lift table needs a rotating cam")
     ang = lift_angles(req.lift_step_deg)
     text = lift_table_csv(ang, prog(np.radians(ang)), lift_unit=prog.axis.lift_unit)
-    return [Artifact(f"{cam.name}_lift.csv", text.encode(), "lift_table")]
+    return [Artifact(f"{safe_stem(cam.name)}_lift.csv", text.encode(), "lift_table")]
 
 
 def _xlsx(cam: Cam, req: Request) -> list[Artifact]:
     from .formats.camdas_workbook import camdas_workbook
 
     data = camdas_workbook(cam.spec, cam.geometry, cam.check(), step_deg=req.xlsx_step_deg)
-    return [Artifact(f"{cam.name}.xlsx", data, "xlsx")]
+    return [Artifact(f"{safe_stem(cam.name)}.xlsx", data, "xlsx")]
 
 
 def _report(cam: Cam, req: Request) -> list[Artifact]:
@@ -367,7 +367,8 @@ def _drawing(cam: Cam, req: Request) -> list[Artifact]:
 
     shapes = cam.shapes(req.tol)
     text = drawing_sheet(cam.spec, cam.geometry, cam.check(), shapes)
-    return [Artifact(f"{cam.name}_drawing.dxf", text.encode(), "drawing", None, max(shapes.profile_deviation))]
+    return [Artifact(f"{safe_stem(cam.name)}_drawing.dxf", text.encode(), "drawing", None,
+                     max(shapes.profile_deviation))]
 
 
 #: every artifact's stage, in the order :func:`run` builds them
@@ -405,8 +406,9 @@ def run(cam: Cam, outdir: str | Path, req: Request, *, progress: Callable[[str],
             if art.kind != "report":
                 res.deviations[art.filename] = art.deviation_mm
     folder = Path(outdir)
+    paths = {name: inside(folder, name) for name in files}  # every path proved inside outdir before any write
     for name, data in sorted(files.items()):
-        res.files[name] = atomic_write(folder / name, data)
+        res.files[name] = atomic_write(paths[name], data)
     return res
 
 

@@ -16,7 +16,7 @@ from pathlib import Path
 from ..design.kinds import ContactKind
 from ..discretize import ArcDiscretisation, arcs, measure_deviation, validate_tol
 from ..geom2d import ArcChain
-from ..io import atomic_write
+from ..io import atomic_write, inside, safe_stem
 from ..offset.cutter import pitch_curve, profile_curve, tool_centre_path
 from . import dxf as dxf_mod
 from . import step, stl
@@ -131,17 +131,17 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
             fine = arcs(curve, tol=tol / 2)
             dev = float(measure_deviation(fine.flatten(tol / 2), curve).max)
             data = stl.dumps(fine, plate, tol=tol / 2, name=spec.name)
-            out.append(Artifact(f"{spec.name}{_suffix(i, n)}.stl", data, "stl", None, dev))
+            out.append(Artifact(f"{safe_stem(spec.name)}{_suffix(i, n)}.stl", data, "stl", None, dev))
     if "step" in formats:
         for i, (loop, dev) in enumerate(zip(shapes.profiles, shapes.profile_deviation, strict=True)):
             say(f"STEP{_suffix(i, n)}")
             text = step.dumps(loop, plate, name=f"{spec.name}{_suffix(i, n)}")
-            out.append(Artifact(f"{spec.name}{_suffix(i, n)}.step", text.encode("utf-8"), "step",
+            out.append(Artifact(f"{safe_stem(spec.name)}{_suffix(i, n)}.step", text.encode("utf-8"), "step",
                                 loop.n_entities, dev))
         if n > 1:
             say("STEP pair on the shaft")
             text = step.stack_dumps(shapes.profiles, plate, name=f"{spec.name}_pair")
-            out.append(Artifact(f"{spec.name}_pair.step", text.encode("utf-8"), "step",
+            out.append(Artifact(f"{safe_stem(spec.name)}_pair.step", text.encode("utf-8"), "step",
                                 sum(lp.n_entities for lp in shapes.profiles), max(shapes.profile_deviation),
                                 "both cams positioned along the shaft"))
     return out
@@ -163,11 +163,13 @@ def _dxf(spec, geometry, shapes: CamShapes, plate: PlateSpec, tol: float, flavou
         tool_paths=tools, tol_mm=tol, deviation_mm=max(shapes.profile_deviation), name=spec.name)
     text = dxf_mod.dumps(content, flavour=flavour)
     ents = sum(lp.n_entities for lp in shapes.profiles)
-    return Artifact(f"{spec.name}.dxf", text.encode("utf-8"), "dxf", ents, max(shapes.profile_deviation),
+    return Artifact(f"{safe_stem(spec.name)}.dxf", text.encode("utf-8"), "dxf", ents, max(shapes.profile_deviation),
                     f"{flavour}; {len(tools)} tool path(s)" if tools else flavour)
 
 
 def write_artifacts(artifacts: Iterable[Artifact], outdir: str | Path) -> list[Path]:
     """Write every artifact atomically into ``outdir``; returns the paths."""
     outdir = Path(outdir)
-    return [atomic_write(outdir / a.filename, a.data) for a in artifacts]
+    artifacts = list(artifacts)
+    targets = [inside(outdir, a.filename) for a in artifacts]  # all proved inside outdir before any write
+    return [atomic_write(t, a.data) for t, a in zip(targets, artifacts, strict=True)]

@@ -371,7 +371,8 @@ def render_report(spec, geometry, report, *, standalone: bool = False, frames: i
 
 def write_files(files: Mapping[str, bytes], out_dir: str | Path) -> list[Path]:
     """Write ``{relative path: bytes}`` under ``out_dir`` (atomic writes); returns the paths in order."""
-    from ..io import atomic_write
+    from ..io import atomic_write, inside
 
     out = Path(out_dir)
-    return [atomic_write(out / rel, data) for rel, data in files.items()]
+    targets = [inside(out, rel) for rel in files]  # all proved inside out_dir before any write
+    return [atomic_write(t, data) for t, data in zip(targets, files.values(), strict=True)]
