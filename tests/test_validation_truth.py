@@ -37,3 +37,41 @@ def test_dwell_with_lift_refused_by_the_api():
 def test_dwell_with_zero_lift_still_accepted():
     MotionProgram.from_segments([("simple_harmonic", 10, 90), ("dwell", 0, 90),
                                  ("simple_harmonic", -10, 90), ("dwell", 0, 90)])
+
+
+# ---- a closed stdout pipe ends quietly
+def test_closed_pipe_is_quiet():
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    env = {**os.environ, "PYTHONPATH": str(root)}
+    r = subprocess.run(f"set -o pipefail; '{sys.executable}' -m camfab check ejemplo9rt | head -1",
+                       shell=True, executable="/bin/bash", capture_output=True, text=True, env=env, cwd=root)
+    assert r.stdout.startswith("Ejemplo9RT")
+    assert "Traceback" not in r.stderr and "Broken pipe" not in r.stderr and "BrokenPipe" not in r.stderr
+    assert r.returncode in (0, 141)  # the command's own code, or 128 + SIGPIPE when cut off mid-output
+
+
+# ---- example names: a suggestion for a typo, and a command that lists them
+def test_mistyped_example_suggests_the_closest(capsys):
+    from camfab.cli import main
+
+    assert main(["check", "ejemplo9r"]) == 2
+    err = capsys.readouterr().err
+    assert "'ejemplo9rt'" in err and "camfab examples" in err
+
+
+def test_examples_command(capsys):
+    import json
+
+    import camfab
+    from camfab.cli import main
+
+    assert main(["examples"]) == 0
+    names = capsys.readouterr().out.split()
+    assert names == camfab.examples() and "ejemplo9rt" in names
+    assert main(["examples", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out) == names
