@@ -75,3 +75,79 @@ def test_examples_command(capsys):
     assert names == camfab.examples() and "ejemplo9rt" in names
     assert main(["examples", "--json"]) == 0
     assert json.loads(capsys.readouterr().out) == names
+
+
+# ---- --force on a design whose velocity jumps (constant velocity beside dwells)
+_CV_JUMP = """name = "cv_jump"
+[cam]
+kind = "disc"
+omega_rad_s = 1.0
+[follower]
+type = "{follower}"
+motion = "translating"
+base_radius_mm = 40.0
+{roller}offset_mm = 0.0
+[[motion]]
+law = "constant_velocity"
+lift = 10.0
+angle_deg = 120.0
+[[motion]]
+law = "dwell"
+angle_deg = 60.0
+[[motion]]
+law = "constant_velocity"
+lift = -10.0
+angle_deg = 120.0
+[[motion]]
+law = "dwell"
+angle_deg = 60.0
+[manufacturing]
+thickness_mm = 10.0
+bore_mm = 12.0
+tool_diameter_mm = 6.0
+tolerance_mm = 0.01
+"""
+
+
+@pytest.mark.parametrize("argv", [["run", "--force"], ["export", "--dxf", "--force"]])
+def test_force_on_a_velocity_jump_with_a_roller_is_refused_clearly(tmp_path, capsys, argv):
+    """The roller profile jumps where the pitch curve has a corner: no file can be within the tolerance, so
+    the command says where and why (exit 2, nothing written) instead of a numpy ValueError."""
+    from camfab.cli import main
+
+    d = tmp_path / "cv.toml"
+    d.write_text(_CV_JUMP.format(follower="roller", roller="roller_radius_mm = 8.0\n"))
+    out = tmp_path / "out"
+    assert main([argv[0], str(d), "-o", str(out), *argv[1:]]) == 2
+    err = capsys.readouterr().err
+    assert "the profile is not continuous at 120°" in err and "velocity jumps" in err
+    assert "repeats" not in err and not out.exists()
+
+
+def test_force_on_a_velocity_jump_with_a_knife_edge_writes_within_tolerance(tmp_path):
+    """A knife edge's profile is the pitch curve: continuous with corners, so --force exports it, measured."""
+    import camfab
+    from camfab.cad.export import cam_shapes
+
+    d = tmp_path / "cv.toml"
+    d.write_text(_CV_JUMP.format(follower="knife", roller=""))
+    cam = camfab.load(str(d))
+    assert cam.verdict == "unacceptable"
+    shapes = cam_shapes(cam.geometry, tol=0.01)
+    assert max(shapes.profile_deviation) <= 0.01
+
+
+def test_fit_of_a_jumping_curve_says_so():
+    import numpy as np
+
+    from camfab.discretize.curve import ParametricCurve
+    from camfab.discretize.fit import arcs
+    from camfab.errors import GeometryError
+
+    def point(t):  # a circle of radius 10 that steps out to 11 on [π/2, π)
+        t = np.asarray(t)
+        r = np.where((t >= np.pi / 2) & (t < np.pi), 11.0, 10.0)
+        return np.stack([r * np.cos(t), r * np.sin(t)], axis=-1)
+
+    with pytest.raises(GeometryError, match="P jumps by"):
+        arcs(ParametricCurve(point, [np.pi / 2, np.pi]), tol=0.01)
