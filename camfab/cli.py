@@ -13,6 +13,7 @@ import dataclasses
 import json
 import logging
 import math
+import os
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -28,6 +29,7 @@ from .version import __version__
 __all__ = ["main", "register", "COMMANDS", "UsageError"]
 
 EXIT_OK, EXIT_CHECKS, EXIT_INPUT, EXIT_IO = 0, 1, 2, 3
+EXIT_BROKEN_PIPE = 128 + 13  # 128 + SIGPIPE: what a shell reports for a command whose reader went away
 #: every subcommand: name → (run(args) -> exit code, add_arguments(parser), help)
 COMMANDS: dict[str, tuple[Callable[[argparse.Namespace], int], Callable[[argparse.ArgumentParser], None], str]] = {}
 
@@ -392,6 +394,17 @@ def cmd_compare(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _examples_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--json", action="store_true", help="print one JSON list instead of one name per line")
+
+
+@register("examples", "the names of the built-in example designs (usable wherever a FILE is asked)", _examples_args)
+def cmd_examples(args: argparse.Namespace) -> int:
+    names = pipeline.examples()
+    print(json.dumps(names) if args.json else "\n".join(names))
+    return EXIT_OK
+
+
 # ---------------------------------------------------------------------------
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="camfab", description="Cam design, checks and manufacturing files.")
@@ -437,7 +450,21 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help(sys.stderr)
         return EXIT_INPUT
     with _log_to_stderr(args.verbose):
-        return _guarded(args)
+        code = _guarded(args)
+    try:
+        sys.stdout.flush()  # a pipe closed by the reader shows here when the output fitted in its buffer
+    except BrokenPipeError:
+        _stdout_to_devnull()
+    return code
+
+
+def _stdout_to_devnull() -> None:
+    """The reader of stdout has gone (``camfab check X | head -1``): send what is left to /dev/null, so that
+    neither the command nor the interpreter's last flush complains (the Python docs' recipe, "Note on SIGPIPE")."""
+    with contextlib.suppress(OSError, ValueError):
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
 
 
 def _guarded(args: argparse.Namespace) -> int:
@@ -451,6 +478,9 @@ def _guarded(args: argparse.Namespace) -> int:
     except MissingDependencyError as exc:
         print(f"camfab {args.command}: error: {exc}", file=sys.stderr)
         return EXIT_IO
+    except BrokenPipeError:  # stdout closed by its reader: stop quietly, as a command killed by SIGPIPE does
+        _stdout_to_devnull()
+        return EXIT_BROKEN_PIPE
     except (ApiError, InternalError):
         raise
     except CamfabError as exc:

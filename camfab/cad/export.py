@@ -9,12 +9,15 @@ writer takes the profiles as :class:`~camfab.geom2d.ArcChain` values.
 from __future__ import annotations
 
 import logging
+import math
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
 from ..design.kinds import ContactKind
 from ..discretize import ArcDiscretisation, arcs, measure_deviation, validate_tol
+from ..discretize.curve import discontinuities
+from ..errors import GeometryError
 from ..geom2d import ArcChain
 from ..io import atomic_write, inside, safe_stem
 from ..offset.cutter import pitch_curve, profile_curve, tool_centre_path
@@ -62,12 +65,28 @@ def cam_shapes(geometry, *, tol: float, with_pitch: bool = True) -> CamShapes:
     profiles, pitch, curves = [], [], []
     for c in geometry.profiles:
         curve = profile_curve(c)
+        _require_continuous(curve, tol)
         profiles.append(arcs(curve, tol=tol))
         curves.append(curve)
         pc = pitch_curve(c) if with_pitch and c.roller_radius > 0 else None
         if pc is not None:
             pitch.append(_pitch_loop(profiles[-1], c.roller_radius, pc, tol))
     return CamShapes(tuple(profiles), tuple(pitch), tuple(curves), tol)
+
+
+def _require_continuous(curve, tol: float) -> None:
+    """Refuse a profile that jumps: where the follower's velocity jumps the pitch curve has a corner, and a
+    roller's profile (its envelope) is not built around one — no file could be within ``tol`` of it."""
+    gaps = discontinuities(curve, tol)
+    if not gaps:
+        return
+    scale = 180.0 / math.pi if math.isclose(curve.period, 2 * math.pi) else 1.0
+    unit = "°" if scale != 1.0 else " mm"
+    where = ", ".join(f"{(t % curve.period) * scale:.6g}{unit} (gap {g:.3g} mm)" for t, g in gaps)
+    raise GeometryError(f"the profile is not continuous at {where}: the follower's velocity jumps there, so the "
+                        "pitch curve has a corner that a roller's profile does not follow; no file can be made "
+                        "within the tolerance even with --force: match the velocities at the junctions "
+                        "(e.g. cycloidal or modified-sine rises instead of constant velocity)")
 
 
 def _pitch_loop(profile: ArcChain, roller_radius: float, pitch, tol: float) -> ArcChain:

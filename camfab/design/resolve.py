@@ -4,7 +4,7 @@ Every rule of the CAM-DAS data entry is checked and **all** problems of a stage 
 reported together, each naming its field path (``motion[3].angle_deg``), the value, the
 rule and a fix:
 
-1. each segment alone: a known law, a finite and sensible lift, a positive span (or
+1. each segment alone: a known law, a finite and sensible lift (0 for a dwell), a positive span (or
    ``"auto"`` for a half-period law with a lift), a double-harmonic ``shape``;
 2. the chain: the first segment is not a return; two generic polynomials are never
    adjacent (cyclically), since each is solved from its neighbours' S, S′, S″ (S‴);
@@ -91,6 +91,9 @@ def _lift_problems(i: int, s: SegmentInput, ctx: _Context) -> list[Problem]:
     if abs(s.lift) > 1e5:
         return [Problem(p, s.lift, "lift magnitude is absurd (> 1e5)",
                         "check the units: lift is in mm (translating) or degrees (oscillating)")]
+    if s.law == "dwell" and s.lift != 0:  # the follower would step by the lift at the next junction
+        return [Problem(p, s.lift, "a dwell does not move the follower",
+                        "set lift = 0, or use a rise/return law for the motion")]
     return []
 
 

@@ -25,6 +25,7 @@ __all__ = [
     "derivatives_at",
     "piece_index",
     "check_closed",
+    "discontinuities",
     "curvature_at",
 ]
 
@@ -197,3 +198,19 @@ def curvature_at(curve: ParametricCurve, t) -> np.ndarray:
     d2 = (db - da) / (b - a)[:, None]
     speed = np.hypot(d1[:, 0], d1[:, 1])
     return cross(d1, d2) / speed ** 3
+
+
+def discontinuities(curve: ParametricCurve, tol: float) -> list[tuple[float, float]]:
+    """The breakpoints where ``P`` itself jumps by more than ``tol / 100`` mm (the protocol wants it
+    continuous): ``(parameter, gap in mm)`` each, the closure of a closed curve included."""
+    bp = np.asarray(curve.breakpoints, dtype=float)
+    h = 1e-9 * curve.period
+    inner = bp[(bp > 0) & (bp < curve.period)]
+    ends = [curve.period] if curve.closed else []
+    at = np.concatenate([inner, ends])
+    if at.size == 0:
+        return []
+    left = 2.0 * points_at(curve, at - h) - points_at(curve, at - 2.0 * h)  # the limit from the left, O(h²)
+    right = points_at(curve, np.where(at == curve.period, 0.0, at))
+    gap = np.hypot(*(right - left).T)
+    return [(float(t), float(g)) for t, g in zip(at, gap, strict=True) if g > 0.01 * tol]

@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import GeometryError
 from ..geom2d import cross, dot, unit
 from .chain import Chain
-from .curve import ParametricCurve, derivatives_at, piece_index, points_at
+from .curve import ParametricCurve, derivatives_at, discontinuities, piece_index, points_at
 from .entities import MAX_TURNING_RAD, biarc, entity_distance, entity_point
 from .surrogate import HermiteSurrogate, fit_surrogate
 from .tolerance import MARGIN
@@ -302,8 +302,13 @@ def fit_grid(curve: ParametricCurve, tol: float, kind: str, verify: Callable[[np
     deviation.  ``surrogate``: the curve's Hermite stand-in and its error, when already built.
     """
     sur, sur_err = surrogate or fit_surrogate(curve, tol)
-    curve = sur.as_curve()  # fitting never calls the exact curve; verify() measures on it
     target = tol * (1.0 - MARGIN) - sur_err
+    if not target > 0:  # no stand-in within the tolerance: the curve jumps (or is not finite) somewhere
+        gaps = discontinuities(curve, tol)
+        where = f": P jumps by {gaps[0][1]:.3g} mm at parameter {gaps[0][0]:.9g}" if gaps else ""
+        raise GeometryError(f"the curve cannot be followed within {tol:g} mm{where} (a discretised curve must be "
+                            "continuous)")
+    curve = sur.as_curve()  # fitting never calls the exact curve; verify() measures on it
     nodes, dev = _refine(curve, _initial_grid(curve, target, kind), target, kind)
     for fill in (0.9,):
         alt, alt_dev = _refine(curve, _equidistribute(curve, nodes, dev, target, kind, fill),

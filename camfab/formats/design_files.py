@@ -1,9 +1,11 @@
 """Design files of either format, chosen by suffix (TOML or xlsx), and the built-in examples by name."""
 from __future__ import annotations
 
+import difflib
 from pathlib import Path
 
 from ..design.spec import DesignSpec
+from ..errors import Problem, SpecError
 from .toml_design import load_design_toml
 from .xlsx_design import load_design_xlsx
 
@@ -30,13 +32,19 @@ def load_design(path: str | Path) -> DesignSpec:
 def resolve_design_path(name: str | Path) -> Path:
     """A design path, or the name of a built-in example (``ejemplo9rt``, any case).
 
-    A name that is neither is returned as a path, so that :func:`load_design` reports the
-    missing file.
+    A bare name (no folder, no suffix) that is neither raises a :class:`SpecError` naming the closest
+    examples; any other missing path is returned, so that :func:`load_design` reports the missing file.
     """
     p = Path(name)
     if p.exists():
         return p
-    for cand in sorted(EXAMPLES_DIR.glob("*.toml")):
-        if cand.stem.lower() == str(name).lower():
-            return cand
+    names = sorted(c.stem for c in EXAMPLES_DIR.glob("*.toml"))
+    for stem in names:
+        if stem.lower() == str(name).lower():
+            return EXAMPLES_DIR / f"{stem}.toml"
+    if not p.suffix and len(p.parts) == 1:
+        close = difflib.get_close_matches(str(name).lower(), names, n=3, cutoff=0.6)
+        hint = "did you mean " + " or ".join(f"'{c}'" for c in close) + "? " if close else ""
+        raise SpecError(Problem("file", str(name), "no such design file or built-in example",
+                                f"{hint}`camfab examples` lists the built-in examples"), str(name))
     return p
