@@ -31,7 +31,7 @@ def _every_law_program() -> MotionProgram:
     half = {"semiharmonic_vf0", "semiharmonic_vi0", "semicycloidal_vf0", "semicycloidal_vi0", "poly5", "poly7"}
     rows = []
     for law in law_names():
-        if law not in half:
+        if law not in half and law != "dwell":  # a dwell does not move: it is the spacer between the others
             rows += [(law, 5.0, 8), ("dwell", 0, 2), (law, -5.0, 8), ("dwell", 0, 2)]
     rows += [("poly5", 3, 10), ("dwell", 0, 5), ("poly7", -3, 10), ("dwell", 0, 5)]
     # half-period laws with the matching constant velocity (end slopes 2L/β and (π/2)L/β)
