@@ -6,9 +6,11 @@ them), timed *cold*: the design read afresh and numeric's caches cleared each ti
 an earlier run is reused.  Best of ``--repeat`` (the machine may be shared).
 
 ``--baseline [REF]`` times the same in the code before the redesign (``benchmarks/baseline.py``) in the
-same run.
+same run.  ``--steep`` times, instead, the steep designs of issue 12 (a 10 mm rise over 1° … 0.001°, a flat face
+turning at 0.9995× the cam speed, knots 1e-6° apart with a 1 µm step) with their peak traced allocation: the
+cost of a check must not grow with how steep the design is (docs/decisions.md, "Search budgets").
 
-Run:  python3 benchmarks/bench_check.py [--repeat 7] [--baseline]
+Run:  python3 benchmarks/bench_check.py [--repeat 7] [--baseline | --steep]
 """
 from __future__ import annotations
 
@@ -59,13 +61,77 @@ def timings(repeat: int) -> dict[str, float]:
     return out
 
 
+def _steep_designs() -> dict[str, dict]:
+    roller = {"type": "roller", "motion": "translating", "base_radius_mm": 50.0, "roller_radius_mm": 5.0}
+    flat = {"type": "flat", "motion": "translating", "base_radius_mm": 50.0}
+    face = {"type": "flat", "motion": "oscillating", "base_radius_mm": 50.0, "pivot_distance_mm": 130.0,
+            "face_offset_mm": 10.0}
+
+    def design(follower, rows=None, **over):
+        d = {"name": "steep", "cam": {"kind": "disc", "omega_rad_s": 1.0}, "follower": follower, **over}
+        if rows:
+            d["motion"] = [{"law": law, "lift": h, "angle_deg": b} for law, h, b in rows]
+        return d
+
+    def knots(follower):
+        rows = [[0, 0, 0, 0], [90, 0, 0, 0], [90 + 1e-6, 1e-3, 0, 0], [270, 1e-3, 0, 0], [360, 0, 0, 0]]
+        return design(follower, motion_table={"rows": rows, "units": {"angle": "deg", "s": "mm", "v": "mm/deg",
+                                                                      "a": "mm/deg2"}})
+
+    out = {f"rise 10 mm / {b:g}°": design(roller, [("cycloidal", 10.0, b), ("dwell", 0.0, 180 - b),
+                                                   ("cycloidal", -10.0, 180.0)]) for b in (1.0, 0.01, 0.001)}
+    b = 2 * 10.0 / 0.9995
+    out["face at 0.9995x cam speed"] = design(face, [("cycloidal", 10.0, b), ("dwell", 0.0, 180 - b),
+                                                     ("cycloidal", -10.0, 180.0)])
+    out["knots 1e-6° / 1 um, roller"] = knots(roller)
+    out["knots 1e-6° / 1 um, flat"] = knots(flat)
+    return out
+
+
+def steep(repeat: int) -> None:
+    """Time and peak traced allocation of check() on the steep designs (a refusal counts: it is the answer)."""
+    import contextlib
+    import logging
+    import tracemalloc
+
+    from camfab.design.assemble import check_design
+    from camfab.design.spec import design_from_dict
+    from camfab.errors import CamfabError
+    from camfab.numeric import clear_caches
+
+    logging.disable(logging.WARNING)
+    print(f"check() of steep designs, cold, best of {repeat}; peak traced allocation of one run")
+    for name, d in _steep_designs().items():
+        best, answer = math.inf, ""
+        for _ in range(repeat):
+            spec = design_from_dict(d)
+            clear_caches()
+            t0 = time.perf_counter()
+            try:
+                answer = check_design(spec).verdict.value
+            except CamfabError:
+                answer = "refused (exit 2)"
+            best = min(best, time.perf_counter() - t0)
+        clear_caches()
+        tracemalloc.start()
+        with contextlib.suppress(CamfabError):
+            check_design(design_from_dict(d))
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        print(f"  {name:30}{best * 1e3:9.1f} ms {peak / 2**20:7.1f} MB  {answer}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=7)
     ap.add_argument("--baseline", nargs="?", const="", default=None, metavar="REF")
     ap.add_argument("--rounds", type=int, default=2)
     ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--steep", action="store_true", help="time the steep designs of issue 12 instead")
     a = ap.parse_args()
+    if a.steep:
+        steep(a.repeat)
+        return
     if a.child:
         print(json.dumps(timings(a.repeat)))
         return

@@ -22,10 +22,10 @@ from typing import NamedTuple
 import numpy as np
 
 from .errors import InputError
-from .quadrature import integrate
+from .quadrature import Integral, integral, integrate
 
-__all__ = ["Grid", "Optimum", "Range", "dense_grid", "clear_caches", "search", "extremum", "extrema",
-           "positive_ranges", "root", "integrate"]
+__all__ = ["Grid", "Optimum", "Range", "dense_grid", "resolution", "unresolved", "clear_caches", "search",
+           "extremum", "extrema", "positive_ranges", "root", "integrate", "integral", "Integral"]
 
 Function = Callable[[np.ndarray], np.ndarray]
 log = logging.getLogger(__name__)
@@ -70,7 +70,7 @@ class Range(NamedTuple):
 class Grid:
     """Dense samples of every breakpoint interval, concatenated: ``x`` (m,), the index of each
     interval's first sample ``starts`` (k,), each interval's first and last sample ``lo``, ``hi`` (k,;
-    the breakpoints pulled in by 1e-11·max(period, 1): one-sided limits), the spacing ``step``."""
+    the breakpoints pulled in by :func:`dense_grid`'s margins: one-sided limits), the spacing ``step``."""
 
     x: np.ndarray
     starts: np.ndarray
@@ -84,9 +84,27 @@ class Grid:
         return np.diff(np.append(self.starts, self.x.size))
 
 
+RESOLUTION_ULPS = 2**16  #: narrower intervals (in ulps of the edges) have margins < 64 ulps: :func:`unresolved`
+
+
+def resolution(edges) -> float:
+    """The narrowest interval between ``edges`` that a search resolves: :data:`RESOLUTION_ULPS` ulps of the
+    largest |edge| (at least of 1; 5.8e-11 for a period of 2π)."""
+    e = np.asarray(edges, dtype=float)
+    return float(RESOLUTION_ULPS * np.spacing(max(abs(float(e[0])), abs(float(e[-1])), 1.0)))
+
+
+def unresolved(edges) -> np.ndarray:
+    """Indices of the intervals narrower than :func:`resolution`: left out of every search (refuse them)."""
+    e = np.asarray(edges, dtype=float)
+    return np.flatnonzero(np.diff(e) < resolution(e))
+
+
 def dense_grid(edges, step: float | None = None) -> Grid:
     """The dense sample of the intervals between ``edges`` (memoised, read-only): each interval gets
-    ``max(8, ⌈width/step⌉) + 1`` samples; ``step`` defaults to (edges[-1] − edges[0]) / 1440."""
+    ``max(8, ⌈width/step⌉) + 1`` samples from ``a + m`` to ``b − m``, the one-sided margin m = 1e-11·max(period, 1)
+    or 2⁻¹⁰ of a narrower interval; ``step`` defaults to (edges[-1] − edges[0]) / 1440.  The :func:`unresolved`
+    intervals are left out."""
     e = np.asarray(edges, dtype=float)
     return _grid(e.tobytes(), float(step or (e[-1] - e[0]) / SAMPLES_PER_PERIOD))
 
@@ -94,13 +112,13 @@ def dense_grid(edges, step: float | None = None) -> Grid:
 @lru_cache(maxsize=256)
 def _grid(key: bytes, step: float) -> Grid:
     edges = np.frombuffer(key, dtype=float)
-    eps = 1e-11 * max(edges[-1] - edges[0], 1.0)
+    keep, margin = np.diff(edges) >= resolution(edges), np.minimum(1e-11 * max(edges[-1] - edges[0], 1.0),
+                                                                   np.diff(edges) / 1024)
     parts, lo, hi = [], [], []
-    for a, b in zip(edges[:-1], edges[1:], strict=True):
-        if b - a > 4 * eps:
-            parts.append(np.linspace(a + eps, b - eps, max(8, int(math.ceil((b - a) / step))) + 1))
-            lo.append(a + eps)
-            hi.append(b - eps)
+    for a, b, m in zip(edges[:-1][keep], edges[1:][keep], margin[keep], strict=True):
+        parts.append(np.linspace(a + m, b - m, max(8, int(math.ceil((b - a) / step))) + 1))
+        lo.append(a + m)
+        hi.append(b - m)
     sizes = np.array([p.size for p in parts], dtype=np.intp)
     out = Grid(np.concatenate(parts) if parts else np.empty(0), np.r_[0, np.cumsum(sizes)[:-1]].astype(np.intp)
                if parts else _EMPTY, np.array(lo), np.array(hi), step)

@@ -76,11 +76,12 @@ def segment_candidates(seg: Segment, nu: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _pick(xs: np.ndarray, vals: np.ndarray) -> Peak:
-    """Max and min of ``vals``, each at the first ``x`` (in order) within 1e-12 of it."""
+    """Max and min of ``vals``, each at the first ``x`` (in order) within 1e-12 of it, relative to the
+    values' own size (no absolute floor: a lift of 1e-12 mm has peaks of its own size, not 0)."""
     order = np.argsort(xs, kind="stable")
     xs, vals = xs[order], vals[order]
     span = float(vals.max() - vals.min())
-    tol = 1e-12 * max(span, abs(float(vals.max())), 1.0)
+    tol = 1e-12 * max(span, abs(float(vals.max())), abs(float(vals.min())))
     imax = int(np.flatnonzero(vals >= vals.max() - tol)[0])
     imin = int(np.flatnonzero(vals <= vals.min() + tol)[0])
     return Peak(float(vals[imax]), float(vals[imin]), float(xs[imax]), float(xs[imin]))
@@ -116,12 +117,12 @@ def sampled_peaks(prog: MotionProgram, step: float) -> tuple[Peak, Peak, Peak, P
     return tuple(_pick(x, v[k]) for k in range(4))  # type: ignore[return-value]
 
 
-def _junction(at: float, left: np.ndarray, right: np.ndarray, scale: list[float], tol: float,
+def _junction(at: float, left: np.ndarray, right: np.ndarray, scale: list[float], unit: float, tol: float,
               seg: int | None) -> Junction:
     jumps = np.abs(right - left)
     order = 3
     for j in range(4):
-        if jumps[j] > tol * scale[j] + 1e-12:
+        if jumps[j] > tol * scale[j] + 1e-12 * unit:
             order = j - 1
             break
     return Junction(at, order, tuple(float(v) for v in jumps), seg)  # type: ignore[arg-type]
@@ -132,18 +133,22 @@ def junctions(prog: MotionProgram, tol: float, internal: bool) -> list[Junction]
     the internal breaks of piecewise laws; sorted by position.
 
     A jump counts as a discontinuity when it exceeds ``tol`` times the peak magnitude of
-    that derivative over the cycle (at least 1e-2), plus 1e-12.
+    that derivative over the cycle (at least 1e-2·u), plus 1e-12·u, where u = min(1, H) is the
+    motion's size (H the largest |S|, mm or degrees): a motion smaller than 1 mm (1°) is judged
+    relative to its own size, so a lift of 1e-12 mm jumps where a lift of 1 mm does.
     """
-    scale = [max(abs(p.max), abs(p.min), 1e-2) for p in prog.peaks("exact")]
+    peaks = prog.peaks("exact")
+    u = min(1.0, max(abs(peaks[0].max), abs(peaks[0].min)))
+    scale = [max(abs(p.max), abs(p.min), 1e-2 * u) for p in peaks]
     out = []
     for k, seg in enumerate(prog.segments):
         left = prog.segments[k - 1].end_values(True)
         right = seg.end_values(False)
-        out.append(_junction(seg.start, left, right, scale, tol, k))
+        out.append(_junction(seg.start, left, right, scale, u, tol, k))
         if internal:
             for ub in seg.breaks:
                 lo, hi = np.nextafter(ub, -1.0), np.nextafter(ub, 2.0)
                 left = np.array([seg.value_at(float(lo), j) for j in range(4)])
                 right = np.array([seg.value_at(float(hi), j) for j in range(4)])
-                out.append(_junction(seg.start + ub * seg.span, left, right, scale, tol, None))
+                out.append(_junction(seg.start + ub * seg.span, left, right, scale, u, tol, None))
     return sorted(out, key=lambda j: j.at)

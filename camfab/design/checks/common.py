@@ -15,12 +15,13 @@ from typing import Any
 import numpy as np
 
 from ... import numeric
+from ...errors import GeometryError
 from ...results import Finding
 from ..kinds import ContactKind
 from ..profile import Contact, ProfileSample
 
 __all__ = ["Limits", "RuleResult", "ContactSample", "QUANTITIES", "CUSP_TOL_MM", "DEFAULT_PRESSURE_LIMIT_DEG",
-           "Words", "words", "radius", "span_text"]
+           "Words", "words", "radius", "span_text", "where"]
 
 #: a radius margin within this many mm of its limit is a cusp (not an undercut)
 CUSP_TOL_MM = 1e-7
@@ -115,6 +116,7 @@ class ContactSample:
     def __init__(self, contact: Contact):
         self.contact = contact
         self.edges = contact.breakpoints
+        _refuse_unresolved(contact, self.edges)
         self.grid = numeric.dense_grid(self.edges)
         self._extremes: dict[str, tuple[numeric.Optimum, numeric.Optimum]] | None = None
 
@@ -164,6 +166,44 @@ class ContactSample:
 
 
 def span_text(sample: ContactSample, lo: float, hi: float) -> str:
-    """``"at A°"`` or ``"from A° to B°"`` (user units) for a range of parameters."""
+    """``"at A°"`` or ``"from A° to B°"`` (user units) for a range of parameters; six significant digits, more
+    where a narrow range needs them to show its two ends apart (``from 90° to 90.000001°``, not ``to 90°``)."""
     a, b, u = sample.user(lo), sample.user(hi), sample.unit
-    return f"at {a:.6g}{u}" if abs(b - a) < 1e-9 else f"from {a:.6g}{u} to {b:.6g}{u}"
+    if abs(b - a) < 1e-9:
+        return f"at {a:.6g}{u}"
+    digits = next(d for d in (6, 9, 12, 17) if f"{a:.{d}g}" != f"{b:.{d}g}" or d == 17)
+    return f"from {a:.{digits}g}{u} to {b:.{digits}g}{u}"
+
+
+def _user(contact: Contact, x: float) -> float:
+    return math.degrees(x) if contact.axis.rotating else float(x)
+
+
+def where(contact: Contact, lo: float, hi: float) -> str:
+    """The motion segment holding ``[lo, hi]`` (parameters; its middle decides) by its field path, law, lift
+    and span, for a refusal: ``"motion[2] (cycloidal, lift 10 mm over 0.01°, from 0° to 0.01°)"``, a knot
+    table's segment by the row it starts at (``"motion_table.rows[1] (hermite5, …)"``); a motion without
+    segments (a conjugate partner's) as ``"from A° to B°"``."""
+    u = contact.axis.x_symbol
+    segments = getattr(contact.motion, "segments", None)
+    if not segments:
+        return f"from {_user(contact, lo):.12g}{u} to {_user(contact, hi):.12g}{u}"
+    mid = float(np.mod(0.5 * (lo + hi), contact.period))
+    k = max(int(np.searchsorted([s.start for s in segments], mid, side="right")) - 1, 0)
+    seg = segments[k]
+    path = f"motion_table.rows[{k}]" if seg.law.startswith("hermite") else f"motion[{k}]"
+    return (f"{path} ({seg.law}, lift {seg.lift:.6g} {contact.axis.lift_unit.value} over {_user(contact, seg.span):.6g}"
+            f"{u}, from {_user(contact, seg.start):.12g}{u} to {_user(contact, seg.end):.12g}{u})")
+
+
+def _refuse_unresolved(contact: Contact, edges: np.ndarray) -> None:
+    """A stretch between breakpoints narrower than double precision resolves (:func:`numeric.resolution`)
+    cannot be checked: refused (exit 2) rather than passed unseen."""
+    narrow = numeric.unresolved(edges)
+    if narrow.size:
+        a, b = float(edges[narrow[0]]), float(edges[narrow[0] + 1])
+        u = contact.axis.x_symbol
+        raise GeometryError(
+            f"{where(contact, a, b)}: a stretch {_user(contact, b - a):.3g}{u} wide, narrower than the "
+            f"{_user(contact, numeric.resolution(edges)):.3g}{u} that double precision resolves at this cam size, "
+            "so the checks cannot see into it. Widen it or merge it with its neighbour")
