@@ -30,6 +30,24 @@ __all__ = [
 ]
 
 
+SHOWN_CHARS = 80
+"""How much of a value a message repeats: a problem names the value it refuses, not a copy of a 5 MB string."""
+
+
+def shown(value: Any, limit: int = SHOWN_CHARS) -> str:
+    """``repr(value)`` cut to ``limit`` characters with the length of what was left out, for messages.
+
+    >>> shown("ab" * 500, limit=20)
+    "'abababab... (1002 characters)"
+    >>> shown(3.5)
+    '3.5'
+    """
+    text = repr(value)
+    if len(text) <= limit:
+        return text
+    return f"{text[:limit - 11]}... ({len(text)} characters)"
+
+
 class CamfabError(Exception):
     """Root of every error raised on purpose by camfab."""
 
@@ -44,7 +62,7 @@ class Problem:
     fix: str = ""
 
     def __str__(self) -> str:
-        text = f"{self.path} = {self.value!r}: {self.rule}"
+        text = f"{self.path} = {shown(self.value)}: {self.rule}"
         return f"{text}; {self.fix}" if self.fix else text
 
 
