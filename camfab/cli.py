@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import contextvars
 import dataclasses
 import json
 import logging
@@ -48,9 +49,14 @@ def register(name: str, help: str, arguments: Callable[[argparse.ArgumentParser]
     return deco
 
 
+#: ``--allow-outside-files`` of the command being run (set by :func:`_guarded`)
+_ALLOW_OUTSIDE: contextvars.ContextVar[bool] = contextvars.ContextVar("allow_outside_files", default=False)
+
+
 def _cam(name: str) -> Cam:
-    """The design ``name`` (a TOML or xlsx file, or a built-in example) as a :class:`~camfab.pipeline.Cam`."""
-    return pipeline.load(name)
+    """The design ``name`` (a TOML or xlsx file, or a built-in example) as a :class:`~camfab.pipeline.Cam`;
+    its knot file may lie outside its folder only with ``--allow-outside-files``."""
+    return pipeline.load(name, allow_outside_files=_ALLOW_OUTSIDE.get())
 
 
 def _tol(cam: Cam, value: float | None) -> float:
@@ -338,7 +344,8 @@ def cmd_package(args: argparse.Namespace) -> int:
     if missing:
         raise UsageError(f"no such file or folder: {missing[0]}")
     manifest = package(args.paths, args.output, jobs=args.jobs, outputs=outputs_list(args.outputs),
-                       force=args.force, progress=lambda m: print(m, file=sys.stderr))
+                       force=args.force, progress=lambda m: print(m, file=sys.stderr),
+                       allow_outside_files=args.allow_outside_files)
     cams = manifest["cams"]
     rebuilt = sum(1 for c in cams if c.get("rebuilt"))
     bad = [c for c in cams if c.get("status") == "error"]
@@ -415,10 +422,16 @@ def build_parser() -> argparse.ArgumentParser:
         p = sub.add_parser(name, help=help_text, description=help_text)
         arguments(p)
         p.add_argument("-v", "--verbose", action="store_true", default=argparse.SUPPRESS, help=_VERBOSE_HELP)
+        if name in _READS_DESIGNS:
+            p.add_argument("--allow-outside-files", action="store_true", help=_OUTSIDE_HELP)
     return parser
 
 
 _VERBOSE_HELP = "also log the fallbacks camfab takes (logger 'camfab', INFO) on stderr"
+#: the commands that read design files, and so take --allow-outside-files
+_READS_DESIGNS = ("motion", "check", "export", "gcode", "verify", "run", "package", "report", "compare")
+_OUTSIDE_HELP = ("let a design read a knot file ([motion_table] file) outside its own folder (only for designs "
+                 "you trust)")
 
 
 @contextlib.contextmanager
@@ -473,6 +486,7 @@ def _guarded(args: argparse.Namespace) -> int:
     GeometryError, InputError, ExportError, ...) is invalid input, 2.  ApiError and InternalError are bugs
     of camfab, not of the input: they keep their traceback."""
     fn: Any = COMMANDS[args.command][0]
+    token = _ALLOW_OUTSIDE.set(bool(getattr(args, "allow_outside_files", False)))
     try:
         return int(fn(args))
     except MissingDependencyError as exc:
@@ -489,3 +503,5 @@ def _guarded(args: argparse.Namespace) -> int:
     except OSError as exc:
         print(f"camfab {args.command}: I/O error: {exc}", file=sys.stderr)
         return EXIT_IO
+    finally:
+        _ALLOW_OUTSIDE.reset(token)
