@@ -25,6 +25,7 @@ from .errors import ApiError, CamfabError, InternalError, MissingDependencyError
 from .io import atomic_write, inside
 from .pipeline import Cam, Output, Request
 from .results import Severity, Verdict
+from .textsafe import plain
 from .version import __version__
 
 __all__ = ["main", "register", "COMMANDS", "UsageError"]
@@ -127,7 +128,7 @@ def _refuse_unacceptable(cam: Cam, command: str, force: bool) -> bool:
     if report.verdict != Verdict.UNACCEPTABLE or force:
         return False
     errs = sorted({str(f.code) for f in report.findings if f.severity == Severity.ERROR})
-    print(f"camfab {command}: {cam.name} is unacceptable ({', '.join(errs) or report.verdict}): nothing written "
+    print(f"camfab {command}: {plain(cam.name)} is unacceptable ({', '.join(errs) or report.verdict}): nothing written "
           "(use --force to write anyway)", file=sys.stderr)
     return True
 
@@ -163,7 +164,7 @@ def cmd_export(args: argparse.Namespace) -> int:
     arts = [a for out in pipeline.EXPORTERS if out in req.outputs for a in pipeline.EXPORTERS[out](cam, req)]
     targets = [inside(Path(args.output), a.filename) for a in arts]  # all proved inside -o before any write
     paths = [atomic_write(t, a.data) for t, a in zip(targets, arts, strict=True)]
-    print(f"{cam.name}: verdict {cam.verdict}, tolerance {tol:g} mm")
+    print(f"{plain(cam.name)}: verdict {cam.verdict}, tolerance {tol:g} mm")
     print(f"  {'file':<32}{'entities':>10}{'max deviation (mm)':>22}")
     for a, p in zip(arts, paths, strict=True):
         ents = "-" if a.entities is None else str(a.entities)
@@ -316,7 +317,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     req = Request.from_design(cam.spec, outputs, tol=args.tol, force=args.force,
                               post="linuxcnc" if outputs is not None else None)
     res = pipeline.run(cam, args.output, req, progress=lambda m: print(f"  ... {m}", file=sys.stderr))
-    print(f"{cam.name}: verdict {res.verdict}; tolerance {res.tol:g} mm; {len(res.files)} file(s) in {args.output}")
+    print(f"{plain(cam.name)}: verdict {res.verdict}; tolerance {res.tol:g} mm; {len(res.files)} file(s) in "
+          f"{args.output}")
     for name in res.files:
         dev = res.deviations.get(name)
         print(f"  {name:<36}" + ("" if dev is None else f" max deviation {dev:.3g} mm"))
@@ -375,7 +377,7 @@ def cmd_report(args: argparse.Namespace) -> int:
     require_report_dependencies()
     cam = _cam(args.file)
     paths = write_files(render_report(cam.spec, cam.geometry, cam.check(), standalone=args.standalone), args.out)
-    print(f"{cam.name}: {cam.verdict}")
+    print(f"{plain(cam.name)}: {cam.verdict}")
     print(f"wrote {Path(paths[0])} (+{len(paths) - 1} plot files)", file=sys.stderr)
     return _exit(cam.verdict)
 
@@ -396,7 +398,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
     items = [(c.spec, c.geometry, c.check()) for c in cams]
     paths = write_files(render_comparison(items, standalone=args.standalone), args.out)
     for c in cams:
-        print(f"{c.name}: {c.verdict}")
+        print(f"{plain(c.name)}: {c.verdict}")
     print(f"wrote {paths[0]} (+{len(paths) - 1} plot files)", file=sys.stderr)
     return EXIT_OK
 

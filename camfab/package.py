@@ -40,7 +40,7 @@ from .formats import load_design
 from .io import atomic_write, inside, safe_stem
 from .pipeline import Cam, Request, run
 from .results import Verdict
-from .textsafe import bounded
+from .textsafe import bounded, plain
 from .version import __version__
 
 __all__ = ["discover", "folders", "input_key", "package", "exit_status", "MANIFEST", "INDEX"]
@@ -207,7 +207,7 @@ def package(paths: Iterable[str | Path], out: str | Path, *, jobs: int = 1, outp
         prev = old.get(str(p))
         if prev and prev.get("key") == key and prev.get("folder") == stem and _still_valid(prev, out):
             entries[str(p)] = {**prev, "rebuilt": False}
-            say(f"[up to date] {prev.get('name', p.stem)}")
+            say(f"[up to date] {plain(str(prev.get('name', p.stem)))}")
         else:
             todo.append((str(p), str(out), options, key, spec, stem))
     if jobs > 1 and len(todo) > 1:  # worker processes read their design again (a program does not pickle)
@@ -217,7 +217,7 @@ def package(paths: Iterable[str | Path], out: str | Path, *, jobs: int = 1, outp
         entries[entry["source"]] = entry
         first = (entry.get("error") or "").split("\n", 1)[0]  # an empty error has no first line to index
         tail = entry.get("verdict") or f"ERROR: {first}"
-        say(f"{_bar(done, len(todo))} {done}/{len(todo)} {entry['name']}: {tail} ({entry['seconds']:.2f} s)")
+        say(f"{_bar(done, len(todo))} {done}/{len(todo)} {plain(entry['name'])}: {tail} ({entry['seconds']:.2f} s)")
     manifest = {"camfab_version": __version__, "jobs": jobs, "wall_seconds": time.perf_counter() - t0,
                 "cams": [entries[str(p)] for p in designs]}
     atomic_write(out / MANIFEST, json.dumps(manifest, indent=2) + "\n")

@@ -520,3 +520,16 @@ def test_package_refuses_outside_knot_files_unless_allowed(tmp_path):
     (entry,) = json.loads((out / "manifest.json").read_text())["cams"]
     assert entry["status"] != "error" and entry["files"]
     assert np.isfinite(entry["tolerance_mm"])
+
+
+def test_terminal_output_has_no_control_characters(tmp_path, capsys):
+    """A name with terminal escape sequences (set the title, clear the screen) is printed as plain text."""
+    name = "\x1b]0;pwned\x07cam\x1b[2J"
+    d = tmp_path / "d.toml"
+    text = (EXAMPLES / "ejemplo9rt.toml").read_text(encoding="utf-8")
+    d.write_text(text.replace('name = "Ejemplo9RT"', f"name = {json.dumps(name)}"), encoding="utf-8")
+    assert main(["check", str(d)]) == 0
+    assert main(["motion", str(d)]) == 0
+    assert main(["export", str(d), "--dxf", "-o", str(tmp_path / "out")]) == 0
+    out = capsys.readouterr().out
+    assert plain(name) in out and "\x1b" not in out and "\x07" not in out
