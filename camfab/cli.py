@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import contextvars
 import dataclasses
 import json
 import logging
@@ -24,6 +25,7 @@ from .errors import ApiError, CamfabError, InternalError, MissingDependencyError
 from .io import atomic_write, inside
 from .pipeline import Cam, Output, Request
 from .results import Severity, Verdict
+from .textsafe import plain
 from .version import __version__
 
 __all__ = ["main", "register", "COMMANDS", "UsageError"]
@@ -48,9 +50,14 @@ def register(name: str, help: str, arguments: Callable[[argparse.ArgumentParser]
     return deco
 
 
+#: ``--allow-outside-files`` of the command being run (set by :func:`_guarded`)
+_ALLOW_OUTSIDE: contextvars.ContextVar[bool] = contextvars.ContextVar("allow_outside_files", default=False)
+
+
 def _cam(name: str) -> Cam:
-    """The design ``name`` (a TOML or xlsx file, or a built-in example) as a :class:`~camfab.pipeline.Cam`."""
-    return pipeline.load(name)
+    """The design ``name`` (a TOML or xlsx file, or a built-in example) as a :class:`~camfab.pipeline.Cam`;
+    its knot file may lie outside its folder only with ``--allow-outside-files``."""
+    return pipeline.load(name, allow_outside_files=_ALLOW_OUTSIDE.get())
 
 
 def _tol(cam: Cam, value: float | None) -> float:
@@ -121,7 +128,7 @@ def _refuse_unacceptable(cam: Cam, command: str, force: bool) -> bool:
     if report.verdict != Verdict.UNACCEPTABLE or force:
         return False
     errs = sorted({str(f.code) for f in report.findings if f.severity == Severity.ERROR})
-    print(f"camfab {command}: {cam.name} is unacceptable ({', '.join(errs) or report.verdict}): nothing written "
+    print(f"camfab {command}: {plain(cam.name)} is unacceptable ({', '.join(errs) or report.verdict}): nothing written "
           "(use --force to write anyway)", file=sys.stderr)
     return True
 
@@ -157,7 +164,7 @@ def cmd_export(args: argparse.Namespace) -> int:
     arts = [a for out in pipeline.EXPORTERS if out in req.outputs for a in pipeline.EXPORTERS[out](cam, req)]
     targets = [inside(Path(args.output), a.filename) for a in arts]  # all proved inside -o before any write
     paths = [atomic_write(t, a.data) for t, a in zip(targets, arts, strict=True)]
-    print(f"{cam.name}: verdict {cam.verdict}, tolerance {tol:g} mm")
+    print(f"{plain(cam.name)}: verdict {cam.verdict}, tolerance {tol:g} mm")
     print(f"  {'file':<32}{'entities':>10}{'max deviation (mm)':>22}")
     for a, p in zip(arts, paths, strict=True):
         ents = "-" if a.entities is None else str(a.entities)
@@ -310,7 +317,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     req = Request.from_design(cam.spec, outputs, tol=args.tol, force=args.force,
                               post="linuxcnc" if outputs is not None else None)
     res = pipeline.run(cam, args.output, req, progress=lambda m: print(f"  ... {m}", file=sys.stderr))
-    print(f"{cam.name}: verdict {res.verdict}; tolerance {res.tol:g} mm; {len(res.files)} file(s) in {args.output}")
+    print(f"{plain(cam.name)}: verdict {res.verdict}; tolerance {res.tol:g} mm; {len(res.files)} file(s) in "
+          f"{args.output}")
     for name in res.files:
         dev = res.deviations.get(name)
         print(f"  {name:<36}" + ("" if dev is None else f" max deviation {dev:.3g} mm"))
@@ -338,7 +346,8 @@ def cmd_package(args: argparse.Namespace) -> int:
     if missing:
         raise UsageError(f"no such file or folder: {missing[0]}")
     manifest = package(args.paths, args.output, jobs=args.jobs, outputs=outputs_list(args.outputs),
-                       force=args.force, progress=lambda m: print(m, file=sys.stderr))
+                       force=args.force, progress=lambda m: print(m, file=sys.stderr),
+                       allow_outside_files=args.allow_outside_files)
     cams = manifest["cams"]
     rebuilt = sum(1 for c in cams if c.get("rebuilt"))
     bad = [c for c in cams if c.get("status") == "error"]
@@ -368,7 +377,7 @@ def cmd_report(args: argparse.Namespace) -> int:
     require_report_dependencies()
     cam = _cam(args.file)
     paths = write_files(render_report(cam.spec, cam.geometry, cam.check(), standalone=args.standalone), args.out)
-    print(f"{cam.name}: {cam.verdict}")
+    print(f"{plain(cam.name)}: {cam.verdict}")
     print(f"wrote {Path(paths[0])} (+{len(paths) - 1} plot files)", file=sys.stderr)
     return _exit(cam.verdict)
 
@@ -389,7 +398,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
     items = [(c.spec, c.geometry, c.check()) for c in cams]
     paths = write_files(render_comparison(items, standalone=args.standalone), args.out)
     for c in cams:
-        print(f"{c.name}: {c.verdict}")
+        print(f"{plain(c.name)}: {c.verdict}")
     print(f"wrote {paths[0]} (+{len(paths) - 1} plot files)", file=sys.stderr)
     return EXIT_OK
 
@@ -415,10 +424,16 @@ def build_parser() -> argparse.ArgumentParser:
         p = sub.add_parser(name, help=help_text, description=help_text)
         arguments(p)
         p.add_argument("-v", "--verbose", action="store_true", default=argparse.SUPPRESS, help=_VERBOSE_HELP)
+        if name in _READS_DESIGNS:
+            p.add_argument("--allow-outside-files", action="store_true", help=_OUTSIDE_HELP)
     return parser
 
 
 _VERBOSE_HELP = "also log the fallbacks camfab takes (logger 'camfab', INFO) on stderr"
+#: the commands that read design files, and so take --allow-outside-files
+_READS_DESIGNS = ("motion", "check", "export", "gcode", "verify", "run", "package", "report", "compare")
+_OUTSIDE_HELP = ("let a design read a knot file ([motion_table] file) outside its own folder (only for designs "
+                 "you trust)")
 
 
 @contextlib.contextmanager
@@ -473,6 +488,7 @@ def _guarded(args: argparse.Namespace) -> int:
     GeometryError, InputError, ExportError, ...) is invalid input, 2.  ApiError and InternalError are bugs
     of camfab, not of the input: they keep their traceback."""
     fn: Any = COMMANDS[args.command][0]
+    token = _ALLOW_OUTSIDE.set(bool(getattr(args, "allow_outside_files", False)))
     try:
         return int(fn(args))
     except MissingDependencyError as exc:
@@ -489,3 +505,5 @@ def _guarded(args: argparse.Namespace) -> int:
     except OSError as exc:
         print(f"camfab {args.command}: I/O error: {exc}", file=sys.stderr)
         return EXIT_IO
+    finally:
+        _ALLOW_OUTSIDE.reset(token)

@@ -6,6 +6,14 @@ folder ``out/<name>/`` on a process pool, and writes ``out/manifest.json`` (each
 file's sha256 and size, measured deviation, tolerance, verdict, stage timings)
 and ``out/index.html``.
 
+Folders: each design's folder is :func:`~camfab.io.safe_stem` of its name (of its file's stem when it cannot
+be read), made unique in the order the designs are found (:func:`folders`): a stem already taken — by an
+earlier design or by the package's own ``manifest.json`` / ``index.html``, compared without case — gets
+``_2``, ``_3``, … .  The manifest records each cam's folder.
+
+A failing design's error is recorded bounded (:func:`camfab.textsafe.bounded`: at most 10 lines of 300
+characters, control characters removed), since it may quote a line of any file.
+
 Incremental: each cam's *input key* hashes its design file, the files it
 references (knot tables), the camfab version, the shipped templates and the
 job options.  A cam whose key is unchanged and whose files are all present with
@@ -32,9 +40,10 @@ from .formats import load_design
 from .io import atomic_write, inside, safe_stem
 from .pipeline import Cam, Request, run
 from .results import Verdict
+from .textsafe import bounded, plain
 from .version import __version__
 
-__all__ = ["discover", "input_key", "package", "exit_status", "MANIFEST", "INDEX"]
+__all__ = ["discover", "folders", "input_key", "package", "exit_status", "MANIFEST", "INDEX"]
 
 MANIFEST = "manifest.json"
 INDEX = "index.html"
@@ -56,6 +65,21 @@ def discover(paths: Iterable[str | Path]) -> list[Path]:
         if r not in seen:
             seen.add(r)
             out.append(p)
+    return out
+
+
+def folders(stems: Sequence[str]) -> list[str]:
+    """Unique folder names for designs whose :func:`~camfab.io.safe_stem` are ``stems``, in order: a stem
+    taken (case-insensitively) by an earlier one or by :data:`MANIFEST` / :data:`INDEX` gets ``_2``, ``_3``…"""
+    taken = {MANIFEST.casefold(), INDEX.casefold()}
+    out = []
+    for stem in stems:
+        name, k = stem, 1
+        while name.casefold() in taken:
+            k += 1
+            name = f"{stem}_{k}"
+        taken.add(name.casefold())
+        out.append(name)
     return out
 
 
@@ -88,11 +112,11 @@ def input_key(sources: Sequence[str | Path], options: dict, templates: str) -> s
     return h.hexdigest()
 
 
-def _read(path: Path) -> tuple[DesignSpec | None, tuple[str | Path, ...]]:
+def _read(path: Path, allow_outside_files: bool = False) -> tuple[DesignSpec | None, tuple[str | Path, ...]]:
     """The design's spec and the files it was built from; (None, the file) when it cannot be read
     (the build then records why)."""
     try:
-        spec = load_design(path)
+        spec = load_design(path, allow_outside_files=allow_outside_files)
     except Exception as exc:  # any failure is reported by the build of this design, with the others kept
         log.info("%s cannot be read (%s: %s); its key hashes the file alone", path, type(exc).__name__, exc)
         return None, (path,)
@@ -101,15 +125,16 @@ def _read(path: Path) -> tuple[DesignSpec | None, tuple[str | Path, ...]]:
 
 def _build(args: tuple) -> dict:
     """Worker: build one design into its folder; never raises (errors go into the entry)."""
-    path, out, options, key, spec = args
+    path, out, options, key, spec, stem = args
     from .errors import ApiError, CamfabError, InternalError
 
     t0 = time.perf_counter()
     entry = {"source": str(path), "key": key, "rebuilt": True}
     try:
-        spec = spec if spec is not None else load_design(Path(path))
+        allow = bool(options.get("allow_outside_files"))
+        spec = spec if spec is not None else load_design(Path(path), allow_outside_files=allow)
         entry["name"] = spec.name
-        folder = inside(out, safe_stem(spec.name))
+        folder = inside(out, stem)
         outputs = options.get("outputs")
         req = Request.from_design(spec, outputs, force=options.get("force") or None,
                                   post="linuxcnc" if outputs is not None else None)
@@ -121,7 +146,7 @@ def _build(args: tuple) -> dict:
     except (ApiError, InternalError) as exc:  # bugs of camfab: recorded as internal failures
         _internal_error(entry, exc)
     except (CamfabError, OSError, ValueError) as exc:
-        entry.update(status="error", verdict=None, error=str(exc), files=[],
+        entry.update(status="error", verdict=None, error=bounded(str(exc)), files=[],
                      error_type=type(exc).__name__)
     except Exception as exc:  # an internal failure on one design must not lose the others
         _internal_error(entry, exc)
@@ -136,7 +161,7 @@ def _internal_error(entry: dict, exc: Exception) -> None:
 
     log.error("%s: internal error (%s: %s)", entry["source"], type(exc).__name__, exc, exc_info=exc)
     entry.update(status="error", verdict=None, files=[], error_type=type(exc).__name__,
-                 error=f"internal error ({type(exc).__name__}: {exc}); please report it with this design",
+                 error=bounded(f"internal error ({type(exc).__name__}: {exc}); please report it with this design"),
                  traceback=traceback.format_exc())
 
 
@@ -156,11 +181,13 @@ def _still_valid(entry: dict, out: Path) -> bool:
 
 
 def package(paths: Iterable[str | Path], out: str | Path, *, jobs: int = 1, outputs: Sequence[str] | None = None,
-            force: bool = False, progress: Callable[[str], None] | None = None) -> dict:
+            force: bool = False, progress: Callable[[str], None] | None = None,
+            allow_outside_files: bool = False) -> dict:
     """Build every design; returns the manifest (also written to ``out/manifest.json``).
 
     ``outputs`` replaces every design's ``[outputs]`` (None: each design's own); ``force`` writes the shop
-    outputs of unacceptable designs too."""
+    outputs of unacceptable designs too; ``allow_outside_files`` lets designs read knot files outside their
+    folders."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     say = progress or (lambda m: None)
@@ -169,26 +196,30 @@ def package(paths: Iterable[str | Path], out: str | Path, *, jobs: int = 1, outp
     old = _old_entries(out)
     templates = templates_hash()
     opts = options if (outputs is not None or force) else {}
+    if allow_outside_files:  # only then in the key: the keys of existing packages do not change
+        options["allow_outside_files"] = True
+        opts = {**opts, "allow_outside_files": True}
+    read = [(p, *_read(p, allow_outside_files)) for p in designs]
+    stems = folders([safe_stem(spec.name if spec is not None else p.stem) for p, spec, _ in read])
     todo, entries = [], {}
-    for p in designs:
-        spec, sources = _read(p)
+    for (p, spec, sources), stem in zip(read, stems, strict=True):
         key = input_key(sources, opts, templates) if p.is_file() else "missing"
         prev = old.get(str(p))
-        if prev and prev.get("key") == key and _still_valid(prev, out):
+        if prev and prev.get("key") == key and prev.get("folder") == stem and _still_valid(prev, out):
             entries[str(p)] = {**prev, "rebuilt": False}
-            say(f"[up to date] {prev.get('name', p.stem)}")
+            say(f"[up to date] {plain(str(prev.get('name', p.stem)))}")
         else:
-            todo.append((str(p), str(out), options, key, spec))
+            todo.append((str(p), str(out), options, key, spec, stem))
     if jobs > 1 and len(todo) > 1:  # worker processes read their design again (a program does not pickle)
-        todo = [(*t[:4], None) for t in todo]
+        todo = [(*t[:4], None, t[5]) for t in todo]
     t0 = time.perf_counter()
     for done, entry in enumerate(_map(_build, todo, jobs), 1):
         entries[entry["source"]] = entry
-        tail = entry.get("verdict") or f"ERROR: {entry.get('error', '').splitlines()[0]}"
-        say(f"{_bar(done, len(todo))} {done}/{len(todo)} {entry['name']}: {tail} ({entry['seconds']:.2f} s)")
+        first = (entry.get("error") or "").split("\n", 1)[0]  # an empty error has no first line to index
+        tail = entry.get("verdict") or f"ERROR: {first}"
+        say(f"{_bar(done, len(todo))} {done}/{len(todo)} {plain(entry['name'])}: {tail} ({entry['seconds']:.2f} s)")
     manifest = {"camfab_version": __version__, "jobs": jobs, "wall_seconds": time.perf_counter() - t0,
                 "cams": [entries[str(p)] for p in designs]}
-    _dedupe_folders(manifest)
     atomic_write(out / MANIFEST, json.dumps(manifest, indent=2) + "\n")
     atomic_write(out / INDEX, _index_html(manifest))
     return manifest
@@ -219,19 +250,6 @@ def _old_entries(out: Path) -> dict:
     except (OSError, ValueError, KeyError, TypeError) as exc:
         log.warning("%s cannot be read (%s: %s); every design is rebuilt", out / MANIFEST, type(exc).__name__, exc)
         return {}
-
-
-def _dedupe_folders(manifest: dict) -> None:
-    seen: dict[str, str] = {}
-    for e in manifest["cams"]:
-        f = e.get("folder")
-        if f is None:
-            continue
-        if f in seen:
-            e["status"] = "error"
-            e["error"] = (f"design name '{e.get('name')}' is also used by {seen[f]}: both write to {f}/; "
-                          "give the designs different names")
-        seen[f] = e["source"]
 
 
 def exit_status(manifest: dict) -> int:

@@ -246,9 +246,10 @@ class Cam:
         return run(self, outdir, Request.from_design(self.spec, outputs, force=force, tol=tol))
 
 
-def load(design: str | Path) -> Cam:
-    """A :class:`Cam` from a design file (TOML or xlsx) or the name of a built-in example."""
-    return Cam(load_design(resolve_design_path(design)))
+def load(design: str | Path, *, allow_outside_files: bool = False) -> Cam:
+    """A :class:`Cam` from a design file (TOML or xlsx) or the name of a built-in example.  The knot file a
+    design names must lie in its folder (or below) unless ``allow_outside_files``."""
+    return Cam(load_design(resolve_design_path(design), allow_outside_files=allow_outside_files))
 
 
 def examples() -> list[str]:

@@ -16,7 +16,8 @@ Layers: ``PROFILE``, ``PITCH_CURVE``, ``BASE_CIRCLE``, ``PRIME_CIRCLE``, ``BORE`
 and ``PITCH_CURVE_2``.  For a curved-face follower the pitch curve is the path of the
 face's centre of curvature and the prime circle the circle R_b + R it starts on.  Units
 are recorded as ``$INSUNITS = 4`` (mm) and the tolerance and achieved deviation as custom
-header properties ``CAMFAB_TOL_MM`` / ``CAMFAB_DEVIATION_MM``.  Output is byte-identical
+header properties ``CAMFAB_TOL_MM`` / ``CAMFAB_DEVIATION_MM``; the design's name is ``CAMFAB_NAME``, one
+line with DXF's escapes (:func:`camfab.textsafe.dxf_string`).  Output is byte-identical
 for the same input (ezdxf's fixed-metadata mode, no timestamps).
 """
 from __future__ import annotations
@@ -30,6 +31,7 @@ import numpy as np
 
 from ..errors import InputError, MissingDependencyError
 from ..geom2d import ArcChain, bulge_centre
+from ..textsafe import dxf_string
 
 __all__ = ["DxfContent", "LAYERS", "FLAVOURS", "dumps", "build_document", "loop_nurbs", "write_deterministic"]
 
@@ -128,7 +130,7 @@ def build_document(content: DxfContent, *, flavour: str = "lwpolyline"):
     if flavour != "r12":  # R12 headers have no unit variables: the R12 flavour is mm by contract
         doc.header["$INSUNITS"] = 4
         doc.header["$MEASUREMENT"] = 1
-        doc.header.custom_vars.append("CAMFAB_NAME", content.name)
+        doc.header.custom_vars.append("CAMFAB_NAME", dxf_string(content.name))
         doc.header.custom_vars.append("CAMFAB_TOL_MM", f"{content.tol_mm:g}")
         if content.deviation_mm is not None:
             doc.header.custom_vars.append("CAMFAB_DEVIATION_MM", f"{content.deviation_mm:.3e}")

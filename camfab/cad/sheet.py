@@ -17,6 +17,7 @@ import numpy as np
 from ..assets import read_template
 from ..errors import ExportError, InputError
 from ..geom2d import ArcChain
+from ..textsafe import dxf_mtext, dxf_string, dxf_text
 from .dxf import ezdxf_module
 
 __all__ = ["PAPERS", "LAYERS", "SheetLayout", "load_template", "parse_scale", "sheet_layout", "put_text", "rect",
@@ -172,7 +173,7 @@ def title_block(msp, layout: SheetLayout, fields: dict[str, str]) -> None:
         value = fields[cell["field"]]
         if value:
             h = th["title_height_mm"] if cell.get("large") else th["value_height_mm"]
-            put_text(msp, value, (cx + 1.5, cy + 1.5), h, "TITLE_BLOCK", "BOTTOM_LEFT", width=cw - 3.0)
+            put_text(msp, dxf_text(value), (cx + 1.5, cy + 1.5), h, "TITLE_BLOCK", "BOTTOM_LEFT", width=cw - 3.0)
 
 
 def lift_table_block(msp, layout: SheetLayout, table, closed: bool) -> None:
@@ -216,7 +217,7 @@ def notes_column(msp, layout: SheetLayout, notes: list[str]) -> None:
     x0, y0, x1, y1 = layout.notes
     h = tpl["text_height_mm"]
     put_text(msp, "NOTES", (x0 + 2, y1 - 2), 3.5, "NOTES", "TOP_LEFT")
-    body = "\\P".join(f"{i}. {n}" for i, n in enumerate(notes, 1))
+    body = "\\P".join(f"{i}. {dxf_mtext(n)}" for i, n in enumerate(notes, 1))  # a note is text, never codes
     mt = msp.add_mtext(body, dxfattribs={"layer": "NOTES", "char_height": h, "width": x1 - x0 - 4,
                                          "insert": (x0 + 2, y1 - 8), "attachment_point": 1})
     mt.dxf.line_spacing_factor = 1.2
@@ -259,7 +260,7 @@ def new_document(spec, layout: SheetLayout, shapes, tpl):
     doc.header["$EXTMIN"] = (0.0, 0.0, 0.0)
     doc.header["$EXTMAX"] = (layout.size[0], layout.size[1], 0.0)
     doc.header["$LIMMAX"] = layout.size
-    doc.header.custom_vars.append("CAMFAB_NAME", spec.name)
+    doc.header.custom_vars.append("CAMFAB_NAME", dxf_string(spec.name))
     doc.header.custom_vars.append("CAMFAB_PAPER", layout.paper)
     doc.header.custom_vars.append("CAMFAB_SCALE", f"{layout.scale!r}")
     doc.header.custom_vars.append("CAMFAB_CENTRE", f"{layout.centre[0]!r},{layout.centre[1]!r}")

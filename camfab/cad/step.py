@@ -11,6 +11,7 @@ from pathlib import Path
 
 from ..errors import MissingDependencyError
 from ..geom2d import ArcChain, bulge_midpoint
+from ..textsafe import step_string
 from .plate import PlateSpec
 
 __all__ = ["plate_solid", "dumps", "stack_dumps"]
@@ -62,12 +63,12 @@ def stack_dumps(outlines, plate: PlateSpec, *, gap_mm: float = 2.0, name: str = 
 def _export(solid, name: str) -> str:
     cq = _cq()
     with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / f"{name}.step"
+        path = Path(tmp) / "cam.step"  # never a path built from the name
         cq.exporters.export(solid, str(path), "STEP")
         text = path.read_text(encoding="utf-8", errors="replace")
     text = re.sub(r"(FILE_NAME\('[^']*',)'[^']*'", r"\1'1970-01-01T00:00:00'", text, count=1)
-    safe = re.sub(r"[^A-Za-z0-9_.-]", "_", name)
-    text = re.sub(r"Open CASCADE STEP translator [0-9.]+ [0-9]+", safe, text)
+    product = step_string(name)  # the full name, as an ISO 10303-21 string (a function: no backslash expansion)
+    text = re.sub(r"Open CASCADE STEP translator [0-9.]+ [0-9]+", lambda m: product, text)
     head, sep, data = text.partition("DATA;")
     return head + sep + _REAL.sub(_canonical_real, data)
 

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 from ..errors import GeometryError, MissingDependencyError
 from ..geom2d import ArcChain
+from ..textsafe import plain
 from .plate import PlateSpec
 
 __all__ = ["plate_mesh", "dumps"]
@@ -42,5 +43,5 @@ def dumps(outline: ArcChain, plate: PlateSpec, *, tol: float, name: str = "cam")
     """Binary STL bytes of the plate, deterministic for the same input."""
     mesh = plate_mesh(outline, plate, tol=tol)
     data = mesh.export(file_type="stl")
-    head = f"camfab {name} units=mm tol={tol:g}".encode("ascii", "replace")[:80].ljust(80, b" ")
+    head = f"camfab {plain(name)} units=mm tol={tol:g}".encode("ascii", "replace")[:80].ljust(80, b" ")
     return head + data[80:]

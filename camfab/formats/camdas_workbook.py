@@ -82,6 +82,7 @@ from ..design.kinds import ContactKind, FollowerType
 from ..design.tables import LiftTable, intervals, lift_table, sample_params
 from ..errors import InputError
 from ..results import JUMP_CODES, IssueCode, Severity, Verdict
+from ..textsafe import xlsx_no_formulas, xlsx_put, xlsx_text
 
 __all__ = ["CAMDAS_COLUMNS", "FIXED_DATE", "LiftTable", "camdas_workbook", "camdas_columns", "conclusions",
            "dynamics_columns", "dynamics_summary_rows", "fixed_zip", "geometry_rows", "lift_table", "sample_params",
@@ -328,13 +329,14 @@ def camdas_workbook(spec, geometry, report, *, step_deg: float = 1.0, lift_step_
     if spec.dynamics is not None:
         _dynamics_sheet(wb.create_sheet("Dynamics"), *dynamics_columns(spec, geometry, step_deg=step_deg))
     wb.properties.creator = "camfab"
-    wb.properties.title = spec.name
+    wb.properties.title = xlsx_text(spec.name)
     wb.properties.created = FIXED_DATE
     wb.properties.modified = FIXED_DATE
     return _save(wb)
 
 
 def _save(wb) -> bytes:
+    xlsx_no_formulas(wb)  # camfab writes no formula: text openpyxl took for one stays text
     buf = io.BytesIO()
     wb.save(buf)
     return fixed_zip(buf.getvalue())
@@ -366,7 +368,7 @@ def _camdas_sheet(ws, spec, geometry, report, step_deg: float, profile: int) -> 
     from openpyxl.styles import Font
 
     ws["A1"] = type_text(spec) + (f" — profile {profile + 1}" if profile else "")
-    ws["A2"] = spec.name
+    xlsx_put(ws["A2"], spec.name)  # the design's text: never a formula, no control characters
     ws["A3"] = verdict_sentence(report)
     for i, (label, value, unit) in enumerate(geometry_rows(spec, geometry)):
         if not label:
@@ -441,7 +443,7 @@ def _checks_sheet(ws, spec, report) -> None:
     for concept, mx, mn, note in conclusions(spec, report):
         row += 1
         for col, v in enumerate((concept, _fmt(mx), _fmt(mn), note), 1):
-            ws.cell(row, col, v)
+            xlsx_put(ws.cell(row, col), v)
     row += 2
     ws.cell(row, 1, "Summary").font = bold
     for label, value, unit in (("Base radius (min distance)", report.base_radius_mm, "mm"),
@@ -474,7 +476,7 @@ def _checks_sheet(ws, spec, report) -> None:
     for f in report.findings:
         row += 1
         for col, v in enumerate((f.code, f.severity, f.from_deg, f.to_deg, f.value, f.limit, f.message), 1):
-            ws.cell(row, col, _fmt(float(v)) if isinstance(v, (float, np.floating)) else v)
+            xlsx_put(ws.cell(row, col), _fmt(float(v)) if isinstance(v, (float, np.floating)) else v)
 
 
 def _lift_sheet(ws, table: LiftTable, geometry) -> None:

@@ -16,9 +16,10 @@ __all__ = ["EXAMPLES_DIR", "load_design", "resolve_design_path"]
 EXAMPLES_DIR = Path(__file__).resolve().parent.parent / "examples"
 
 
-def load_design(path: str | Path) -> DesignSpec:
+def load_design(path: str | Path, *, allow_outside_files: bool = False) -> DesignSpec:
     """Read and validate a design file: TOML, or an xlsx workbook (``*.xlsx``, see
-    :mod:`camfab.formats.xlsx_design`).
+    :mod:`camfab.formats.xlsx_design`).  A knot file it names must lie in its folder (or below) unless
+    ``allow_outside_files`` (:mod:`camfab.formats.knot_files`).
 
     Raises
     ------
@@ -26,7 +27,8 @@ def load_design(path: str | Path) -> DesignSpec:
         On unreadable or invalid files; every problem found is listed.
     """
     p = Path(path)
-    return load_design_xlsx(p) if p.suffix.lower() == ".xlsx" else load_design_toml(p)
+    load = load_design_xlsx if p.suffix.lower() == ".xlsx" else load_design_toml
+    return load(p, allow_outside_files=allow_outside_files)
 
 
 def resolve_design_path(name: str | Path) -> Path:

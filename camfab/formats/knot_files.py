@@ -22,7 +22,20 @@ File formats
 * xlsx: the first sheet; empty rows are skipped; a first row holding text is
   a header.  Columns A–D are angle, s, v, a; column E is j when any data row
   has a number there; further columns are ignored.  Numeric text cells are
-  accepted (a decimal comma in a cell is unambiguous).
+  accepted (a decimal comma in a cell is unambiguous).  A formula in columns A–E is refused naming its
+  cells (its cached value may be stale or come from another workbook).
+
+Where the file may be
+---------------------
+A design read from a file (TOML or xlsx: ``base_dir`` is its folder) may only name a file in that folder
+or below it, after resolving symbolic links: ``../x.csv``, an absolute path elsewhere or a link leading out
+is refused naming ``motion_table.file`` — a design received from someone else cannot make camfab read (and
+echo into its messages) any file on the disk.  ``allow_outside_files=True`` (``--allow-outside-files`` on the
+command line) lifts the rule for a design the user trusts.  A design given as data without a folder
+(``base_dir=None``: a dict passed to :func:`~camfab.formats.toml_design.design_from_data` or
+:func:`load_motion_table` by a program) has no folder to be kept in: its file is resolved against the current
+directory and read as given; a program that passes on data it received gives the folder to confine it to as
+``base_dir``.
 
 Every failure is a :class:`~camfab.errors.SpecError` whose problem names the
 field (``motion_table.file``), the file, and the line or cells at fault.
@@ -35,6 +48,7 @@ from typing import Any, cast
 
 from ..design.knots import KnotFile, KnotTable, build_knot_table
 from ..errors import InputError, Problem, SpecError
+from ..textsafe import excerpt
 
 __all__ = [
     "TEXT_SUFFIXES",
@@ -54,7 +68,7 @@ XLSX_SUFFIXES = (".xlsx", ".xlsm")
 # ---------------------------------------------------------------------------
 # a [motion_table] with a file
 def resolve_knot_file(table: Any, base_dir: str | Path | None = None, *,
-                      path: str = "motion_table") -> Any:
+                      path: str = "motion_table", allow_outside_files: bool = False) -> Any:
     """The ``[motion_table]`` with its ``file`` read (a :class:`KnotFile` in place of the name).
 
     Parameters
@@ -66,6 +80,8 @@ def resolve_knot_file(table: Any, base_dir: str | Path | None = None, *,
         (default: the current directory).
     path : str
         Field path used in messages.
+    allow_outside_files : bool
+        Read a file outside ``base_dir`` too (see "Where the file may be" in the module notes).
 
     Returns
     -------
@@ -79,19 +95,35 @@ def resolve_knot_file(table: Any, base_dir: str | Path | None = None, *,
     name = table.get("file")
     if not isinstance(name, (str, Path)) or not str(name):
         return table
-    return {**table, "file": read_knot_file(name, base_dir, field=f"{path}.file")}
+    return {**table, "file": read_knot_file(name, base_dir, field=f"{path}.file",
+                                            allow_outside_files=allow_outside_files)}
 
 
 def read_knot_file(name: str | Path, base_dir: str | Path | None = None, *,
-                   field: str = "motion_table.file") -> KnotFile:
-    """Read the knot file ``name`` (relative to ``base_dir``) into a :class:`KnotFile`.
+                   field: str = "motion_table.file", allow_outside_files: bool = False) -> KnotFile:
+    """Read the knot file ``name`` (relative to ``base_dir``, the current directory when None) into a
+    :class:`KnotFile`.
 
-    A file that cannot be read gives a ``KnotFile`` without rows that carries the
-    problems, so that the core reports them with the design's other problems.
+    A file that cannot be read, or that lies outside ``base_dir`` when one is given (unless
+    ``allow_outside_files``), gives a ``KnotFile`` without rows that carries the problem, so that the core
+    reports it with the design's other problems.
     """
     file = Path(name)
-    if not file.is_absolute() and base_dir is not None:
-        file = Path(base_dir) / file
+    folder = None if base_dir is None else Path(base_dir)
+    if folder is not None and not file.is_absolute():
+        file = folder / file
+    try:
+        target = file.resolve()
+        outside = folder is not None and not target.is_relative_to(folder.resolve())
+    except (OSError, ValueError, RuntimeError) as exc:  # a NUL in the name, a loop of symbolic links
+        return KnotFile(str(name), str(file), None, (Problem(field, str(name), f"is not a usable path ({exc})",
+                                                             "give the name of a file beside the design"),))
+    if outside and not allow_outside_files:
+        return KnotFile(str(name), str(file), None, (Problem(
+            field, str(name), f"lies outside the design's folder {str(folder)!r}; a design may only read "
+            "knot files in its folder or below it",
+            "move the file into the design's folder (or a folder below it), or pass --allow-outside-files "
+            "(Python: allow_outside_files=True) if you trust this design"),))
     try:
         rows = read_knots(file, field=field)
     except SpecError as exc:
@@ -100,7 +132,7 @@ def read_knot_file(name: str | Path, base_dir: str | Path | None = None, *,
 
 
 def load_motion_table(table: Mapping[str, Any], *, base_dir: str | Path | None = None,
-                      path: str = "motion_table") -> KnotTable:
+                      path: str = "motion_table", allow_outside_files: bool = False) -> KnotTable:
     """Build a :class:`KnotTable` from a ``[motion_table]`` dict, reading its ``file`` if it has one.
 
     Parameters
@@ -114,13 +146,16 @@ def load_motion_table(table: Mapping[str, Any], *, base_dir: str | Path | None =
         directory).
     path : str
         Field path used in messages.
+    allow_outside_files : bool
+        Read a file outside ``base_dir`` too.
 
     Raises
     ------
     SpecError
         With every problem found, each naming its field path (and the file).
     """
-    return build_knot_table(resolve_knot_file(table, base_dir, path=path), path=path)
+    return build_knot_table(resolve_knot_file(table, base_dir, path=path, allow_outside_files=allow_outside_files),
+                            path=path)
 
 
 # ---------------------------------------------------------------------------
@@ -184,7 +219,7 @@ def _parse_rows(lines: list[tuple[int, str]], sep: str | None, dc: bool) -> list
         except ValueError:
             if i == 0 and len(lines) > 1:
                 continue  # header
-            raise InputError(f"line {no}: {text.strip()!r} is not a row of numbers") from None
+            raise InputError(f"line {no}: {excerpt(text.strip())!r} is not a row of numbers") from None
     return rows
 
 
@@ -294,12 +329,19 @@ def _xlsx_cells(file: Path, fld: str) -> list[tuple[int, tuple[Any, ...]]]:
     if not file.is_file():
         raise _file_error(fld, file, "file not found", "check the path (relative paths are resolved "
                           "against the design file's folder)")
-    try:
-        wb = openpyxl.load_workbook(file, read_only=True, data_only=True)
+    try:  # formulas as written, not their cached values: a formula is refused below
+        wb = openpyxl.load_workbook(file, read_only=True, data_only=False)
         try:
-            return [(no, tuple(r)) for no, r in enumerate(wb.worksheets[0].iter_rows(values_only=True), 1)]
+            rows = [(no, tuple(r)) for no, r in enumerate(wb.worksheets[0].iter_rows(max_col=5), 1)]
         finally:
             wb.close()
     except Exception as exc:  # openpyxl raises many types for a damaged file
         raise _file_error(fld, file, f"not a readable xlsx workbook ({exc.__class__.__name__}: {exc})",
                           "re-save it as .xlsx from a spreadsheet program, or export the table as CSV") from None
+    formulas = [c.coordinate for _, r in rows for c in r if getattr(c, "data_type", None) == "f"]
+    if formulas:
+        listed = ", ".join(formulas[:20]) + (" …" if len(formulas) > 20 else "")
+        raise _file_error(fld, file, f"cells hold formulas: {listed}; formulas are not accepted in a knot "
+                          "workbook (their cached values may be stale or come from another workbook)",
+                          "type the values (paste them as values), or export the table as CSV")
+    return [(no, tuple(c.value for c in r)) for no, r in rows]

@@ -19,8 +19,9 @@ from .knot_files import resolve_knot_file
 __all__ = ["design_from_data", "load_design_toml"]
 
 
-def load_design_toml(path: str | Path) -> DesignSpec:
-    """Read and validate a TOML design file (its name defaults to the file's stem).
+def load_design_toml(path: str | Path, *, allow_outside_files: bool = False) -> DesignSpec:
+    """Read and validate a TOML design file (its name defaults to the file's stem); its knot file must lie in
+    its folder unless ``allow_outside_files`` (:mod:`camfab.formats.knot_files`).
 
     Raises
     ------
@@ -42,11 +43,11 @@ def load_design_toml(path: str | Path) -> DesignSpec:
         raise SpecError(Problem("file", p.name, f"is not valid TOML: {exc}",
                                 "fix the TOML syntax at the line named"), str(p)) from None
     data.setdefault("name", p.stem)
-    return design_from_data(data, source=str(p), base_dir=p.parent)
+    return design_from_data(data, source=str(p), base_dir=p.parent, allow_outside_files=allow_outside_files)
 
 
 def design_from_data(data: Mapping[str, Any], *, source: str | None = None,
-                     base_dir: str | Path | None = None) -> DesignSpec:
+                     base_dir: str | Path | None = None, allow_outside_files: bool = False) -> DesignSpec:
     """Validate a design dict (the TOML structure), reading the knot file its ``[motion_table]`` names.
 
     Parameters
@@ -57,7 +58,9 @@ def design_from_data(data: Mapping[str, Any], *, source: str | None = None,
         The design file, named in messages.
     base_dir : str or Path, optional
         Folder a relative ``motion_table.file`` is resolved against (the design file's folder;
-        default: the current directory).
+        default: the current directory).  When given, the file must lie in it or below it.
+    allow_outside_files : bool
+        Read a ``motion_table.file`` outside ``base_dir`` too (a design the caller trusts).
 
     Raises
     ------
@@ -65,5 +68,6 @@ def design_from_data(data: Mapping[str, Any], *, source: str | None = None,
         Every problem found, the knot file's included.
     """
     if "motion_table" in data:
-        data = {**data, "motion_table": resolve_knot_file(data["motion_table"], base_dir)}
+        data = {**data, "motion_table": resolve_knot_file(data["motion_table"], base_dir,
+                                                          allow_outside_files=allow_outside_files)}
     return design_from_dict(data, source=source)

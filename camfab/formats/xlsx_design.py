@@ -29,7 +29,10 @@ Cell values: numbers, text and booleans as Excel stores them.  Text that
 reads as a number (``35`` or ``35,5``) or as a boolean (``true``/``false``,
 any case) is converted, except for the free-text keys ``name``,
 ``description``, ``manufacturing.material`` and ``motion_table.file``.
-A relative ``motion_table.file`` is resolved against the workbook's folder.
+A relative ``motion_table.file`` is resolved against the workbook's folder (and must lie in it, see
+:func:`~camfab.formats.knot_files.read_knot_file`).  A formula in a cell that is read (columns A–B of
+``design``, any cell of ``motion``, columns A–E of ``knots``) is refused naming its cell — its cached value
+may be stale or come from another workbook; type the value.
 
 The dict is validated by :func:`~camfab.formats.toml_design.design_from_data`,
 so the rules and messages are those of TOML files; every problem's field path is
@@ -49,6 +52,7 @@ from ..design.knots import KnotFile
 from ..design.shop import MachiningSpec
 from ..design.spec import CamSpec, DesignSpec, FollowerSpec, ManufacturingSpec, OutputsSpec, dynamics_items
 from ..errors import Problem, SpecError
+from ..textsafe import excerpt, xlsx_no_formulas, xlsx_put, xlsx_text
 from ..units import RPM
 from .camdas_workbook import FIXED_DATE, fixed_zip
 from .toml_design import design_from_data
@@ -64,13 +68,15 @@ _FIX_FORMAT = ("save it as an .xlsx workbook with a 'design' sheet of key/value 
 
 # ---------------------------------------------------------------------------
 # reading
-def load_design_xlsx(path: str | Path) -> DesignSpec:
+def load_design_xlsx(path: str | Path, *, allow_outside_files: bool = False) -> DesignSpec:
     """Read and validate a design workbook (format in the module notes).
 
     Parameters
     ----------
     path : str or Path
         The ``.xlsx`` file.
+    allow_outside_files : bool
+        Read a ``motion_table.file`` outside the workbook's folder too.
 
     Returns
     -------
@@ -85,6 +91,9 @@ def load_design_xlsx(path: str | Path) -> DesignSpec:
     p = Path(path)
     wb = _open(p)
     try:
+        formulas = _formula_problems(wb)
+        if formulas:
+            raise SpecError(formulas, str(p))
         cells: dict[str, str] = {}
         problems: list[Problem] = []
         data = _read_design_sheet(wb, cells, problems)
@@ -104,7 +113,7 @@ def load_design_xlsx(path: str | Path) -> DesignSpec:
         raise SpecError(problems, str(p))
     data.setdefault("name", p.stem)
     try:
-        return design_from_data(data, source=str(p), base_dir=p.parent)
+        return design_from_data(data, source=str(p), base_dir=p.parent, allow_outside_files=allow_outside_files)
     except SpecError as exc:
         raise SpecError([_locate(q, cells) for q in exc.problems], str(p)) from None
 
@@ -114,11 +123,43 @@ def _open(p: Path):
 
     if not p.is_file():
         raise SpecError(Problem("file", str(p), "no such design workbook", "check the path"), str(p))
-    try:
-        return openpyxl.load_workbook(p, data_only=True)
+    try:  # formulas as written (not their cached values), so that they can be refused
+        return openpyxl.load_workbook(p, data_only=False)
     except Exception as exc:  # openpyxl raises many types for a damaged or foreign file
         raise SpecError(Problem("file", str(p), f"is not a readable xlsx workbook ({exc.__class__.__name__}: "
                                 f"{exc})", _FIX_FORMAT), str(p)) from None
+
+
+#: the columns read as input, by sheet (the design sheet's further columns are notes)
+_INPUT_COLUMNS = {"design": 2, "motion": None, "knots": 5}
+_EXTERNAL = re.compile(r"\[\d+\]")
+
+
+def _formula_problems(wb) -> list[Problem]:
+    """One problem per input cell that holds a formula (its cached value is never used: it may be stale or
+    come from another workbook); empty when there is none."""
+    problems = []
+    linked = bool(getattr(wb, "_external_links", None))
+    for ws in wb.worksheets:
+        low = ws.title.lower()
+        if low not in _INPUT_COLUMNS:
+            continue
+        for row in ws.iter_rows(max_col=_INPUT_COLUMNS[low]):
+            for cell in row:
+                if cell.data_type != "f":
+                    continue
+                formula = cell.value if isinstance(cell.value, str) else getattr(cell.value, "text", None)
+                text = str(formula or "")
+                link = linked and _EXTERNAL.search(text) is not None
+                key = ws.cell(cell.row, 1).value if low == "design" and cell.column == 2 else None
+                where = f"{ws.title}!{cell.coordinate}"
+                problems.append(Problem(
+                    f"{key.strip()} [{where}]" if isinstance(key, str) and key.strip() else where,
+                    excerpt(text),
+                    "formulas are not accepted in a design workbook" + (" (this one reads another workbook)"
+                                                                          if link else ""),
+                    "type the value (copy the cell and paste it as a value)"))
+    return problems
 
 
 def _convert(key: str, value: Any) -> Any:
@@ -430,8 +471,8 @@ def design_to_xlsx(spec: DesignSpec) -> bytes:
     bold = Font(bold=True)
     ws.append(["key", "value"])
     ws["A1"].font = ws["B1"].font = bold
-    for key, value in kv:
-        ws.append([key, value])
+    for row, (key, value) in enumerate(kv, 2):  # text as text (never a formula), without control characters
+        xlsx_put(ws.cell(row, 1), key), xlsx_put(ws.cell(row, 2), value)
     ws.column_dimensions["A"].width = 34
     if segs is not None:
         ms = wb.create_sheet("motion")
@@ -450,9 +491,10 @@ def design_to_xlsx(spec: DesignSpec) -> bytes:
         for r in knots:
             ks.append(list(r))
     wb.properties.creator = "camfab"
-    wb.properties.title = spec.name
+    wb.properties.title = xlsx_text(spec.name)
     wb.properties.created = FIXED_DATE
     wb.properties.modified = FIXED_DATE
+    xlsx_no_formulas(wb)
     buf = io.BytesIO()
     wb.save(buf)
     return fixed_zip(buf.getvalue())

@@ -15,6 +15,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..results import Severity
+from ..textsafe import mpl_text
 from ._common import VERDICT_CLASS, VERDICT_TEXT, axis_of, fmt, mechanism_text, sample_grid
 from .plots import SVAJ_UNITS, new_figure, off_view, plot_style
 
@@ -56,7 +57,7 @@ def compare_svaj_figure(items, labels: Sequence[str] | None = None):
     -------
     matplotlib.figure.Figure
     """
-    labels = list(labels or design_labels(items))
+    labels = [mpl_text(t) for t in (labels or design_labels(items))]  # no mathtext from a name
     units = sorted({spec.follower.lift_unit for spec, _, _ in items})
     with plot_style():
         fig = new_figure(9.0, 8.6)
@@ -80,7 +81,7 @@ def compare_svaj_figure(items, labels: Sequence[str] | None = None):
 
 def compare_curvature_figure(items, labels: Sequence[str] | None = None):
     """Radius of curvature of every design's profile(s), overlaid (view clipped at ±3·Rmax)."""
-    labels = list(labels or design_labels(items))
+    labels = [mpl_text(t) for t in (labels or design_labels(items))]  # no mathtext from a name
     rmax = max((r.max_radius_mm or 50.0) for _, _, r in items)
     lim = 3.0 * rmax
     with plot_style():
@@ -106,7 +107,7 @@ def compare_curvature_figure(items, labels: Sequence[str] | None = None):
 
 def compare_pressure_angle_figure(items, labels: Sequence[str] | None = None):
     """Pressure angle of every design with its limit (dashed, in the design's colour)."""
-    labels = list(labels or design_labels(items))
+    labels = [mpl_text(t) for t in (labels or design_labels(items))]  # no mathtext from a name
     with plot_style():
         fig = new_figure(9.0, 4.2)
         ax = fig.subplots()

@@ -26,6 +26,7 @@ import numpy as np
 from ..design.kinds import ContactKind
 from ..errors import InputError
 from ..results import Extreme, IssueCode
+from ..textsafe import mpl_text
 from ._common import CURVATURE_CODES, Axis, axis_of, finding_spans, fmt, fmt_at, sample_grid
 
 __all__ = ["svaj_figure", "profile_figure", "curvature_figure", "pressure_angle_figure", "face_position_figure",
@@ -170,7 +171,7 @@ def svaj_figure(spec, prog, *, n: int = _N):
         x_axis(axes[-1], axis)
         speed = (f"ω = {spec.speed:.4g} rad/s ({spec.speed * 30 / math.pi:.4g} rpm)" if axis.closed
                  else f"v = {spec.speed:.4g} mm/s")
-        fig.suptitle(f"{spec.name}: motion diagrams at {speed}", fontsize=11)
+        fig.suptitle(f"{mpl_text(spec.name)}: motion diagrams at {speed}", fontsize=11)
     return fig
 
 
@@ -236,10 +237,10 @@ def profile_figure(spec, geometry, report):
                         label=f"bore Ø{spec.manufacturing.bore_mm:g} mm")
             ax.plot([0], [0], "k+", ms=12, mew=1.2, label="cam centre")
             _rotation_arrow(ax, report.max_radius_mm or 1.0, geometry.profiles[0].sense)
-            ax.set_title(f"{spec.name}: cam profile (cam frame, follower at +Y at 0°)")
+            ax.set_title(f"{mpl_text(spec.name)}: cam profile (cam frame, follower at +Y at 0°)")
         else:
             ax.axhline(spec.follower.base_height_mm or 0.0, color="0.35", lw=0.9, ls="--", label="cam base line")
-            ax.set_title(f"{spec.name}: translating cam profile")
+            ax.set_title(f"{mpl_text(spec.name)}: translating cam profile")
         ax.set_xlabel("x (mm)")
         ax.set_ylabel("y (mm)")
         ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
@@ -326,7 +327,7 @@ def curvature_figure(spec, geometry, report, *, n: int = _N):
         ax.set_ylim(max(lo, -lim) - 0.08 * lim, min(hi, lim) + 0.08 * lim)
         x_axis(ax, axis)
         ax.set_ylabel("radius of curvature ρ (mm)")
-        ax.set_title(f"{spec.name}: radius of curvature (+ convex, − concave; view clipped at ±{lim:.0f} mm)")
+        ax.set_title(f"{mpl_text(spec.name)}: radius of curvature (+ convex, − concave; view clipped at ±{lim:.0f} mm)")
         ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     return fig
 
@@ -376,7 +377,7 @@ def pressure_angle_figure(spec, geometry, report, *, n: int = _N):
         x_axis(ax, axis)
         ax.margins(y=0.15)
         ax.set_ylabel("pressure angle δ (°)")
-        ax.set_title(f"{spec.name}: pressure angle against its limit")
+        ax.set_title(f"{mpl_text(spec.name)}: pressure angle against its limit")
         ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     return fig
 
@@ -425,7 +426,7 @@ def face_position_figure(spec, geometry, report, *, n: int = _N):
         x_axis(ax, axis)
         ax.margins(y=0.15)
         ax.set_ylabel("contact position on the face (mm)")
-        ax.set_title(f"{spec.name}: {word} contact position ({where})")
+        ax.set_title(f"{mpl_text(spec.name)}: {word} contact position ({where})")
         ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     return fig
 
@@ -522,7 +523,7 @@ def dynamics_figure(spec, geometry, report, *, n: int = _N):
             a.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
         x_axis(ax2, axis)
         speed = (f"{spec.speed * 30 / math.pi:.4g} rpm" if axis.closed else f"{spec.speed:.4g} mm/s")
-        fig.suptitle(f"{spec.name}: follower dynamics at {speed}", fontsize=11)
+        fig.suptitle(f"{mpl_text(spec.name)}: follower dynamics at {speed}", fontsize=11)
     return fig
 
 

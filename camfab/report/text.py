@@ -10,6 +10,7 @@ import math
 import numpy as np
 
 from ..results import FORCE_CODES, IssueCode, Verdict
+from ..textsafe import plain
 
 __all__ = ["motion_csv", "segment_rows", "format_motion", "format_check", "VERDICT_TEXT"]
 
@@ -44,7 +45,7 @@ def format_motion(spec, prog, report) -> str:
     xu = "°" if prog.axis.rotating else "mm"
     speed = (f"ω = {spec.speed:.6g} rad/s ({spec.speed * 60 / (2 * math.pi):.6g} rpm)"
              if xu == "°" else f"v = {spec.speed:.6g} mm/s")
-    out = [f"{spec.name}: {spec.cam.kind} cam, {spec.follower.motion} {spec.follower.type} follower, {speed}"
+    out = [f"{plain(spec.name)}: {spec.cam.kind} cam, {spec.follower.motion} {spec.follower.type} follower, {speed}"
            + ("" if spec.cam.speed_given else " [default speed]"), ""]
     out.append(f"{'#':>3}  {'law':<34}{'lift(' + lu + ')':>10}{'from(' + xu + ')':>10}{'to(' + xu + ')':>10}"
                f"{'S start':>10}{'S end':>10}")
@@ -69,7 +70,7 @@ def format_check(spec, report) -> str:
     if report.dynamics is not None:
         rows += _dynamics_rows(report.dynamics, codes)
     width = max(len(r[0]) for r in rows) + 2
-    out = [f"{spec.name}: {VERDICT_TEXT[report.verdict]}", ""]
+    out = [f"{plain(spec.name)}: {VERDICT_TEXT[report.verdict]}", ""]  # no control characters to a terminal
     out.append(f"{'Concept':<{width}}{'Maximum':>13}{'Minimum':>13}  Comments")
     out += [f"{a:<{width}}{b:>13}{c:>13}  {e}" for a, b, c, e in rows]
     extra = [("base_radius_mm", report.base_radius_mm), ("max_radius_mm", report.max_radius_mm),

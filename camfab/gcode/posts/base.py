@@ -12,13 +12,13 @@ integer.  ``-0`` is written as ``0``.  There are no timestamps: the same program
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Sequence
 from typing import Any
 
 from camfab.errors import ApiError, ExportError, InputError
 from camfab.gcode.model import Arc, Comment, Coolant, CutterComp, Feed, Program, Rapid, Spindle, ToolChange
 from camfab.geom2d import arc_sweep
+from camfab.textsafe import gcode_comment
 
 __all__ = ["MM_PER_INCH", "Post", "decimals_for", "header_lines"]
 
@@ -126,10 +126,9 @@ class Post:
         return ["G17", "G20" if units == "inch" else "G21", "G40", "G49", "G54", "G80", "G90", "G94"]
 
     def sanitize_comment(self, text: str) -> str:
-        """Make ``text`` legal inside ``( )`` for this controller (no parentheses, ASCII)."""
-        t = text.replace("(", "[").replace(")", "]")
-        t = "".join(c if 32 <= ord(c) < 127 else "?" for c in t)
-        return re.sub(r"\s+", " ", t).strip()
+        """Make ``text`` legal inside ``( )`` for this controller: one line of printable ASCII without
+        parentheses, ``;`` or ``%`` (:func:`camfab.textsafe.gcode_comment`)."""
+        return gcode_comment(text)
 
     def coolant_code(self, mode: str, opts: dict) -> str:
         """M-code switching coolant ``mode`` (flood, mist, off)."""
