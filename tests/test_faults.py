@@ -170,6 +170,7 @@ def test_ctrl_c_during_run_or_export_writes_nothing(tmp_path, argv):
 
 
 @linux_only
+@pytest.mark.slow
 def test_a_second_ctrl_c_ends_at_once(designs, tmp_path):
     out = tmp_path / "out"
     proc = Proc(tmp_path, "package", str(designs), "-o", str(out), "--jobs", "2", "--outputs", FAST)
@@ -192,6 +193,7 @@ def test_a_second_ctrl_c_ends_at_once(designs, tmp_path):
 # ---------------------------------------------------------------------------
 # 2. kill -9 of package: the workers die with it
 @linux_only
+@pytest.mark.slow
 def test_kill_9_of_package_takes_its_workers_along(designs, tmp_path):
     out = tmp_path / "out"
     proc = Proc(tmp_path, "package", str(designs), "-o", str(out), "--jobs", "2", "--outputs", FAST)
@@ -307,6 +309,7 @@ def test_a_locked_folder_is_refused_with_exit_3_naming_it(tmp_path, capsys):
 
 
 @linux_only
+@pytest.mark.slow
 def test_two_packages_into_one_folder(designs, tmp_path):
     out = tmp_path / "out"
     argv = ("package", str(designs), "-o", str(out), "--outputs", FAST)
