@@ -15,14 +15,16 @@ import json
 import logging
 import math
 import os
+import signal
 import sys
+import threading
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from . import pipeline
 from .errors import ApiError, CamfabError, InternalError, MissingDependencyError
-from .io import atomic_write, inside
+from .io import atomic_write, inside, output_folder, write_all
 from .pipeline import Cam, Output, Request
 from .results import Severity, Verdict
 from .textsafe import plain
@@ -32,6 +34,7 @@ __all__ = ["main", "register", "COMMANDS", "UsageError"]
 
 EXIT_OK, EXIT_CHECKS, EXIT_INPUT, EXIT_IO = 0, 1, 2, 3
 EXIT_BROKEN_PIPE = 128 + 13  # 128 + SIGPIPE: what a shell reports for a command whose reader went away
+EXIT_INTERRUPTED = 128 + 2  # 128 + SIGINT: what a shell reports for a command ended by Ctrl-C
 #: every subcommand: name → (run(args) -> exit code, add_arguments(parser), help)
 COMMANDS: dict[str, tuple[Callable[[argparse.Namespace], int], Callable[[argparse.ArgumentParser], None], str]] = {}
 
@@ -157,13 +160,14 @@ def cmd_export(args: argparse.Namespace) -> int:
     if not formats:
         raise UsageError("nothing to export: give --dxf, --step or --stl, or enable them in [outputs]")
     tol = _tol(cam, args.tol)
-    if _refuse_unacceptable(cam, "export", args.force):
-        return EXIT_CHECKS
-    req = Request(frozenset(Output(f) for f in formats), tol=tol, dxf_flavour=args.dxf_flavour,
-                  tool_paths=args.tool_path)
-    arts = [a for out in pipeline.EXPORTERS if out in req.outputs for a in pipeline.EXPORTERS[out](cam, req)]
-    targets = [inside(Path(args.output), a.filename) for a in arts]  # all proved inside -o before any write
-    paths = [atomic_write(t, a.data) for t, a in zip(targets, arts, strict=True)]
+    with output_folder(args.output) as folder:  # created, writable and locked before computing (else exit 3)
+        if _refuse_unacceptable(cam, "export", args.force):
+            return EXIT_CHECKS
+        req = Request(frozenset(Output(f) for f in formats), tol=tol, dxf_flavour=args.dxf_flavour,
+                      tool_paths=args.tool_path)
+        arts = [a for out in pipeline.EXPORTERS if out in req.outputs for a in pipeline.EXPORTERS[out](cam, req)]
+        targets = [inside(folder, a.filename) for a in arts]  # all proved inside -o before any write
+        paths = write_all({t: a.data for t, a in zip(targets, arts, strict=True)})  # all files or none
     print(f"{plain(cam.name)}: verdict {cam.verdict}, tolerance {tol:g} mm")
     print(f"  {'file':<32}{'entities':>10}{'max deviation (mm)':>22}")
     for a, p in zip(arts, paths, strict=True):
@@ -324,6 +328,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(f"  {name:<36}" + ("" if dev is None else f" max deviation {dev:.3g} mm"))
     if res.withheld:
         print(f"  withheld (verdict unacceptable, use --force): {', '.join(res.withheld)}")
+    if res.removed:
+        print(f"  removed (an earlier run's shop files; verdict unacceptable): {', '.join(res.removed)}")
     return _exit(Verdict(res.verdict))
 
 
@@ -464,13 +470,38 @@ def main(argv: list[str] | None = None) -> int:
     if not args.command:
         parser.print_help(sys.stderr)
         return EXIT_INPUT
-    with _log_to_stderr(args.verbose):
-        code = _guarded(args)
+    try:
+        with _log_to_stderr(args.verbose), _first_interrupt_only():
+            code = _guarded(args)
+    except KeyboardInterrupt:  # Ctrl-C: one line, no traceback; what was being written has been removed
+        print(f"camfab {args.command}: interrupted", file=sys.stderr)
+        code = EXIT_INTERRUPTED
     try:
         sys.stdout.flush()  # a pipe closed by the reader shows here when the output fitted in its buffer
     except BrokenPipeError:
         _stdout_to_devnull()
     return code
+
+
+@contextlib.contextmanager
+def _first_interrupt_only():
+    """The first Ctrl-C raises KeyboardInterrupt (the command cleans up and exits 130); it also restores the
+    default action, so a second Ctrl-C ends the process at once.  Only in the main thread, and only where
+    Ctrl-C has Python's default handler (a shell that made the command ignore it is obeyed)."""
+    if threading.current_thread() is not threading.main_thread() or \
+            signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        yield
+        return
+
+    def first(signum: int, frame: Any) -> None:
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+        signal.default_int_handler(signum, frame)  # raises KeyboardInterrupt
+
+    signal.signal(signal.SIGINT, first)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def _stdout_to_devnull() -> None:

@@ -1,17 +1,43 @@
-"""Atomic, deterministic file writes shared by every exporter and the CLI, and the rule that turns a
-design's name into a safe output file name (:func:`safe_stem`, :func:`inside`)."""
+"""Atomic, deterministic file writes shared by every exporter and the CLI, the rule that turns a
+design's name into a safe output file name (:func:`safe_stem`, :func:`inside`), and what keeps an output
+folder whole through faults: one writer at a time (:func:`output_folder`), sets of files written together
+(:func:`write_all`), folders swapped whole (:func:`swap_dir`), leftovers of killed processes removed
+(:func:`clean_stale`)."""
 from __future__ import annotations
 
+import contextlib
+import errno
 import hashlib
 import os
 import re
+import shutil
+import signal
+import sys
 import tempfile
+import threading
 import unicodedata
+from collections.abc import Iterator, Mapping
 from pathlib import Path
+from typing import BinaryIO
 
 from .errors import ExportError
 
-__all__ = ["atomic_write", "safe_stem", "inside", "STEM_MAX"]
+try:
+    import fcntl
+except ImportError:  # Windows: no lock
+    fcntl = None  # type: ignore[assignment]
+
+__all__ = ["atomic_write", "write_all", "write_bytes", "named", "fsync_dir", "safe_stem", "inside", "STEM_MAX",
+           "DURABLE", "LOCK", "TEMP_MARK", "hold_sigint", "leftover_name", "clean_stale", "output_folder",
+           "swap_dir"]
+
+#: fsync every file written and its folder (docs/decisions.md, "Faults: staging, locks, durability")
+DURABLE = True
+#: the lock file of an output folder while a camfab command writes into it
+LOCK = ".camfab.lock"
+#: marks camfab's temporary names: ``.<name>.camfab-<kind>-<pid>[-<random>]``
+TEMP_MARK = ".camfab-"
+_LEFTOVER = re.compile(r"^\..*\.camfab-(tmp|staging|old)-(\d+)(?:-[A-Za-z0-9_]*)?$")
 
 #: longest stem :func:`safe_stem` returns (suffixes such as ``_drawing.dxf`` stay well under 255 bytes)
 STEM_MAX = 100
@@ -69,26 +95,282 @@ def inside(outdir: str | Path, relative: str | Path) -> Path:
     return path
 
 
-def atomic_write(path: str | Path, data: str | bytes) -> Path:
+def atomic_write(path: str | Path, data: str | bytes, *, durable: bool | None = None) -> Path:
     """Write ``data`` to ``path`` through a temporary file and a rename.
 
     A crash or error leaves either the old file or none, never a partial one.
     Text is written as UTF-8 with ``\\n`` line ends, so output is byte-identical
-    across platforms.
+    across platforms.  ``durable`` (default :data:`DURABLE`): the file and its folder
+    are fsynced.  An ``OSError`` names ``path``.
     """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    raw = data.encode("utf-8") if isinstance(data, str) else data
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    return write_all({Path(path): data}, durable=durable)[0]
+
+
+def write_all(files: Mapping[Path, str | bytes], *, durable: bool | None = None) -> list[Path]:
+    """Write several files as one set: every file to a temporary name first, then all renamed.
+
+    A failure while writing (disk full, permission, an interrupt) removes the temporaries and leaves every
+    old file untouched; Ctrl-C is held back during the renames, so an interrupt never leaves half a set.
+    Temporary names are ``.<name>.camfab-tmp-<pid>-<random>`` (:func:`clean_stale` removes those of dead
+    processes).  ``durable`` (default :data:`DURABLE`): each file is fsynced before its rename and each folder
+    after.  An ``OSError`` is re-raised naming the file it was writing.  Returns the paths, in order.
+    """
+    sync = DURABLE if durable is None else durable
+    temps: list[tuple[str, Path]] = []
+    try:
+        for path, data in files.items():
+            raw = data.encode("utf-8") if isinstance(data, str) else data
+            temps.append((_write_temp(Path(path), raw, sync), Path(path)))
+        with hold_sigint():
+            for tmp, path in temps:
+                try:
+                    os.replace(tmp, path)
+                except OSError as exc:
+                    raise named(exc, path) from exc
+    except BaseException:
+        for tmp, _ in temps:
+            Path(tmp).unlink(missing_ok=True)
+        raise
+    if sync:
+        for folder in dict.fromkeys(path.parent for _, path in temps):
+            fsync_dir(folder)
+    return [path for _, path in temps]
+
+
+def _write_temp(path: Path, raw: bytes, sync: bool) -> str:
+    """``raw`` in a new temporary file beside ``path`` (its name returned); nothing left on failure."""
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}{TEMP_MARK}tmp-{os.getpid()}-")
+    except OSError as exc:
+        raise named(exc, path) from exc
     try:
         with os.fdopen(fd, "wb") as fh:
-            fh.write(raw)
+            write_bytes(fh, raw, path)
+            if sync:
+                fh.flush()
+                os.fsync(fh.fileno())
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp creates 0600; give the usual file mode
-        os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         Path(tmp).unlink(missing_ok=True)
+        if isinstance(exc, OSError):
+            raise named(exc, path) from exc
         raise
-    return path
+    return tmp
+
+
+def write_bytes(fh: BinaryIO, raw: bytes, path: Path) -> None:
+    """The one place where camfab's output bytes reach a file: ``raw`` into ``fh``, the temporary file of
+    ``path`` (a test replaces it to inject disk faults)."""
+    fh.write(raw)
+
+
+def named(exc: OSError, path: str | Path, doing: str = "") -> OSError:
+    """``exc`` as an ``OSError`` of the same kind (``PermissionError``, ...) whose message names ``path`` (and
+    what camfab was ``doing``)."""
+    what = f"{exc.strerror or exc}{f' ({doing})' if doing else ''}"
+    if exc.errno is None:
+        return OSError(f"{what}: {str(path)!r}")
+    return OSError(exc.errno, what, str(path))
+
+
+def fsync_dir(folder: str | Path) -> None:
+    """Make a folder's entries (a rename, a new file) durable; a no-op where folders cannot be fsynced."""
+    try:
+        fd = os.open(folder, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:  # some file systems (and Windows) refuse to fsync a folder: nothing more can be done
+        pass
+    finally:
+        os.close(fd)
+
+
+@contextlib.contextmanager
+def hold_sigint() -> Iterator[None]:
+    """Hold SIGINT back while the block runs (it is delivered at the end), on POSIX in the main thread: a set of
+    renames is not cut in half, and processes started inside begin with SIGINT blocked."""
+    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
+# ---------------------------------------------------------------------------
+# leftovers of killed processes, and one writer per output folder
+def leftover_name(name: str, kind: str) -> str:
+    """The name of a temporary entry (``kind``: ``tmp``, ``staging``, ``old``) for ``name``, owned by this
+    process: ``.<name>.camfab-<kind>-<pid>`` (:func:`clean_stale` recognises it)."""
+    return f".{name}{TEMP_MARK}{kind}-{os.getpid()}"
+
+
+def _alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    if os.name != "posix":  # no cheap, safe test: keep the entry
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # exists, owned by someone else
+        return True
+    return True
+
+
+def clean_stale(folder: str | Path, depth: int = 2) -> list[Path]:
+    """Remove camfab's temporary files and staging folders whose process is dead, in ``folder`` and its
+    subfolders down to ``depth`` levels; returns what was removed.  Only names of the
+    :func:`leftover_name` / :func:`write_all` pattern are touched, never another file."""
+    removed: list[Path] = []
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return removed
+    for e in entries:
+        m = _LEFTOVER.match(e.name)
+        if m and not _alive(int(m.group(2))):
+            p = Path(e.path)
+            if e.is_dir(follow_symlinks=False):
+                shutil.rmtree(p, ignore_errors=True)
+            else:
+                p.unlink(missing_ok=True)
+            removed.append(p)
+        elif depth > 0 and e.is_dir(follow_symlinks=False):
+            removed += clean_stale(e.path, depth - 1)
+    return removed
+
+
+@contextlib.contextmanager
+def output_folder(folder: str | Path) -> Iterator[Path]:
+    """Prepare ``folder`` for one camfab command that writes into it, before any computing:
+
+    1. create it (and its parents), then prove it writable with a temporary file: an ``OSError`` naming the
+       folder otherwise (``run -o /proc/x`` fails at once, exit 3);
+    2. take its lock ``<folder>/.camfab.lock`` (``fcntl.flock``, not waiting): a folder another camfab command
+       is writing into raises ``BlockingIOError`` naming it.  The lock file is removed on exit;
+    3. remove the leftovers of killed camfab processes (:func:`clean_stale`).
+
+    On exit the folders it created are removed again if nothing was written into them.  Without ``fcntl``
+    (Windows) there is no lock.
+    """
+    folder = Path(folder)
+    created = _missing_ancestors(folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise named(exc, folder, "cannot create the output folder") from exc
+    try:
+        fd = _lock(folder)
+        try:
+            _probe(folder)
+            clean_stale(folder)
+            yield folder
+        finally:
+            Path(folder, LOCK).unlink(missing_ok=True)  # before the unlock: see _lock
+            os.close(fd)
+            clean_stale(folder)  # what killed workers of this command left
+    finally:
+        for d in created:  # deepest first; stops at the first folder that is not empty
+            try:
+                d.rmdir()
+            except OSError:
+                break
+
+
+def _missing_ancestors(folder: Path) -> list[Path]:
+    """``folder`` and those of its parents that do not exist yet, deepest first."""
+    out = []
+    for d in (folder, *folder.parents):
+        if d.exists() or d.is_symlink():
+            break
+        out.append(d)
+    return out
+
+
+def _lock(folder: Path) -> int:
+    """An open descriptor of ``folder/.camfab.lock`` holding its exclusive lock.
+
+    The lock file is unlinked by its holder before it unlocks, so a descriptor locked after that may belong
+    to an unlinked file: the lock counts only if the path still names the locked file (else try again)."""
+    path = folder / LOCK
+    for _ in range(100):
+        try:
+            fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666)
+        except OSError as exc:
+            raise named(exc, folder, "cannot write into the output folder") from exc
+        if fcntl is None:
+            return fd
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(fd)
+            raise _busy(folder, f"another camfab command is writing into this folder (it holds {LOCK}); wait "
+                                "until it ends, or choose another output folder") from None
+        except BaseException:
+            os.close(fd)
+            raise
+        try:
+            if os.fstat(fd).st_ino == os.stat(path).st_ino:
+                return fd
+        except FileNotFoundError:
+            pass
+        os.close(fd)
+    raise _busy(folder, f"its lock {LOCK} keeps changing hands")
+
+
+def _busy(folder: Path, why: str) -> OSError:
+    """The I/O error (a ``BlockingIOError``, exit code 3) of a folder another camfab command holds."""
+    return OSError(errno.EWOULDBLOCK, why, str(folder))
+
+
+def _probe(folder: Path) -> None:
+    """Create and remove a temporary file in ``folder``: an ``OSError`` naming it if it cannot be written."""
+    try:
+        fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".probe{TEMP_MARK}tmp-{os.getpid()}-")
+        os.close(fd)
+        os.unlink(tmp)
+    except OSError as exc:
+        raise named(exc, folder, "cannot write into the output folder") from exc
+
+
+def swap_dir(new: Path, target: Path) -> None:
+    """Put the folder ``new`` at ``target``, replacing the folder there whole: ``target`` always holds either
+    its old or its new complete contents.  Afterwards ``new`` is gone and the old contents are deleted.
+
+    Linux: one ``renameat2(RENAME_EXCHANGE)``; elsewhere (or where the file system refuses it) ``target`` is
+    first renamed aside, so for an instant it does not exist, but it never holds a mix."""
+    if not target.exists():
+        os.rename(new, target)
+    elif _exchange(new, target):
+        shutil.rmtree(new, ignore_errors=True)  # now the old contents
+    else:
+        aside = target.with_name(leftover_name(target.name, "old"))
+        os.rename(target, aside)
+        os.rename(new, target)
+        shutil.rmtree(aside, ignore_errors=True)
+    if DURABLE:
+        fsync_dir(target.parent)
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Atomically exchange two paths (Linux ``renameat2`` with ``RENAME_EXCHANGE``); False if unavailable."""
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        import ctypes
+
+        fn = ctypes.CDLL(None, use_errno=True).renameat2
+    except (OSError, AttributeError):
+        return False
+    at_fdcwd, rename_exchange = -100, 2
+    return fn(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), rename_exchange) == 0
 
 
 def _umask() -> int:

@@ -20,15 +20,27 @@ job options.  A cam whose key is unchanged and whose files are all present with
 their recorded hashes is not rebuilt.  A design that fails is recorded with its
 error (in the manifest, the index and the exit status) without stopping the
 others.
+
+Faults (docs/decisions.md, "Faults: staging, locks, durability"): the output folder is locked
+while a package is written into it; each cam is written into a staging folder
+``out/.<name>.camfab-staging-<pid>`` and swapped in whole, so a cam folder holds either its old or
+its new complete set; files an earlier package wrote (recorded in its manifest) that the new
+manifest does not list are removed, any other file is kept; worker processes ignore Ctrl-C (the
+parent stops them) and die with their parent.
 """
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import html
 import json
 import logging
 import multiprocessing
 import os
+import shutil
+import signal
+import sys
+import threading
 import time
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import ProcessPoolExecutor
@@ -36,9 +48,10 @@ from pathlib import Path
 
 from .assets import read_template, templates_hash
 from .design.spec import DesignSpec
+from .errors import ExportError, MissingDependencyError
 from .formats import load_design
-from .io import atomic_write, inside, safe_stem
-from .pipeline import Cam, Request, run
+from .io import atomic_write, hold_sigint, inside, leftover_name, output_folder, safe_stem, swap_dir
+from .pipeline import Cam, Request, run, shop_file_names
 from .results import Verdict
 from .textsafe import bounded, plain
 from .version import __version__
@@ -124,35 +137,70 @@ def _read(path: Path, allow_outside_files: bool = False) -> tuple[DesignSpec | N
 
 
 def _build(args: tuple) -> dict:
-    """Worker: build one design into its folder; never raises (errors go into the entry)."""
-    path, out, options, key, spec, stem = args
+    """Worker: build one design into a staging folder and swap it in as ``out/<stem>/``; never raises
+    (errors go into the entry; an interrupt does, after the staging folder is removed)."""
+    path, out, options, key, spec, stem, recorded = args
     from .errors import ApiError, CamfabError, InternalError
 
     t0 = time.perf_counter()
     entry = {"source": str(path), "key": key, "rebuilt": True}
+    staging = folder = None
     try:
         allow = bool(options.get("allow_outside_files"))
         spec = spec if spec is not None else load_design(Path(path), allow_outside_files=allow)
         entry["name"] = spec.name
         folder = inside(out, stem)
+        staging = inside(out, leftover_name(folder.name, "staging"))
+        shutil.rmtree(staging, ignore_errors=True)
         outputs = options.get("outputs")
         req = Request.from_design(spec, outputs, force=options.get("force") or None,
                                   post="linuxcnc" if outputs is not None else None)
-        res = run(Cam(spec), folder, req)
+        cam = Cam(spec)
+        res = run(cam, staging, req, lock=False)
+        _keep_other_files(folder, staging, Path(out), recorded, shop_file_names(cam))
+        swap_dir(staging, folder)
         entry.update(status="unacceptable" if res.verdict == Verdict.UNACCEPTABLE else "ok", verdict=str(res.verdict),
                      tolerance_mm=res.tol, withheld=res.withheld, timings=res.timings,
                      folder=str(folder.relative_to(out)),
-                     files=[_file_entry(p, Path(out), res.deviations.get(n)) for n, p in sorted(res.files.items())])
+                     files=[_file_entry(folder / n, Path(out), res.deviations.get(n)) for n in sorted(res.files)])
     except (ApiError, InternalError) as exc:  # bugs of camfab: recorded as internal failures
         _internal_error(entry, exc)
     except (CamfabError, OSError, ValueError) as exc:
-        entry.update(status="error", verdict=None, error=bounded(str(exc)), files=[],
-                     error_type=type(exc).__name__)
+        kind = "io" if isinstance(exc, OSError) else "dependency" if isinstance(exc, MissingDependencyError) \
+            else "input"
+        error = str(exc) if staging is None else str(exc).replace(str(staging), str(folder))
+        entry.update(status="error", verdict=None, error=bounded(error), files=[], error_type=type(exc).__name__,
+                     error_kind=kind)
     except Exception as exc:  # an internal failure on one design must not lose the others
         _internal_error(entry, exc)
+    finally:
+        if staging is not None:
+            shutil.rmtree(staging, ignore_errors=True)
     entry.setdefault("name", Path(path).stem)
     entry["seconds"] = time.perf_counter() - t0
     return entry
+
+
+def _keep_other_files(folder: Path, staging: Path, out: Path, recorded: frozenset[str], shop: set[str]) -> None:
+    """Carry into ``staging`` the files of the old ``folder`` that camfab did not write: not recorded in the
+    previous manifest, not a shop file of this cam (:func:`~camfab.pipeline.shop_file_names`), not a
+    leftover, not replaced by a new file.  Hard links (copies where the file system has none), so the old
+    folder stays whole until the swap."""
+    if not folder.is_dir():
+        return
+    for root, _dirs, names in os.walk(folder):
+        for name in names:
+            p = Path(root, name)
+            rel = p.relative_to(folder)
+            dest = staging / rel
+            if (p.relative_to(out).as_posix() in recorded or rel.as_posix() in shop or ".camfab-" in name
+                    or dest.exists() or dest.is_symlink()):
+                continue
+            dest.parent.mkdir(parents=True, exist_ok=True)
+            try:
+                os.link(p, dest, follow_symlinks=False)
+            except OSError:
+                shutil.copy2(p, dest, follow_symlinks=False)
 
 
 def _internal_error(entry: dict, exc: Exception) -> None:
@@ -160,7 +208,7 @@ def _internal_error(entry: dict, exc: Exception) -> None:
     import traceback
 
     log.error("%s: internal error (%s: %s)", entry["source"], type(exc).__name__, exc, exc_info=exc)
-    entry.update(status="error", verdict=None, files=[], error_type=type(exc).__name__,
+    entry.update(status="error", verdict=None, files=[], error_type=type(exc).__name__, error_kind="internal",
                  error=bounded(f"internal error ({type(exc).__name__}: {exc}); please report it with this design"),
                  traceback=traceback.format_exc())
 
@@ -187,13 +235,18 @@ def package(paths: Iterable[str | Path], out: str | Path, *, jobs: int = 1, outp
 
     ``outputs`` replaces every design's ``[outputs]`` (None: each design's own); ``force`` writes the shop
     outputs of unacceptable designs too; ``allow_outside_files`` lets designs read knot files outside their
-    folders."""
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
-    say = progress or (lambda m: None)
+    folders.  ``out`` is created, proved writable and locked before any design is read
+    (:func:`camfab.io.output_folder`: an ``OSError`` naming it otherwise)."""
+    with output_folder(out) as folder:
+        return _package(paths, folder, jobs, outputs, force, progress or (lambda m: None), allow_outside_files)
+
+
+def _package(paths: Iterable[str | Path], out: Path, jobs: int, outputs: Sequence[str] | None, force: bool,
+             say: Callable[[str], None], allow_outside_files: bool) -> dict:
     options = {"outputs": sorted(outputs) if outputs is not None else None, "force": force}
     designs = discover(paths)
     old = _old_entries(out)
+    recorded = frozenset(f for e in old.values() for f in _recorded(e))
     templates = templates_hash()
     opts = options if (outputs is not None or force) else {}
     if allow_outside_files:  # only then in the key: the keys of existing packages do not change
@@ -201,7 +254,8 @@ def package(paths: Iterable[str | Path], out: str | Path, *, jobs: int = 1, outp
         opts = {**opts, "allow_outside_files": True}
     read = [(p, *_read(p, allow_outside_files)) for p in designs]
     stems = folders([safe_stem(spec.name if spec is not None else p.stem) for p, spec, _ in read])
-    todo, entries = [], {}
+    todo: list[tuple] = []
+    entries: dict[str, dict] = {}
     for (p, spec, sources), stem in zip(read, stems, strict=True):
         key = input_key(sources, opts, templates) if p.is_file() else "missing"
         prev = old.get(str(p))
@@ -209,20 +263,57 @@ def package(paths: Iterable[str | Path], out: str | Path, *, jobs: int = 1, outp
             entries[str(p)] = {**prev, "rebuilt": False}
             say(f"[up to date] {plain(str(prev.get('name', p.stem)))}")
         else:
-            todo.append((str(p), str(out), options, key, spec, stem))
+            todo.append((str(p), str(out), options, key, spec, stem, recorded))
     if jobs > 1 and len(todo) > 1:  # worker processes read their design again (a program does not pickle)
-        todo = [(*t[:4], None, t[5]) for t in todo]
+        todo = [(*t[:4], None, *t[5:]) for t in todo]
     t0 = time.perf_counter()
-    for done, entry in enumerate(_map(_build, todo, jobs), 1):
-        entries[entry["source"]] = entry
-        first = (entry.get("error") or "").split("\n", 1)[0]  # an empty error has no first line to index
-        tail = entry.get("verdict") or f"ERROR: {first}"
-        say(f"{_bar(done, len(todo))} {done}/{len(todo)} {plain(entry['name'])}: {tail} ({entry['seconds']:.2f} s)")
+    with contextlib.closing(_map(_build, todo, jobs)) as results:
+        for done, entry in enumerate(results, 1):
+            entries[entry["source"]] = entry
+            first = (entry.get("error") or "").split("\n", 1)[0]  # an empty error has no first line to index
+            tail = entry.get("verdict") or f"ERROR: {first}"
+            say(f"{_bar(done, len(todo))} {done}/{len(todo)} {plain(entry['name'])}: {tail} "
+                f"({entry['seconds']:.2f} s)")
     manifest = {"camfab_version": __version__, "jobs": jobs, "wall_seconds": time.perf_counter() - t0,
                 "cams": [entries[str(p)] for p in designs]}
-    atomic_write(out / MANIFEST, json.dumps(manifest, indent=2) + "\n")
-    atomic_write(out / INDEX, _index_html(manifest))
+    _remove_stale(out, old, manifest)
+    failed: list[OSError] = []
+    for name, text in ((MANIFEST, lambda: json.dumps(manifest, indent=2) + "\n"),
+                       (INDEX, lambda: _index_html(manifest))):
+        try:  # the index is still written when the manifest cannot be, and the other way round
+            atomic_write(out / name, text())
+        except OSError as exc:
+            failed.append(exc)
+    if failed:
+        raise failed[0]
     return manifest
+
+
+def _recorded(entry: dict) -> list[str]:
+    """The paths (relative to the package folder, POSIX form) of the files a manifest entry lists."""
+    try:
+        return [Path(f["path"]).as_posix() for f in entry.get("files", [])]
+    except (TypeError, KeyError, AttributeError):
+        return []
+
+
+def _remove_stale(out: Path, old: dict, manifest: dict) -> None:
+    """Remove the files the previous manifest listed that the new one does not (what camfab wrote before:
+    outputs no longer asked for, designs gone or failing now), then the folders this leaves empty.  Files
+    camfab did not record are never touched."""
+    keep = {f for e in manifest["cams"] for f in _recorded(e)}
+    emptied: set[Path] = set()
+    for rel in sorted({f for e in old.values() for f in _recorded(e)} - keep):
+        try:
+            p = inside(out, rel)
+        except ExportError:  # a manifest edited to point outside: ignored
+            continue
+        if p.is_file() or p.is_symlink():
+            p.unlink()
+            emptied.update(d for d in p.parents if d != out and d.is_relative_to(out))
+    for d in sorted(emptied, key=lambda d: len(d.parts), reverse=True):
+        with contextlib.suppress(OSError):
+            d.rmdir()
 
 
 def _bar(done: int, total: int, width: int = 20) -> str:
@@ -237,8 +328,60 @@ def _map(fn, items: list, jobs: int):
         return
     # "spawn": a forked worker can deadlock on locks held by threads of the parent (OCCT, browsers)
     ctx = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=min(jobs, len(items), os.cpu_count() or 1), mp_context=ctx) as pool:
-        yield from pool.map(fn, items)
+    pool = ProcessPoolExecutor(max_workers=min(jobs, len(items), os.cpu_count() or 1), mp_context=ctx,
+                               initializer=_worker_init, initargs=(os.getpid(),))
+    before = set(multiprocessing.active_children())
+    try:
+        with hold_sigint():  # the workers start with Ctrl-C blocked (they ignore it); the parent gets it after
+            results = pool.map(fn, items)
+        yield from results
+    except BaseException:  # Ctrl-C, or the consumer gone: stop the workers now, do not wait for them
+        _stop(pool, [p for p in multiprocessing.active_children() if p not in before])
+        raise
+    pool.shutdown()
+
+
+def _stop(pool: ProcessPoolExecutor, workers: list) -> None:
+    """Terminate the pool's worker processes, cancel what is queued, reap them (killed if they linger)."""
+    for w in workers:
+        w.terminate()
+    pool.shutdown(wait=False, cancel_futures=True)
+    for w in workers:
+        w.join(2.0)
+        if w.is_alive():
+            w.kill()
+            w.join(1.0)
+
+
+def _worker_init(parent: int) -> None:
+    """A worker process ignores Ctrl-C (its parent stops it) and dies with its parent."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    _die_with_parent(parent)
+
+
+def _die_with_parent(parent: int) -> None:
+    """End this process when ``parent`` ends (even by ``kill -9``): Linux ``prctl(PR_SET_PDEATHSIG, SIGKILL)``,
+    then a check that the parent is not already gone; elsewhere a thread that watches the parent."""
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            pr_set_pdeathsig = 1
+            if ctypes.CDLL(None, use_errno=True).prctl(pr_set_pdeathsig, int(signal.SIGKILL), 0, 0, 0) == 0:
+                if os.getppid() != parent:  # the parent died before the prctl
+                    os._exit(1)
+                return
+        except (OSError, AttributeError):
+            pass
+    threading.Thread(target=_watch_parent, args=(parent,), daemon=True, name="camfab-parent-watch").start()
+
+
+def _watch_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(0.5)
+    os._exit(1)
 
 
 def _old_entries(out: Path) -> dict:
@@ -253,9 +396,15 @@ def _old_entries(out: Path) -> dict:
 
 
 def exit_status(manifest: dict) -> int:
-    """2 if any design is invalid, else 1 if any is unacceptable, else 0."""
+    """3 if any design could not be written (an I/O error, a missing dependency), else 2 if any design is
+    invalid, else 1 if any is unacceptable, else 0."""
     st = [e.get("status") for e in manifest["cams"]]
+    if any(e.get("status") == "error" and e.get("error_kind") in ("io", "dependency") for e in manifest["cams"]):
+        return 3
     return 2 if "error" in st else 1 if "unacceptable" in st else 0
+
+
+_ERROR_LABEL = {"io": "I/O error", "dependency": "missing dependency", "internal": "internal error"}
 
 
 def _index_html(manifest: dict) -> str:
@@ -267,6 +416,7 @@ def _index_html(manifest: dict) -> str:
     for e in manifest["cams"]:
         files = {Path(f["path"]).name: f["path"] for f in e.get("files", [])}
         rows.append({"name": e.get("name"), "source": e.get("source"), "status": e.get("status"),
+                     "error_label": _ERROR_LABEL.get(e.get("error_kind", ""), "error"),
                      "verdict": e.get("verdict"), "error": e.get("error"),
                      "report": files.get("report.html"), "files": sorted(files.values()),
                      "withheld": e.get("withheld", [])})

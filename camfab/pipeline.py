@@ -32,11 +32,11 @@ from .design.spec import DesignSpec
 from .discretize import validate_tol
 from .errors import GeometryError, Problem, SpecError
 from .formats import EXAMPLES_DIR, load_design, resolve_design_path
-from .io import atomic_write, inside, safe_stem
+from .io import atomic_write, inside, output_folder, safe_stem, write_all
 from .results import CheckReport, Verdict
 
 __all__ = ["Output", "SHOP_OUTPUTS", "Request", "RunResult", "Cam", "EXPORTERS", "gcode_job", "run", "load",
-           "examples"]
+           "examples", "shop_file_names"]
 
 
 class Output(StrEnum):
@@ -119,6 +119,8 @@ class RunResult:
     timings: dict[str, float] = field(default_factory=dict)
     withheld: list[str] = field(default_factory=list)
     tol: float = 0.0
+    #: shop files an earlier run left in the folder, removed because the verdict is now unacceptable
+    removed: list[str] = field(default_factory=list)
 
 
 # ---------------------------------------------------------------------------
@@ -385,18 +387,32 @@ EXPORTERS: dict[Output, Stage] = {
 }
 
 
-def run(cam: Cam, outdir: str | Path, req: Request, *, progress: Callable[[str], None] | None = None) -> RunResult:
+def run(cam: Cam, outdir: str | Path, req: Request, *, progress: Callable[[str], None] | None = None,
+        lock: bool = True) -> RunResult:
     """Build what ``req`` asks for and write it into ``outdir`` (``check.json`` always).
 
+    Before computing, ``outdir`` is created, proved writable and locked (:func:`camfab.io.output_folder`;
+    ``lock=False``: the caller holds it).  The files are written as one set (:func:`camfab.io.write_all`):
+    all or, on a failure, none.  An unacceptable design's shop files are withheld unless forced, and the shop
+    files an earlier run left in ``outdir`` for this cam are removed (:func:`shop_file_names`).
+
     Raises the usual camfab errors (SpecError, GeometryError, MissingDependencyError) before anything is
-    written.
+    written; an ``OSError`` naming the path it could not write.
     """
     say = progress or (lambda m: None)
     res = RunResult(cam.name, "", tol=cam.tolerance(req.tol))
+    if not lock:
+        return _run(cam, Path(outdir), req, res, say)
+    with output_folder(outdir) as folder:
+        return _run(cam, folder, req, res, say)
+
+
+def _run(cam: Cam, folder: Path, req: Request, res: RunResult, say: Callable[[str], None]) -> RunResult:
     report = _timed(res, "check", say, cam.check)
     res.verdict = report.verdict
     wanted = [o for o in EXPORTERS if o in req.outputs]
-    if report.verdict == Verdict.UNACCEPTABLE and not req.force:
+    refused = report.verdict == Verdict.UNACCEPTABLE and not req.force
+    if refused:
         res.withheld = [str(o) for o in SHOP_OUTPUTS if o in req.outputs]
         wanted = [o for o in wanted if o not in SHOP_OUTPUTS]
     _timed(res, "geometry", say, lambda: cam.geometry)
@@ -406,11 +422,25 @@ def run(cam: Cam, outdir: str | Path, req: Request, *, progress: Callable[[str],
             files[art.filename] = art.data
             if art.kind != "report":
                 res.deviations[art.filename] = art.deviation_mm
-    folder = Path(outdir)
     paths = {name: inside(folder, name) for name in files}  # every path proved inside outdir before any write
-    for name, data in sorted(files.items()):
-        res.files[name] = atomic_write(paths[name], data)
+    names = sorted(files)
+    written = write_all({paths[n]: files[n] for n in names})
+    res.files = dict(zip(names, written, strict=True))
+    if refused:  # a shop must never find G-code beside an unacceptable verdict
+        res.removed = [name for name in sorted(shop_file_names(cam)) if (folder / name).is_file()]
+        for name in res.removed:
+            (folder / name).unlink(missing_ok=True)
     return res
+
+
+def shop_file_names(cam: Cam) -> set[str]:
+    """The names of every shop file (:data:`SHOP_OUTPUTS`) camfab writes for ``cam``: what an unacceptable
+    verdict withholds, and removes when an earlier run left it."""
+    stem = safe_stem(cam.name)
+    n = len(cam.geometry.profiles)
+    per_profile = [f"{stem}{_suffix(i, n)}" for i in range(n)]
+    names = {f"{stem}.dxf", f"{stem}_drawing.dxf", f"{stem}_lift.csv", *([f"{stem}_pair.step"] if n > 1 else [])}
+    return names | {f"{s}.{ext}" for s in per_profile for ext in ("stl", "step", "nc")}
 
 
 def _timed(res: RunResult, stage: str, say: Callable[[str], None], fn: Callable[..., Any], *args: Any) -> Any:
