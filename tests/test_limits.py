@@ -297,3 +297,13 @@ def _export(path: Path, out: Path) -> tuple[int, str, str, float]:
     r = subprocess.run([sys.executable, "-m", "camfab", "export", str(path), "--dxf", "-o", str(out)],
                        capture_output=True, text=True, env=env, timeout=120, preexec_fn=_cap)
     return r.returncode, r.stdout, r.stderr, time.monotonic() - t
+
+
+def test_a_long_bad_line_of_a_knot_file_is_quoted_not_echoed(tmp_path):
+    from camfab.formats import read_knots_csv
+
+    f = tmp_path / "k.csv"
+    f.write_text("angle,s,v,a\n0,0,0,0\n" + "z" * 1_000_000 + "\n")
+    with pytest.raises(SpecError) as e:
+        read_knots_csv(f)
+    assert "line 3: 'zzzz" in str(e.value) and "(1000000 characters)" in str(e.value) and len(str(e.value)) < 600

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..errors import Problem, SpecError
-from ..limits import MAX_LIFT_MM, MAX_SEGMENTS, data_problems
+from ..limits import MAX_LENGTH_MM, MAX_LIFT_MM, MAX_SEGMENTS, data_problems
 from ..units import DEG, RPM
 from .kinds import CamKind, Direction, FollowerMotion, FollowerType, LiftUnit, Rotation
 from .knots import KnotFile, KnotTable, build_knot_table
@@ -379,13 +379,13 @@ def _follower_numbers(v: Validator, t: Mapping[str, Any]) -> dict[str, float | N
     vals: dict[str, float | None] = {}
     for key in _FOLLOWER_FLOATS:
         if key in _POSITIVE:
-            vals[key] = v.number(t, key, "follower", None, lo=0.0, lo_open=True, hi=1e6,
+            vals[key] = v.number(t, key, "follower", None, lo=0.0, lo_open=True, hi=MAX_LENGTH_MM,
                                  fix=f"{key} must be a positive length in mm")
         elif key in _NON_NEGATIVE:
-            vals[key] = v.number(t, key, "follower", None, lo=0.0, hi=1e6,
+            vals[key] = v.number(t, key, "follower", None, lo=0.0, hi=MAX_LENGTH_MM,
                                  fix=f"{key} must be a length >= 0 in mm")
         else:
-            vals[key] = v.number(t, key, "follower", None, lo=-1e6, hi=1e6)
+            vals[key] = v.number(t, key, "follower", None, lo=-MAX_LENGTH_MM, hi=MAX_LENGTH_MM)
     return vals
 
 
@@ -457,7 +457,8 @@ def _segment(v: Validator, r: Mapping[str, Any], p: str, span_key: str) -> Segme
         v.add(f"{p}.{span_key}", None, "is required", f"give {span_key} (or \"auto\" for a half-period law)")
         span = math.nan
     elif span_raw != "auto":
-        span = v.number(r, span_key, p, None, lo=0.0, lo_open=True, hi=360.0 if span_key == "angle_deg" else 1e6)
+        span = v.number(r, span_key, p, None, lo=0.0, lo_open=True,
+                        hi=360.0 if span_key == "angle_deg" else MAX_LENGTH_MM)
         if span is None:
             span = math.nan  # already reported
     return SegmentSpec("" if law is None else str(law), lift, span, r.get("shape"))

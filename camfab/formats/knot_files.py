@@ -35,7 +35,7 @@ from typing import Any, cast
 
 from ..design.knots import KnotFile, KnotTable, build_knot_table
 from ..errors import InputError, Problem, SpecError
-from ..limits import MAX_KNOTS, MAX_SHEET_ROWS
+from ..limits import MAX_KNOTS, MAX_SHEET_ROWS, preview
 from .input_limits import check_xlsx, first_rows, read_text_limited
 
 __all__ = [
@@ -186,7 +186,7 @@ def _parse_rows(lines: list[tuple[int, str]], sep: str | None, dc: bool) -> list
         except ValueError:
             if i == 0 and len(lines) > 1:
                 continue  # header
-            raise InputError(f"line {no}: {text.strip()!r} is not a row of numbers") from None
+            raise InputError(f"line {no}: {preview(text.strip(), 80)!r} is not a row of numbers") from None
     return rows
 
 
