@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from . import pipeline
-from .errors import ApiError, CamfabError, InternalError, MissingDependencyError
+from .errors import ApiError, CamfabError, InternalError, MissingDependencyError, SpecError
 from .io import atomic_write, inside, output_folder, write_all
 from .pipeline import Cam, Output, Request
 from .results import Severity, Verdict
@@ -66,6 +66,8 @@ def _cam(name: str) -> Cam:
 def _tol(cam: Cam, value: float | None) -> float:
     try:
         return cam.tolerance(value)
+    except SpecError:  # the design's own tolerance_mm: its field path, not the option
+        raise
     except ValueError as exc:
         raise UsageError(f"--tol {value}: {exc}") from None
 
@@ -532,6 +534,8 @@ def _guarded(args: argparse.Namespace) -> int:
         raise
     except CamfabError as exc:
         print(f"camfab {args.command}: error: {exc}", file=sys.stderr)
+        if isinstance(exc, SpecError) and getattr(args, "json", False):  # every problem, machine-readable
+            print(json.dumps(exc.to_dict(), indent=2))
         return EXIT_INPUT
     except OSError as exc:
         print(f"camfab {args.command}: I/O error: {exc}", file=sys.stderr)

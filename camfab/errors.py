@@ -14,6 +14,7 @@ fails on a ``raise`` of a builtin exception anywhere in the package.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -65,6 +66,13 @@ class Problem:
         text = f"{self.path} = {shown(self.value)}: {self.rule}"
         return f"{text}; {self.fix}" if self.fix else text
 
+    def to_dict(self) -> dict[str, Any]:
+        """``{"path", "value", "rule", "fix"}``; a value strict JSON cannot hold (NaN, a list…) as its text."""
+        v = self.value
+        ok = v is None or isinstance(v, (str, int, bool)) or (isinstance(v, float) and math.isfinite(v))
+        return {"path": self.path, "value": v if ok else repr(v), "rule": self.rule,
+                "fix": self.fix}
+
 
 class SpecError(CamfabError, ValueError):
     """Invalid design input; carries every problem found, not only the first."""
@@ -79,6 +87,10 @@ class SpecError(CamfabError, ValueError):
         lines = [f"{head}{n} problem{'s' if n != 1 else ''} in the design:"]
         lines += [f"  - {p}" for p in self.problems]
         super().__init__("\n".join(lines))
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``--json`` form of the error: ``{"error": "invalid_design", "source", "problems": [...]}``."""
+        return {"error": "invalid_design", "source": self.source, "problems": [p.to_dict() for p in self.problems]}
 
 
 class GeometryError(CamfabError):

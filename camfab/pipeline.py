@@ -30,9 +30,10 @@ from .design.mechanisms import geometry_from_spec
 from .design.profile import CamGeometry, ProfileSample
 from .design.spec import DesignSpec
 from .discretize import validate_tol
-from .errors import GeometryError, Problem, SpecError
+from .errors import GeometryError, InputError, Problem, SpecError
 from .formats import EXAMPLES_DIR, load_design, resolve_design_path
 from .io import atomic_write, inside, output_folder, safe_stem, write_all
+from .limits import MAX_SIZE_OVER_TOL
 from .results import CheckReport, Verdict
 
 __all__ = ["Output", "SHOP_OUTPUTS", "Request", "RunResult", "Cam", "EXPORTERS", "gcode_job", "run", "load",
@@ -178,8 +179,19 @@ class Cam:
         return self.check().verdict
 
     def tolerance(self, tol: float | None = None) -> float:
-        """``tol`` or the design's tolerance, validated (mm)."""
-        return validate_tol(self.spec.manufacturing.tolerance_mm if tol is None else tol)
+        """``tol`` or the design's tolerance, validated (mm): within the accepted range, and no finer than
+        1/:data:`~camfab.limits.MAX_SIZE_OVER_TOL` of the cam's largest radius (``docs/decisions.md``,
+        "Input limits")."""
+        t = validate_tol(self.spec.manufacturing.tolerance_mm if tol is None else tol)
+        size = self.geometry.max_radius
+        if size > t * MAX_SIZE_OVER_TOL:
+            rule = (f"{t:g} mm is finer than 1/{MAX_SIZE_OVER_TOL:.0e} of the cam's largest radius {size:.6g} mm "
+                    "(the input limit: no machine holds it, and the fit's cost grows with the ratio)")
+            fix = f"give a tolerance of at least {size / MAX_SIZE_OVER_TOL:.2g} mm"
+            if tol is None:
+                raise SpecError(Problem("manufacturing.tolerance_mm", t, rule, fix), self.spec.source)
+            raise InputError(f"{rule}; {fix}")
+        return t
 
     def shapes(self, tol: float | None = None) -> CamShapes:
         """Every profile arc-fitted within ``tol`` (and the pitch curves), measured; once per tolerance."""

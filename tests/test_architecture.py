@@ -16,12 +16,13 @@ PACKAGE = ROOT / "camfab"
 #: what each part of the package may import from camfab (module-name prefixes); a module not listed here
 #: fails the test, so a new package must take its place in the layers
 BASE = ("camfab.version", "camfab.errors", "camfab.units", "camfab.tolerances", "camfab.results", "camfab.numeric",
-        "camfab.geom2d", "camfab.textsafe")
+        "camfab.geom2d", "camfab.textsafe", "camfab.limits")
 LAYERS: dict[str, tuple[str, ...]] = {
     "camfab.version": (),
     "camfab.errors": (),
     "camfab.units": (),
     "camfab.tolerances": (),
+    "camfab.limits": ("camfab.errors",),
     "camfab.io": ("camfab.errors",),
     "camfab.textsafe": (),
     "camfab.assets": ("camfab.errors",),

@@ -74,6 +74,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import Problem, SpecError
+from ..limits import MAX_KNOTS, MAX_LIFT_MM
 from ..results import Finding, IssueCode, Severity
 from ..tolerances import ANGLE_SUM_TOL_DEG
 from ..units import DEG, rpm_to_rad_s
@@ -384,6 +385,10 @@ def _rows_array(rows: Any, degree: int, path: str, problems: list[Problem]) -> n
     if isinstance(rows, (str, bytes)) or not isinstance(rows, Sequence) or len(rows) == 0:
         problems.append(Problem(p, rows, "the knot table has no rows", "give rows = [[angle, s, v, a], ...]"))
         return None
+    if len(rows) > MAX_KNOTS:  # not read further (docs/decisions.md, "Input limits")
+        problems.append(Problem(p, f"{len(rows)} rows", f"more than the limit of {MAX_KNOTS} knots",
+                                f"give at most {MAX_KNOTS} knots (a 0.1° table has 3600; thin a denser one out)"))
+        return None
     out = np.full((len(rows), 5), np.nan)
     for i, row in enumerate(rows):
         if isinstance(row, (str, bytes)) or not isinstance(row, Sequence) or len(row) not in (4, 5):
@@ -440,6 +445,46 @@ def _check_closure(raw: np.ndarray, degree: int, full: str, p: str, problems: li
                                 "(the table then closes from its last row back to row 0)"))
 
 
+def _knot_intervals(angles: np.ndarray) -> np.ndarray | None:
+    """Per knot, the longer of the two segments it bounds (radians, the closing segment included); None
+    when the angles do not increase strictly from 0 to at most 2π (reported by the cycle rules)."""
+    seg = np.diff(angles)
+    if angles[0] != 0.0 or not np.all(seg > 0) or angles[-1] > TWO_PI * (1 + 1e-12):
+        return None
+    if abs(angles[-1] - TWO_PI) > ANGLE_SUM_TOL_DEG * DEG or len(angles) == 1:
+        seg = np.append(seg, TWO_PI - angles[-1])  # the closing segment back to row 0
+    i = np.arange(len(angles))
+    m = len(seg)
+    return np.maximum(seg[np.minimum(i, m - 1)], seg[(i - 1) % m])
+
+
+def _check_magnitudes(raw: np.ndarray, units: Mapping[str, str], omega: float, degree: int, path: str,
+                      problems: list[Problem]) -> None:
+    """The input limits of knot values (``docs/decisions.md``, "Input limits"): s within
+    :data:`~camfab.limits.MAX_LIFT_MM`, and each derivative no larger than one that alone would move the
+    follower that far over the knot's own interval g: |S⁽ᵏ⁾|·gᵏ/k! ≤ MAX_LIFT_MM (per radian)."""
+    p = f"{path}.rows"
+    angle_factor = DEG if units.get("angle", "deg") == "deg" else 1.0
+    with np.errstate(over="ignore", invalid="ignore"):
+        s_mm = np.abs(raw[:, 1] * _LENGTH_MM.get(units.get("s", "mm"), 1.0))
+        for i in np.flatnonzero(s_mm > MAX_LIFT_MM):
+            problems.append(Problem(f"{p}[{i}][1]", float(raw[i, 1]), f"s is {s_mm[i]:.6g} mm, beyond the "
+                                    f"input limit of {MAX_LIFT_MM:g} mm", "check the value and the units of s"))
+        g = _knot_intervals(raw[:, 0] * angle_factor)
+        if g is None:
+            return
+        for k in range(1, 4 if degree == 7 else 3):
+            unit = units.get(COLUMNS[k + 1])
+            f = _factor(unit, k + 1, omega) if unit else math.nan
+            move = np.abs(raw[:, k + 1] * f) * g**k / math.factorial(k)
+            for i in np.flatnonzero(move > MAX_LIFT_MM):
+                problems.append(Problem(
+                    f"{p}[{i}][{k + 1}]", float(raw[i, k + 1]),
+                    f"{COLUMNS[k + 1]} = {raw[i, k + 1]:.6g} {unit} alone would move the follower {move[i]:.3g} mm "
+                    f"over its knot interval ({math.degrees(g[i]):.6g}°), beyond the input limit of "
+                    f"{MAX_LIFT_MM:g} mm", f"check the value and the units of {COLUMNS[k + 1]}"))
+
+
 def _build(rows: Any, units: Any, speed: Any, degree: Any, path: str, source: str | None,
            problems: list[Problem]) -> KnotTable:
     if isinstance(degree, bool) or degree not in (5, 7):
@@ -453,6 +498,7 @@ def _build(rows: Any, units: Any, speed: Any, degree: Any, path: str, source: st
     raw = _rows_array(rows, degree, path, problems) if rows is not None or not problems else None
     if raw is not None:
         _check_cycle(raw, degree, resolved["angle"], path, problems)
+        _check_magnitudes(raw, resolved, omega, degree, path, problems)
     if problems:
         raise SpecError(problems, source)
     assert raw is not None

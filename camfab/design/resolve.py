@@ -1,9 +1,11 @@
 """Validation and resolution of segment inputs into the segments of a motion program.
 
-Every rule of the CAM-DAS data entry is checked and **all** problems of a stage are
-reported together, each naming its field path (``motion[3].angle_deg``), the value, the
-rule and a fix:
+Every rule of the CAM-DAS data entry is checked and **all** problems are reported
+together, each naming its field path (``motion[3].angle_deg``), the value, the rule and a
+fix.  Rules 1–3 are judged in one pass (a chain or closure rule wherever the segments it
+involves are valid); rule 4 needs the resolved motion, so it waits for 1–3 to pass:
 
+0. at most :data:`~camfab.limits.MAX_SEGMENTS` segments (``docs/decisions.md``, "Input limits");
 1. each segment alone: a known law, a finite and sensible lift (0 for a dwell), a positive span (or
    ``"auto"`` for a half-period law with a lift), a double-harmonic ``shape``;
 2. the chain: the first segment is not a return; two generic polynomials are never
@@ -23,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import Problem, SpecError
+from ..limits import MAX_LIFT_MM, MAX_SEGMENTS
 from ..tolerances import ANGLE_SUM_TOL_DEG
 from .extrema import segment_candidates
 from .laws import GENERIC, HALF_PERIOD, LAWS, get_law, law_names
@@ -88,8 +91,8 @@ def _lift_problems(i: int, s: SegmentInput, ctx: _Context) -> list[Problem]:
     p = f"{ctx.path}[{i}].lift"
     if not math.isfinite(s.lift):
         return [Problem(p, s.lift, "lift must be a finite number", "give the lift in mm or degrees")]
-    if abs(s.lift) > 1e5:
-        return [Problem(p, s.lift, "lift magnitude is absurd (> 1e5)",
+    if abs(s.lift) > MAX_LIFT_MM:
+        return [Problem(p, s.lift, f"lift magnitude is absurd (> {MAX_LIFT_MM:g})",
                         "check the units: lift is in mm (translating) or degrees (oscillating)")]
     if s.law == "dwell" and s.lift != 0:  # the follower would step by the lift at the next junction
         return [Problem(p, s.lift, "a dwell does not move the follower",
@@ -195,19 +198,24 @@ def _spans(inputs: Sequence[SegmentInput], laws: list[str], ctx: _Context,
 
 
 # ---- 3. closure
-def _closure_problems(inputs: Sequence[SegmentInput], spans: list[float], period: float,
-                      ctx: _Context) -> list[Problem]:
+def _closure_problems(inputs: Sequence[SegmentInput], spans: Sequence[float | None], period: float,
+                      ctx: _Context, *, lifts: bool = True) -> list[Problem]:
+    """The spans sum to the period and the lifts (when ``lifts``) to 0, each judged when all its terms are
+    known and valid."""
     out, to_user, key = [], ctx.to_user, ctx.span_key
-    total = sum(spans)
-    tol = ANGLE_SUM_TOL_DEG if ctx.unit != "mm" else 1e-9
-    if abs(to_user(total) - to_user(period)) > tol:
-        out.append(Problem(f"{ctx.path}[*].{key}", round(to_user(total), 12),
-                           f"segment spans must sum to {to_user(period):.12g}",
-                           f"change the spans by {to_user(period - total):+.12g} in total"))
-    net = sum(s.lift for s in inputs)
-    if abs(net) > 1e-9 * max(1.0, max(abs(s.lift) for s in inputs)):
-        out.append(Problem(f"{ctx.path}[*].lift", round(net, 12), "lifts must sum to 0 so the cycle closes",
-                           f"change the lifts by {-net:+.12g} in total"))
+    if all(sp is not None and math.isfinite(sp) and sp > 0 for sp in spans):
+        total = sum(spans)  # type: ignore[arg-type]
+        tol = ANGLE_SUM_TOL_DEG if ctx.unit != "mm" else 1e-9
+        if abs(to_user(total) - to_user(period)) > tol:
+            out.append(Problem(f"{ctx.path}[*].{key}", round(to_user(total), 12),
+                               f"segment spans must sum to {to_user(period):.12g}",
+                               f"change the spans by {to_user(period - total):+.12g} in total"))
+    values = [s.lift for s in inputs]
+    if lifts and all(math.isfinite(h) for h in values):
+        net = sum(values)
+        if abs(net) > 1e-9 * max(1.0, max(abs(h) for h in values)):
+            out.append(Problem(f"{ctx.path}[*].lift", round(net, 12), "lifts must sum to 0 so the cycle closes",
+                               f"change the lifts by {-net:+.12g} in total"))
     return out
 
 
@@ -254,9 +262,29 @@ def _below_zero_problems(segs: Sequence[Segment], ctx: _Context) -> list[Problem
     return out
 
 
+def _known_laws(inputs: Sequence[SegmentInput], bad: set[int]) -> list[str | None]:
+    """The resolved law key of every segment whose own inputs are valid (None for the others)."""
+    return [None if i in bad else s.law if s.law in GENERIC else get_law(s.law, s.lift, s.shape).name
+            for i, s in enumerate(inputs)]
+
+
+def _count_problems(inputs: Sequence[SegmentInput], ctx: _Context) -> list[Problem]:
+    if len(inputs) == 0:
+        return [Problem(ctx.path, [], "the program has no segments",
+                        "add [[motion]] segments whose spans sum to the cycle")]
+    if len(inputs) > MAX_SEGMENTS:
+        return [Problem(ctx.path, f"{len(inputs)} segments", f"more than the limit of {MAX_SEGMENTS} segments",
+                        "join consecutive segments, or give the motion as a knot table ([motion_table])")]
+    return []
+
+
 def resolve_segments(inputs: Sequence[SegmentInput], *, period: float, unit: str = "rad",
                      path: str = "motion", source: str | None = None) -> tuple[Segment, ...]:
     """Validate segment inputs (rules in the module docstring) and resolve them into segments.
+
+    Every rule that can be judged is judged in one pass: each segment's own inputs, the chain rules among
+    segments whose inputs are valid, the half-period spans once every input is valid, and the closure of the
+    spans and of the lifts whenever they are all known.  Only S ≥ 0 waits for a motion without problems.
 
     Parameters
     ----------
@@ -271,18 +299,25 @@ def resolve_segments(inputs: Sequence[SegmentInput], *, period: float, unit: str
     Raises
     ------
     SpecError
-        With every problem of the first stage that has any.
+        With every problem found.
     """
     ctx = _Context(path, unit, source)
-    if len(inputs) == 0:
-        raise SpecError(Problem(path, [], "the program has no segments",
-                                "add [[motion]] segments whose spans sum to the cycle"), source)
-    ctx.raise_if([p for i, s in enumerate(inputs) for rule in _INPUT_RULES for p in rule(i, s, ctx)])
-    laws = [get_law(s.law, s.lift, s.shape).name if s.law not in GENERIC else s.law for s in inputs]
-    problems = _first_problems(inputs, ctx) + _adjacent_generic_problems(inputs, laws, ctx)
-    spans = _spans(inputs, laws, ctx, problems)
+    ctx.raise_if(_count_problems(inputs, ctx))
+    problems: list[Problem] = []
+    bad: set[int] = set()
+    for i, s in enumerate(inputs):
+        own = [p for rule in _INPUT_RULES for p in rule(i, s, ctx)]
+        problems += own
+        if own:
+            bad.add(i)
+    laws = _known_laws(inputs, bad)
+    spans = _spans(inputs, laws, ctx, problems) if not bad else [s.span for s in inputs]  # type: ignore[arg-type]
+    judged = [p.path.rpartition(".")[2] for p in problems]  # a term already reported is not summed
+    first = _first_problems(inputs, ctx) if 0 not in bad else []
+    problems += first + _adjacent_generic_problems(inputs, laws, ctx)  # type: ignore[arg-type]
+    problems += _closure_problems(inputs, spans if ctx.span_key not in judged else [None], period, ctx,
+                                  lifts="lift" not in judged)
     ctx.raise_if(problems)
-    ctx.raise_if(_closure_problems(inputs, spans, period, ctx))  # type: ignore[arg-type]
     segs = _segments(inputs, laws, spans, period)  # type: ignore[arg-type]
     ctx.raise_if(_below_zero_problems(segs, ctx))
     return segs

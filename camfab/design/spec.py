@@ -12,16 +12,18 @@ from __future__ import annotations
 
 import difflib
 import functools
-from collections.abc import Mapping
+import math
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 from ..errors import Problem, SpecError
+from ..limits import MAX_LENGTH_MM, MAX_LIFT_MM, MAX_SEGMENTS, data_problems
 from ..units import DEG, RPM
 from .kinds import CamKind, Direction, FollowerMotion, FollowerType, LiftUnit, Rotation
 from .knots import KnotFile, KnotTable, build_knot_table
 from .laws import law_names
-from .mechanisms import MECHANISMS, mechanism_class
+from .mechanisms import MECHANISMS, mechanism_class, mechanism_from_spec
 from .program import TWO_PI, MotionProgram, SegmentInput, build_program
 from .shop import (
     POSTS,
@@ -236,16 +238,52 @@ def design_from_dict(data: Mapping[str, Any], *, source: str | None = None) -> D
     SpecError
         Every problem found, each with its field path, value, rule and fix.
     """
+    over = data_problems(data) if isinstance(data, Mapping) else []
+    if over:  # nothing more is read from a design beyond the input limits
+        raise SpecError(over, source)
     v = Validator()
     spec = _validate(v, data, source)
-    if not v.problems:
-        try:
-            spec.program()
-        except SpecError as exc:
-            v.problems.extend(exc.problems)
-    if v.problems:
-        raise SpecError(v.problems, source)
+    problems = list(v.problems)
+    program = _program_problems(spec, problems)
+    _mechanism_problems(spec, program, problems)
+    if problems:
+        raise SpecError(problems, source)
     return spec
+
+
+def _merge(problems: list[Problem], more: Sequence[Problem]) -> None:
+    """Add the problems of a later rule, leaving out a field already reported (its first report stands)."""
+    seen = {p.path for p in problems}
+    problems.extend(p for p in more if p.path not in seen)
+
+
+def _program_problems(spec: DesignSpec, problems: list[Problem]) -> MotionProgram | None:
+    """The motion program, built whatever the other sections hold, its problems merged into ``problems``;
+    None when it cannot be built, or when the sections it reads are broken ([[motion]] / [motion_table] as
+    a whole, the cam kind, or the follower of a constant-width/diameter cam, whose law it sets)."""
+    paths = {p.path for p in problems}
+    if paths & {"motion", "motion_table", "cam.kind"} or (
+            spec.cam.kind.symmetric and any(p.startswith("follower.") for p in paths)):
+        return None
+    try:
+        return spec.program()
+    except SpecError as exc:
+        _merge(problems, exc.problems)
+        return None
+
+
+def _mechanism_problems(spec: DesignSpec, program: MotionProgram | None, problems: list[Problem]) -> None:
+    """The mechanism's rules (``docs/decisions.md``: every family's dimensions, then those that need the
+    motion), judged once [cam] and [follower] are valid; merged into ``problems``."""
+    if any(p.path.startswith(("cam.", "follower.")) for p in problems):
+        return
+    if mechanism_class(spec.cam.kind, spec.follower.type, spec.follower.motion) is None:
+        return
+    mech = mechanism_from_spec(spec)
+    found = mech.validate()
+    if not found and program is not None:
+        found = mech.validate_motion(program, bore_mm=spec.manufacturing.bore_mm or None)
+    _merge(problems, found)
 
 
 def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> DesignSpec:
@@ -341,13 +379,13 @@ def _follower_numbers(v: Validator, t: Mapping[str, Any]) -> dict[str, float | N
     vals: dict[str, float | None] = {}
     for key in _FOLLOWER_FLOATS:
         if key in _POSITIVE:
-            vals[key] = v.number(t, key, "follower", None, lo=0.0, lo_open=True, hi=1e6,
+            vals[key] = v.number(t, key, "follower", None, lo=0.0, lo_open=True, hi=MAX_LENGTH_MM,
                                  fix=f"{key} must be a positive length in mm")
         elif key in _NON_NEGATIVE:
-            vals[key] = v.number(t, key, "follower", None, lo=0.0, hi=1e6,
+            vals[key] = v.number(t, key, "follower", None, lo=0.0, hi=MAX_LENGTH_MM,
                                  fix=f"{key} must be a length >= 0 in mm")
         else:
-            vals[key] = v.number(t, key, "follower", None, lo=-1e6, hi=1e6)
+            vals[key] = v.number(t, key, "follower", None, lo=-MAX_LENGTH_MM, hi=MAX_LENGTH_MM)
     return vals
 
 
@@ -386,12 +424,19 @@ def _motion(v: Validator, data: Mapping[str, Any],
     if not isinstance(rows, list) or not all(isinstance(r, Mapping) for r in rows):
         v.add("motion", rows, "must be an array of tables", "write each segment as a [[motion]] block")
         return None, None
+    if len(rows) > MAX_SEGMENTS:  # not read further (docs/decisions.md, "Input limits")
+        v.add("motion", f"{len(rows)} segments", f"more than the limit of {MAX_SEGMENTS} segments",
+              "join consecutive segments, or give the motion as a knot table ([motion_table])")
+        return None, None
     span_key = "length_mm" if cam.kind == CamKind.TRANSLATING else "angle_deg"
     return tuple(_segment(v, r, f"motion[{i}]", span_key) for i, r in enumerate(rows)), None
 
 
 def _segment(v: Validator, r: Mapping[str, Any], p: str, span_key: str) -> SegmentSpec:
-    """One ``[[motion]]`` segment; its span is in ``span_key`` (degrees, or mm on a translating cam)."""
+    """One ``[[motion]]`` segment; its span is in ``span_key`` (degrees, or mm on a translating cam).
+
+    A value reported here is kept as written (a law) or as NaN (a number), so that the program's own rules
+    skip it (and do not report it again) while judging the rest."""
     v.keys(r, _SEGMENT_KEYS, p)
     law = r.get("law", "dwell" if r.get("lift", 0) == 0 else None)
     laws = law_names()
@@ -399,8 +444,10 @@ def _segment(v: Validator, r: Mapping[str, Any], p: str, span_key: str) -> Segme
         close = difflib.get_close_matches(str(law), laws, n=1)
         v.add(f"{p}.law", law, "unknown motion law" if law is not None else "is required",
               f"did you mean '{close[0]}'?" if close else "use one of: " + ", ".join(laws))
-        law = "dwell"
-    lift = v.number(r, "lift", p, 0.0, lo=-1e5, hi=1e5)
+    n = len(v.problems)
+    lift = v.number(r, "lift", p, 0.0, lo=-MAX_LIFT_MM, hi=MAX_LIFT_MM)
+    if len(v.problems) > n:
+        lift = math.nan
     other = "angle_deg" if span_key == "length_mm" else "length_mm"
     if other in r:
         v.add(f"{p}.{other}", r[other], f"this cam measures segments in {span_key}", f"rename it to {span_key}")
@@ -408,11 +455,13 @@ def _segment(v: Validator, r: Mapping[str, Any], p: str, span_key: str) -> Segme
     span = None
     if span_raw is None:
         v.add(f"{p}.{span_key}", None, "is required", f"give {span_key} (or \"auto\" for a half-period law)")
+        span = math.nan
     elif span_raw != "auto":
-        span = v.number(r, span_key, p, None, lo=0.0, lo_open=True, hi=360.0 if span_key == "angle_deg" else 1e6)
+        span = v.number(r, span_key, p, None, lo=0.0, lo_open=True,
+                        hi=360.0 if span_key == "angle_deg" else MAX_LENGTH_MM)
         if span is None:
-            span = 1.0  # already reported; keep going to collect the other problems
-    return SegmentSpec(str(law), lift, span, r.get("shape"))
+            span = math.nan  # already reported
+    return SegmentSpec("" if law is None else str(law), lift, span, r.get("shape"))
 
 
 # ---------------------------------------------------------------------------

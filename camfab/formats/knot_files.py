@@ -48,7 +48,9 @@ from typing import Any, cast
 
 from ..design.knots import KnotFile, KnotTable, build_knot_table
 from ..errors import InputError, Problem, SpecError
+from ..limits import MAX_KNOTS, MAX_SHEET_ROWS
 from ..textsafe import excerpt
+from .input_limits import check_xlsx, first_cells, read_text_limited
 
 __all__ = [
     "TEXT_SUFFIXES",
@@ -257,7 +259,7 @@ def read_knots_csv(path: str | Path, *, field: str = "motion_table.file") -> lis
     """
     file = Path(path)
     try:
-        text = file.read_text(encoding="utf-8-sig")
+        text = read_text_limited(file, field=field, encoding="utf-8-sig")
     except FileNotFoundError:
         raise _file_error(field, file, "file not found", "check the path (relative paths are "
                           "resolved against the design file's folder)") from None
@@ -268,12 +270,20 @@ def read_knots_csv(path: str | Path, *, field: str = "motion_table.file") -> lis
              if ln.strip() and not ln.lstrip().startswith(("#", "%"))]
     if not lines:
         raise _file_error(field, file, "the file holds no knot rows", "add rows: angle, s, v, a[, j]")
+    _check_count(len(lines) - 1, field, file)  # one line may be a header
     try:
         rows = _parse_lines(lines)
     except ValueError as exc:
         raise _file_error(field, file, str(exc), "write one knot per line: angle, s, v, a[, j] "
                           "(separated by ',', ';' or spaces; one optional header line)") from None
     return rows
+
+
+def _check_count(n: int, field: str, file: Path) -> None:
+    """Refuse a knot file of more than :data:`~camfab.limits.MAX_KNOTS` rows before parsing them."""
+    if n > MAX_KNOTS:
+        raise _file_error(field, file, f"the file holds {n:,} knot rows, more than the limit of {MAX_KNOTS:,}",
+                          f"give at most {MAX_KNOTS:,} knots (a 0.1° table has 3,600; thin a denser one out)")
 
 
 def _cell_number(x: Any) -> float | None:
@@ -305,6 +315,7 @@ def read_knots_xlsx(path: str | Path, *, field: str = "motion_table.file") -> li
     cells = [(no, r) for no, r in cells if any(c is not None and str(c).strip() for c in r)]
     if cells and any(isinstance(c, str) and _cell_number(c) is None for c in cells[0][1]):
         cells = cells[1:]
+    _check_count(len(cells), field, file)
     if not cells:
         raise _file_error(field, file, "the first sheet holds no knot rows",
                           "put angle, s, v, a[, j] in columns A–E")
@@ -329,15 +340,19 @@ def _xlsx_cells(file: Path, fld: str) -> list[tuple[int, tuple[Any, ...]]]:
     if not file.is_file():
         raise _file_error(fld, file, "file not found", "check the path (relative paths are resolved "
                           "against the design file's folder)")
+    check_xlsx(file, field=fld)
     try:  # formulas as written, not their cached values: a formula is refused below
         wb = openpyxl.load_workbook(file, read_only=True, data_only=False)
         try:
-            rows = [(no, tuple(r)) for no, r in enumerate(wb.worksheets[0].iter_rows(max_col=5), 1)]
+            rows = first_cells(wb.worksheets[0], max_col=5)  # columns A–E are read, F… ignored
         finally:
             wb.close()
     except Exception as exc:  # openpyxl raises many types for a damaged file
         raise _file_error(fld, file, f"not a readable xlsx workbook ({exc.__class__.__name__}: {exc})",
                           "re-save it as .xlsx from a spreadsheet program, or export the table as CSV") from None
+    if rows is None:
+        raise _file_error(fld, file, f"the first sheet spans more than {MAX_SHEET_ROWS:,} rows (the input limit)",
+                          f"give at most {MAX_KNOTS:,} knots, without far-away stray cells")
     formulas = [c.coordinate for _, r in rows for c in r if getattr(c, "data_type", None) == "f"]
     if formulas:
         listed = ", ".join(formulas[:20]) + (" …" if len(formulas) > 20 else "")

@@ -14,6 +14,8 @@ from typing import Any
 
 from ..design.spec import DesignSpec, design_from_dict
 from ..errors import Problem, SpecError
+from ..limits import MAX_NESTING
+from .input_limits import read_text_limited
 from .knot_files import resolve_knot_file
 
 __all__ = ["design_from_data", "load_design_toml"]
@@ -26,12 +28,12 @@ def load_design_toml(path: str | Path, *, allow_outside_files: bool = False) -> 
     Raises
     ------
     SpecError
-        A missing, unreadable or non-TOML file (naming the file and the line), or every problem
-        of the design.
+        A missing, unreadable, non-TOML or over-limit file (naming the file and the line), or every
+        problem of the design.
     """
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8")
+        text = read_text_limited(p, field="file")
     except FileNotFoundError:
         raise SpecError(Problem("file", str(p), "no such design file", "check the path"), str(p)) from None
     except (OSError, UnicodeDecodeError) as exc:
@@ -42,6 +44,10 @@ def load_design_toml(path: str | Path, *, allow_outside_files: bool = False) -> 
     except tomllib.TOMLDecodeError as exc:
         raise SpecError(Problem("file", p.name, f"is not valid TOML: {exc}",
                                 "fix the TOML syntax at the line named"), str(p)) from None
+    except RecursionError:  # tomllib parses nested brackets recursively
+        raise SpecError(Problem("file", p.name, f"nesting too deep (more than {MAX_NESTING} levels of tables "
+                                "and arrays)", "a design nests at most motion_table.rows[i][k]; remove the "
+                                "extra brackets"), str(p)) from None
     data.setdefault("name", p.stem)
     return design_from_data(data, source=str(p), base_dir=p.parent, allow_outside_files=allow_outside_files)
 

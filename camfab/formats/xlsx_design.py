@@ -55,6 +55,7 @@ from ..errors import Problem, SpecError
 from ..textsafe import excerpt, xlsx_no_formulas, xlsx_put, xlsx_text
 from ..units import RPM
 from .camdas_workbook import FIXED_DATE, fixed_zip
+from .input_limits import check_xlsx, sheet_problems
 from .toml_design import design_from_data
 
 __all__ = ["load_design_xlsx", "design_to_xlsx", "design_rows", "SEGMENT_COLUMNS", "KNOT_COLUMNS"]
@@ -91,6 +92,10 @@ def load_design_xlsx(path: str | Path, *, allow_outside_files: bool = False) -> 
     p = Path(path)
     wb = _open(p)
     try:
+        too_big = [q for ws in wb.worksheets if ws.title.lower() in ("design", "motion", "knots")
+                   for q in sheet_problems(ws)]
+        if too_big:  # the sheets are read cell by cell: refuse before
+            raise SpecError(too_big, str(p))
         formulas = _formula_problems(wb)
         if formulas:
             raise SpecError(formulas, str(p))
@@ -109,13 +114,18 @@ def load_design_xlsx(path: str | Path, *, allow_outside_files: bool = False) -> 
             data["motion_table"] = table
     finally:
         wb.close()
-    if problems:
+    if any(q.path == "design" for q in problems):  # no design sheet: nothing to validate
         raise SpecError(problems, str(p))
     data.setdefault("name", p.stem)
     try:
-        return design_from_data(data, source=str(p), base_dir=p.parent, allow_outside_files=allow_outside_files)
-    except SpecError as exc:
-        raise SpecError([_locate(q, cells) for q in exc.problems], str(p)) from None
+        spec = design_from_data(data, source=str(p), base_dir=p.parent,
+                                  allow_outside_files=allow_outside_files)
+    except SpecError as exc:  # with the sheets' own problems: all at once, a field reported once
+        seen = {q.path.split(" [")[0] for q in problems}
+        problems += [q for q in (_locate(q, cells) for q in exc.problems) if q.path.split(" [")[0] not in seen]
+    if problems:
+        raise SpecError(problems, str(p))
+    return spec
 
 
 def _open(p: Path):
@@ -123,6 +133,7 @@ def _open(p: Path):
 
     if not p.is_file():
         raise SpecError(Problem("file", str(p), "no such design workbook", "check the path"), str(p))
+    check_xlsx(p, field="file")
     try:  # formulas as written (not their cached values), so that they can be refused
         return openpyxl.load_workbook(p, data_only=False)
     except Exception as exc:  # openpyxl raises many types for a damaged or foreign file
