@@ -225,6 +225,7 @@ def cmd_gcode(args: argparse.Namespace) -> int:
     req = Request(frozenset({Output.GCODE}), args.post or cam.spec.outputs.gcode or "linuxcnc", tol=tol,
                   machining=machining, lift_step_deg=args.lift_step)
     pipeline.gcode_job(cam.spec, tol=tol, overrides=machining)  # a bad job is refused before the check
+    _refuse_compensation(req.post, pipeline.machining_of(cam.spec, machining).compensation, args.compensation)
     if _refuse_unacceptable(cam, "gcode", args.force):
         return EXIT_CHECKS
     arts = pipeline.EXPORTERS[Output.GCODE](cam, req)
@@ -241,6 +242,17 @@ def cmd_gcode(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _refuse_compensation(post: str, compensation: str | None, flag: str | None) -> None:
+    """A controller without cutter radius compensation cannot run a G41/G42 program: refused before any work."""
+    from .gcode import get_post
+
+    if compensation and not get_post(post).compensation:
+        where = f"--compensation {flag}" if flag else f"[machining] compensation = {compensation!r}"
+        raise UsageError(f"{where}: the {post} post has no cutter radius compensation ({post} rejects G41/G42), so "
+                         "it cannot run a program of the part contour; leave compensation out to write the tool-centre "
+                         "program (what the controller needs), or choose --post linuxcnc or fanuc")
+
+
 def _verify_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("program", help="G-code file to verify")
     p.add_argument("--design", required=True, help="the design the program should cut")
@@ -251,36 +263,50 @@ def _verify_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--profile", type=int, default=1, help="which profile of a conjugate pair (1 or 2)")
     p.add_argument("--comp-radius", type=float, default=None, metavar="MM",
                    help="radius in the controller's D register for G41/G42 programs (default: the tool radius)")
+    p.add_argument("--post", choices=("linuxcnc", "fanuc", "grbl"), default=None,
+                   help="controller the program is for (default: the one its header names, else [outputs] gcode, "
+                        "else linuxcnc): whether T.. M6 and G43 H.. are expected")
+    g = p.add_argument_group("job", "what the program must do, when the gcode command was given other values than "
+                                    "the design's [machining]")
+    g.add_argument("--tool-number", type=int, help="T word and H register [1]")
+    g.add_argument("--rpm", type=float, help="spindle speed [3000]")
+    g.add_argument("--feed", type=float, help="cutting feed, mm/min [600]")
+    g.add_argument("--plunge-feed", type=float, help="plunge feed, mm/min [200]")
+    g.add_argument("--step-down", type=float, help="largest depth per level, mm [3]")
+    g.add_argument("--direction", choices=("climb", "conventional"), help="[climb]")
+    g.add_argument("--coolant", choices=("flood", "mist", "off"), help="[flood]")
     p.add_argument("--json", action="store_true")
 
 
-@register("verify", "back-plot a G-code program and check it against the exact design", _verify_args)
+#: ``camfab verify`` flags that override the design's job (flag dest → Job field)
+_VERIFY_JOB_FLAGS = {"tool_diameter": "tool_diameter_mm", "safe_z": "safe_z_mm", "tool_number": "tool_number",
+                     "rpm": "spindle_rpm", "feed": "feed_mm_min", "plunge_feed": "plunge_feed_mm_min",
+                     "step_down": "step_down_mm", "direction": "direction", "coolant": "coolant"}
+
+
+@register("verify", "back-plot a G-code program and check it against the exact design and its job", _verify_args)
 def cmd_verify(args: argparse.Namespace) -> int:
-    from .gcode import GcodeError, parse, verify
     from .gcode.cam import signed_distance
-    from .offset import offset_curve, profile_curve
+    from .gcode.verify import verify_program
+    from .offset import profile_curve
 
     cam = _cam(args.design)
     tol = _tol(cam, args.tol)
-    tool = args.tool_diameter if args.tool_diameter is not None else cam.spec.manufacturing.tool_diameter_mm
-    if tool is None:
-        raise UsageError("no tool: give --tool-diameter or [manufacturing] tool_diameter_mm")
     if args.comp_radius is not None and not (math.isfinite(args.comp_radius) and args.comp_radius > 0):
         raise UsageError(f"--comp-radius {args.comp_radius:g}: must be a positive radius in mm")
     profiles = cam.geometry.profiles
     if not 1 <= args.profile <= len(profiles):
         raise UsageError(f"--profile {args.profile}: the design has {len(profiles)} profile(s)")
-    contact = profiles[args.profile - 1]
-    try:
-        moves = parse(Path(args.program).read_text(encoding="utf-8"))
-    except UnicodeDecodeError:
-        raise UsageError(f"{args.program}: not a text G-code file") from None
-    except GcodeError as exc:
-        raise UsageError(f"{args.program}: {exc}") from None
-    safe_z = args.safe_z if args.safe_z is not None else cam.spec.machining.safe_z_mm
-    rep = verify(moves, exact_curve_distance=signed_distance(offset_curve(contact, tool / 2), tol=tol),
-                 part_distance=signed_distance(profile_curve(contact), tol=tol), tool_radius=tool / 2, tol=tol,
-                 safe_z=safe_z, top_z=0.0, comp_radius=args.comp_radius)
+    job = pipeline.gcode_job(cam.spec, tol=tol, overrides={key: getattr(args, flag)
+                                                            for flag, key in _VERIFY_JOB_FLAGS.items()})
+    data = Path(args.program).read_bytes()  # a missing file is an I/O error (3); an unreadable one a finding
+    contact, r = profiles[args.profile - 1], job.tool_radius_mm
+    part = signed_distance(profile_curve(contact), tol=tol)
+    # the exact tool-centre curve is the set of points r from the part: its distance is |part distance - r|
+    rep = verify_program(data, post=args.post, default_post=cam.spec.outputs.gcode or "linuxcnc",
+                         exact_curve_distance=lambda p: part(p) - r, part_distance=part, part_curve=part,
+                         tool_radius=r, tol=tol, safe_z=job.safe_z_mm, top_z=0.0, comp_radius=args.comp_radius,
+                         job=job)
     if args.json:
         print(json.dumps(rep.to_dict(), indent=2))
     else:

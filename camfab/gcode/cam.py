@@ -8,14 +8,12 @@ reaches the toolpath builder as an :class:`~camfab.geom2d.ArcChain`.
 """
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, replace
-
-import numpy as np
 
 from ..discretize import ParametricCurve, arcs, polyline
 from ..geom2d import ArcChain
 from ..offset.cutter import offset_curve, profile_curve, tool_centre_path
+from .distance import IndexedContourDistance
 from .model import Job, Program
 from .toolpath import contour_toolpath
 
@@ -72,24 +70,13 @@ def _rough(contact, job: Job, tol: float) -> list[ArcChain]:
     return out
 
 
-def signed_distance(curve: ParametricCurve, *, tol: float) -> Callable[[np.ndarray], np.ndarray]:
+def signed_distance(curve: ParametricCurve, *, tol: float) -> IndexedContourDistance:
     """``f(points (n, 2)) -> (n,)``: signed distance to a closed exact curve, positive outside.
 
-    Uses a polyline within ``tol/50`` of the curve (so distances are exact to
-    ``tol/50``) and shapely's vectorised distance and containment.
+    Measures against a polyline within ``tol/50`` of the curve (so distances are exact to ``tol/50``),
+    through :class:`~camfab.gcode.distance.IndexedContourDistance`: each point costs an R-tree query for
+    its nearest segment, not a pass over every vertex.
+    The returned object also gives points along the curve (``.points(spacing, max_per_entity)``, for the
+    verifier's coverage check).
     """
-    import shapely
-    from shapely.geometry import Polygon
-
-    pts = polyline(curve, tol=max(tol / 50, 1e-6)).points
-    poly = Polygon(pts)
-    ring = poly.exterior
-    shapely.prepare(poly)
-
-    def f(p: np.ndarray) -> np.ndarray:
-        p = np.asarray(p, dtype=float)
-        d = shapely.distance(ring, shapely.points(p))
-        inside = shapely.contains_xy(poly, p[:, 0], p[:, 1])
-        return np.where(inside, -d, d)
-
-    return f
+    return IndexedContourDistance(polyline(curve, tol=max(tol / 50, 1e-6)).arc_chain())

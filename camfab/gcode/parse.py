@@ -99,6 +99,14 @@ class Move:
     spindle_on : bool
     spindle_rpm : float or None
     tool : int or None
+        The tool loaded by the last ``T.. M6`` (None before any).
+    spindle_dir : {"cw", "ccw"} or None
+        ``M3`` clockwise, ``M4`` counter-clockwise (the last one given; None before any).
+    coolant : {"off", "flood", "mist", "flood+mist"}
+        Coolant in effect (``M8`` flood, ``M7`` mist, ``M9`` off).
+    length_offset : int or None
+        The tool-length offset register in effect (``G43 H..``; ``G43`` alone takes the loaded tool;
+        None before any and after ``G49``).
     """
 
     kind: str
@@ -117,6 +125,9 @@ class Move:
     spindle_on: bool = False
     spindle_rpm: float | None = None
     tool: int | None = None
+    spindle_dir: str | None = None
+    coolant: str = "off"
+    length_offset: int | None = None
 
     @property
     def is_cutting(self) -> bool:
@@ -126,7 +137,12 @@ class Move:
 
 @dataclass(frozen=True)
 class Backplot:
-    """Result of :func:`parse`: the moves plus what the program declared."""
+    """Result of :func:`parse`: the moves plus what the program declared.
+
+    ``modal_before_motion`` holds the G-code modal groups the program sets before (or on) its first motion
+    block: ``"plane"``, ``"units"``, ``"distance"``, ``"comp"``, ``"wcs"``, ``"feed_mode"``, ...  A group a
+    program never sets is whatever the controller was left in.
+    """
 
     moves: tuple
     units: str | None
@@ -134,6 +150,7 @@ class Backplot:
     comments: tuple
     warnings: tuple
     ended: bool
+    modal_before_motion: frozenset = frozenset()
 
 
 @dataclass(frozen=True)
@@ -225,7 +242,8 @@ def parse(text: str, *, arc_radius_tol_mm: float = 0.02) -> Backplot:
     if st.units is None and st.moves:
         st.warnings.append("the program never sets units (G20/G21); mm assumed")
     return Backplot(moves=tuple(st.moves), units=st.units, program_number=st.program_number,
-                    comments=tuple(st.comments), warnings=tuple(st.warnings), ended=st.ended)
+                    comments=tuple(st.comments), warnings=tuple(st.warnings), ended=st.ended,
+                    modal_before_motion=frozenset(st.modal_before_motion if st.moves else st.groups_seen))
 
 
 def backplot(text: str, **kw) -> list[Move]:
@@ -246,6 +264,11 @@ class _State:
         self.F: float | None = None
         self.S: float | None = None
         self.spindle_on = False
+        self.spindle_dir: str | None = None
+        self.coolant: set[str] = set()
+        self.length_offset: int | None = None
+        self.groups_seen: set[str] = set()
+        self.modal_before_motion: set[str] = set()
         self.tool: int | None = None
         self.selected: int | None = None
         self.label: str | None = None
@@ -338,6 +361,12 @@ class _State:
             self.tool = self.selected
         if "spindle" in ms:
             self.spindle_on = ms["spindle"] in ("3", "4")
+            if self.spindle_on:
+                self.spindle_dir = "cw" if ms["spindle"] == "3" else "ccw"
+        if "coolant_on" in ms:
+            self.coolant.add("mist" if ms["coolant_on"] == "7" else "flood")
+        if "coolant_off" in ms:
+            self.coolant.clear()
         # 7 dwell
         if "dwell" in gs and "P" not in vals:
             raise err("G4 needs a P word")
@@ -356,6 +385,11 @@ class _State:
             raise err("D word without G41/G42")
         if "H" in vals and gs.get("length") != "43":
             raise err("H word without G43")
+        if gs.get("length") == "43":
+            self.length_offset = int(vals["H"]) if "H" in vals else self.tool
+        elif gs.get("length") == "49":
+            self.length_offset = None
+        self.groups_seen.update(gs)
         if "distance" in gs:
             self.incremental = gs["distance"] == "91"
         if "arc_distance" in gs:
@@ -373,6 +407,8 @@ class _State:
                 raise err("axis words without a motion mode (G0/G1/G2/G3)")
             if self.motion == "80":
                 raise err("axis words with G80 (motion cancelled)")
+            if not self.moves:
+                self.modal_before_motion = set(self.groups_seen)
             if self.units is None and not self.warned_units:
                 self.warned_units = True
                 self.warnings.append(f"line {lineno}: coordinates before any G20/G21; mm assumed")
@@ -404,7 +440,8 @@ class _State:
             fu = MM_PER_INCH if self.units == "inch" else 1.0
             feed = self.F * fu
         common = dict(line=lineno, n=n, label=self.label, comp=self.comp, spindle_on=self.spindle_on,
-                      spindle_rpm=self.S, tool=self.tool)
+                      spindle_rpm=self.S, tool=self.tool, spindle_dir=self.spindle_dir,
+                      coolant="+".join(sorted(self.coolant)) or "off", length_offset=self.length_offset)
         if self.motion in ("0", "1"):
             kind = "rapid" if self.motion == "0" else "line"
             self.moves.append(Move(kind, start, tuple(end), feed=feed, **common))
@@ -471,7 +508,7 @@ class _State:
                     radius_start=rs, radius_end=re_, **common)
 
 
-def _move_points(m: Move, step: float) -> np.ndarray:
+def _move_points(m: Move, step: float, max_per_move: int | None = None) -> np.ndarray:
     s = np.array(m.start, dtype=float)
     e = np.array(m.end, dtype=float)
     if m.kind != "arc":
@@ -479,12 +516,17 @@ def _move_points(m: Move, step: float) -> np.ndarray:
             return e[None, :]
         L = float(np.linalg.norm(e - s))
         k = max(1, int(math.ceil(L / step)))
+        if max_per_move is not None:
+            k = min(k, max_per_move)
         u = np.linspace(0.0, 1.0, k + 1)
         return s + u[:, None] * (e - s)
     assert m.center is not None  # an arc always carries its centre (_State.arc)
     cx, cy = m.center
     L = abs(m.sweep) * max(m.radius_start, m.radius_end)
-    k = max(2, int(math.ceil(L / step)))
+    k = int(math.ceil(L / step))
+    if max_per_move is not None:
+        k = min(k, max_per_move)
+    k = max(k, 2, int(math.ceil(abs(m.sweep) / (math.pi / 32))))
     u = np.linspace(0.0, 1.0, k + 1)
     a0 = math.atan2(s[1] - cy, s[0] - cx)
     a = a0 + m.sweep * u
@@ -495,7 +537,7 @@ def _move_points(m: Move, step: float) -> np.ndarray:
     return pts
 
 
-def sample(moves: Sequence[Move], step: float = 0.05) -> Samples:
+def sample(moves: Sequence[Move], step: float = 0.05, max_per_move: int | None = None) -> Samples:
     """Densify moves into points at most ``step`` mm apart (arcs along the arc, spirals included).
 
     Points with an unknown coordinate (before the first positioning) are left out.
@@ -505,6 +547,10 @@ def sample(moves: Sequence[Move], step: float = 0.05) -> Samples:
     moves : sequence of Move
     step : float
         Largest distance between consecutive points of a move, mm.
+    max_per_move : int, optional
+        At most this many intervals per move (a long move is then sampled more sparsely than ``step``),
+        so that the number of points follows the number of moves, not their length; arcs keep at least
+        one point per 5.6 degrees of sweep.
 
     Returns
     -------
@@ -514,7 +560,7 @@ def sample(moves: Sequence[Move], step: float = 0.05) -> Samples:
         raise InputError(f"step = {step!r}: must be > 0 (the largest distance between samples of a move, mm)")
     chunks, idx = [], []
     for i, m in enumerate(moves):
-        p = _move_points(m, step)
+        p = _move_points(m, step, max_per_move)
         p = p[np.all(np.isfinite(p), axis=1)]
         chunks.append(p)
         idx.append(np.full(len(p), i, dtype=np.int64))

@@ -12,8 +12,14 @@ radius with the tool on its centre's side), ``COMP_CORNER`` (a concave corner or
 tool: the offset moves do not meet), ``COMP_SIDE_CHANGE`` (G41 <-> G42 without G40); and
 ``COMP_WRONG_SIDE`` when a gouging G41/G42 stretch would not gouge compensated to the other side.
 
-Checks (all vectorised over densely sampled moves):
+Checks (vectorised over the moves' sample points; each move is sampled every ``step`` mm but at most
+``max_samples_per_move`` times, so the cost follows the number of moves, not the size of the part):
 
+* **readable** - a program that cannot be parsed is one ``PARSE_ERROR`` finding (:func:`verify_program`),
+  a parse warning (no program end, no units) a ``PARSE_WARNING``; ``MODAL_STATE`` when the program does not
+  set the plane (G17), units (G20/G21), distance mode (G90/G91), feed mode (G94), cutter compensation
+  (G40/G41/G42) and work offset (G54-G59) before its first move (a controller keeps what the last program
+  left);
 * **deviation** - the largest ``|exact_curve_distance|`` over the finishing-pass cutting moves at final
   depth (moves labelled ``FINISH CONTOUR`` by camfab's posts; without such labels, every horizontal
   cutting move at the deepest Z, which then includes any lead-in arcs); for simulated compensated moves
@@ -24,11 +30,25 @@ Checks (all vectorised over densely sampled moves):
   program lines involved;
 * **rapids** - a rapid with horizontal travel below ``safe_z - tol`` (or before Z is known), a rapid that
   descends below the stock top, or a rapid below the stock top whose tool overlaps the part;
-* **feed** - a cutting move before any feed was set (or at F0); cutting below the top with the spindle off;
+* **feed** - every cutting move: none set or F0 (``FEED_MISSING``); with a ``job``, a feed other than the
+  job's (``FEED_OUT_OF_RANGE``: a Z-only move at the plunge feed, every other cutting move at the cutting
+  feed, within the rounding of the written F word);
+* **spindle** - cutting below the top with the spindle off (``SPINDLE_OFF``) or turning counter-clockwise
+  (``M4``, ``SPINDLE_DIRECTION``: camfab's end mills cut with M3); with a ``job``, at another speed
+  (``SPINDLE_SPEED``);
+* **coolant** (with a ``job``) - every cut below the top runs with the coolant the job asks
+  (``COOLANT``: flood M8, mist M7 - or M8 where the post writes M8 for mist - or none);
+* **tool** (with a ``job``) - the job's tool loaded by ``T.. M6`` (where the post has a tool changer) and
+  its length offset ``G43 H..`` active (where the post writes one) while cutting (``TOOL``,
+  ``TOOL_LENGTH_OFFSET``);
+* **depth** (with a ``job``) - the finishing pass at the final depth ``Z = -depth_mm`` (``FINISH_DEPTH``),
+  nothing cut below it (``TOO_DEEP``), no cut deeper than one step-down below what was cut before
+  (``STEP_DOWN``), and the finishing pass in the job's milling direction (``DIRECTION``: climb is
+  clockwise around the part);
 * **arcs** - an arc whose start and end radius differ by more than ``tol`` (as programmed);
-* **coverage** (optional, ``curve_points``) - the largest distance from points of the exact tool-centre
-  curve to the finishing back-plot (simulated for compensated programs), so a program that skips part of
-  the contour fails too.
+* **coverage** (``curve_points``) - the largest distance from points of the exact tool-centre curve to
+  the finishing moves at final depth (exact distances to the lines and arcs, simulated for compensated
+  programs), so a program that skips part of the contour fails too.
 
 Every problem names the program line (1-based); moves the simulation inserts (corner arcs, bridges) carry
 the line of the programmed move they lead into.
@@ -36,18 +56,34 @@ the line of the programmed move they lead into.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+import re
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from camfab.gcode.checks import (
+    EPS_Z,
+    depth_findings,
+    direction_findings,
+    feed_findings,
+    line_list,
+    machine_state_findings,
+    modal_state,
+)
 from camfab.gcode.compensation import CompensatedPath, simulate_compensation
-from camfab.gcode.parse import Backplot, sample
+from camfab.gcode.distance import Entities, IndexedContourDistance
+from camfab.gcode.model import Job
+from camfab.gcode.parse import Backplot, GcodeError, parse, sample
+from camfab.gcode.post import POSTS, get_post
+from camfab.gcode.posts.base import Post
 from camfab.results import Finding, IssueCode, Severity
 
-__all__ = ["VerifyReport", "verify"]
+__all__ = ["MAX_SAMPLES_PER_MOVE", "VerifyReport", "declared_post", "default_step", "verify", "verify_program"]
 
-_EPS_Z = 1e-6
+_EPS_Z = EPS_Z
+#: at most this many sample intervals per move: the cost follows the number of moves, not their length
+MAX_SAMPLES_PER_MOVE = 256
 
 
 @dataclass(frozen=True)
@@ -105,6 +141,11 @@ class VerifyReport:
         }
 
 
+def default_step(tool_radius: float) -> float:
+    """The sampling step of :func:`verify` in mm: ``tool_radius / 20`` within [0.001, 0.05]."""
+    return max(1e-3, min(0.05, 0.05 * float(tool_radius)))
+
+
 def _r(v: float) -> float:
     return float(f"{v:.6g}")
 
@@ -113,13 +154,16 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
            part_distance: Callable[[np.ndarray], np.ndarray], tool_radius: float, tol: float,
            safe_z: float, top_z: float = 0.0, step: float | None = None,
            finish_label: str = "FINISH CONTOUR", curve_points: np.ndarray | None = None,
-           comp_radius: float | None = None) -> VerifyReport:
+           comp_radius: float | None = None, job: Job | None = None, post: str | Post | None = None,
+           part_curve: IndexedContourDistance | None = None,
+           max_samples_per_move: int = MAX_SAMPLES_PER_MOVE) -> VerifyReport:
     """Check a back-plotted program.
 
     Parameters
     ----------
     moves : Backplot or sequence of Move
-        From :func:`camfab.gcode.parse.parse`; a Backplot's warnings become problems.
+        From :func:`camfab.gcode.parse.parse`; a Backplot's warnings become problems and its modal state
+        is checked.
     exact_curve_distance : callable
         ``f(points (n, 2)) -> (n,)`` signed distance in mm from the exact tool-centre curve (positive
         outside).
@@ -139,10 +183,24 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
     finish_label : str
         Comment label (prefix, case-insensitive) of the finishing contour moves.
     curve_points : ndarray (m, 2), optional
-        Points on the exact tool-centre curve; enables the coverage check.
+        Points on the exact tool-centre curve; enables the coverage check (measured at these points).
     comp_radius : float, optional
         Radius the controller compensates G41/G42 moves by (what the D register holds); default
         ``tool_radius``.  Gouge and deviation are always measured for ``tool_radius``.
+    job : Job, optional
+        What the program must do: final depth, step-down, feeds, spindle speed, coolant, tool, milling
+        direction.  Without it those checks are left out (and a note says so).
+    post : str or Post, optional
+        The controller the program is for (``"linuxcnc"``, ``"fanuc"``, ``"grbl"``): whether a tool change
+        and a length offset are expected, and which code means mist coolant.
+    part_curve : IndexedContourDistance, optional
+        The finished part's contour (e.g. :func:`camfab.gcode.cam.signed_distance` of it, which may serve as
+        ``part_distance`` too); enables the coverage check at a cost that follows the program: the
+        finishing samples are projected onto the part, the stretches between consecutive ones marked
+        covered, and the material left measured (distance to the pass minus ``tool_radius``) where
+        nothing covers the part, and at 4096 points spread along it.
+    max_samples_per_move : int
+        At most this many sample intervals per move.
 
     Returns
     -------
@@ -153,28 +211,26 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
     if isinstance(moves, Backplot):
         for w in moves.warnings:
             problems.append(Finding.at_line(IssueCode.PARSE_WARNING, w, severity=Severity.WARNING))
+        if moves.moves:
+            problems.extend(modal_state(moves))
         moves = moves.moves
     moves = list(moves)
     if step is None:
-        step = max(1e-3, min(0.05, 0.05 * tool_radius))
+        step = default_step(tool_radius)
+    K = int(max_samples_per_move)
     r_tool = float(tool_radius)
+    the_post = get_post(post) if post is not None else None
 
     cutting = [i for i, m in enumerate(moves) if m.is_cutting]
     if not cutting:
         problems.append(Finding.at_line(IssueCode.NO_CUTTING_MOVES, "the program has no cutting moves"))
 
-    # -- feed and spindle --------------------------------------------------------------------------
-    if cutting:
-        m0 = moves[cutting[0]]
-        if m0.feed is None or m0.feed <= 0:
-            problems.append(Finding.at_line(IssueCode.FEED_MISSING, "the first cutting move runs without a feed "
-                                          "(no F word before it, or F0)", m0.line))
-    for i in cutting:
-        m = moves[i]
-        if not m.spindle_on and min(m.start[2], m.end[2]) < top_z - _EPS_Z:
-            problems.append(Finding.at_line(IssueCode.SPINDLE_OFF, "cutting below the stock top with the spindle off",
-                                          m.line))
-            break
+    # -- feed, spindle, coolant, tool: every cutting move --------------------------------------------
+    problems.extend(feed_findings(moves, cutting, job))
+    problems.extend(machine_state_findings(moves, cutting, top_z, job, the_post))
+    if job is None:
+        notes.append("no job given: depth, step-down, feeds, spindle speed, coolant, tool and milling direction "
+                     "were not checked against one")
 
     # -- arcs ----------------------------------------------------------------------------------------
     for m in moves:
@@ -201,7 +257,7 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
     # -- gouge ---------------------------------------------------------------------------------------
     gouge_at = None
     if cutting:
-        smp = sample([moves[i] for i in cutting], step)
+        smp = sample([moves[i] for i in cutting], step, K)
         pts, idx = smp.points, np.asarray(cutting)[smp.index]
         below = pts[:, 2] < top_z - _EPS_Z
         if below.any():
@@ -218,14 +274,14 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
                 problems.append(Finding.at_line(
                     IssueCode.GOUGE, f"the tool enters the finished profile by up to {pen[w]:.4f} mm "
                     f"(> tol {tol} mm) at X{p[w, 0]:.4f} Y{p[w, 1]:.4f} Z{p[w, 2]:.4f}; "
-                    f"lines {_line_list(lines)}", moves[int(ii[w])].line))
+                    f"lines {line_list(lines)}", moves[int(ii[w])].line))
                 if comp_path is not None:
                     runs = comp_path.run[ii[bad]]
                     worst = {int(k): float(pen[bad][runs == k].max()) for k in np.unique(runs) if k >= 0}
                     problems.extend(_wrong_side(comp_path, programmed, worst, part_distance, r_tool, r_comp,
-                                                tol, top_z, step, join_tol))
+                                                tol, top_z, step, join_tol, K))
 
-    # -- deviation -----------------------------------------------------------------------------------
+    # -- deviation, coverage, final depth and direction of the finishing pass ---------------------------
     lab = finish_label.upper()
     fin = [i for i in cutting if (moves[i].label or "").upper().startswith(lab)]
     if not fin and cutting:
@@ -235,12 +291,13 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
     max_dev = None
     gap = None
     fin_final: list[int] = []
+    zf = math.nan
     if fin:
         zf = min(min(moves[i].start[2], moves[i].end[2]) for i in fin)
         fin_final = [i for i in fin
                      if abs(moves[i].start[2] - zf) <= _EPS_Z and abs(moves[i].end[2] - zf) <= _EPS_Z]
     if fin_final:
-        smp = sample([moves[i] for i in fin_final], step)
+        smp = sample([moves[i] for i in fin_final], step, K)
         pts, idx = smp.points, np.asarray(fin_final)[smp.index]
         # simulated compensated moves: the exact tool-centre curve is where the part is tool_radius away
         comp = np.array([moves[i].comp != "G40" for i in idx])
@@ -255,14 +312,35 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
             problems.append(Finding.at_line(
                 IssueCode.DEVIATION, f"the finishing pass deviates {dev[w]:.4f} mm from the exact curve "
                 f"(> tol {tol} mm) at X{pts[w, 0]:.4f} Y{pts[w, 1]:.4f}", moves[int(idx[w])].line))
-        if curve_points is not None:
-            gap = _r(_coverage_gap(np.asarray(curve_points, float).reshape(-1, 2), pts[:, :2], idx, step))
-            if gap > tol:
+        # coverage: the largest distance from the exact tool-centre curve to the finishing pass (points of it
+        # given), or the thickest material the pass leaves on the part (the part's curve given)
+        fin_ent = Entities.from_moves([moves[i] for i in fin_final]) if (
+            curve_points is not None or part_curve is not None) else None
+        probes = []
+        if curve_points is not None and fin_ent is not None:
+            on_centre = np.asarray(curve_points, float).reshape(-1, 2)
+            probes.append((on_centre, fin_ent.distance(on_centre)))
+        if part_curve is not None and fin_ent is not None:
+            on_part = _uncovered_probe(part_curve, pts[:, :2], idx, r_tool, tol)
+            probes.append((on_part, fin_ent.distance(on_part) - r_tool))
+        if probes:
+            curve = np.concatenate([q for q, _ in probes])
+            d_cov = np.concatenate([d for _, d in probes])
+            wc = int(np.argmax(d_cov)) if len(d_cov) else 0
+            gap = _r(max(float(d_cov[wc]), 0.0)) if len(d_cov) else None
+            if gap is not None and gap > tol:
                 problems.append(Finding.at_line(
-                    IssueCode.COVERAGE, f"part of the exact curve is {gap:.4f} mm from the finishing pass "
-                    f"(> tol {tol} mm): the program does not cut the whole contour"))
+                    IssueCode.COVERAGE, f"the finishing pass at Z{zf:.4f} leaves up to {gap:.4f} mm (> tol {tol} mm) "
+                    f"of the contour uncut, e.g. at X{curve[wc, 0]:.4f} Y{curve[wc, 1]:.4f}: the program does not "
+                    "cut the whole contour"))
+        if job is not None:
+            problems.extend(direction_findings(pts[:, :2], job, moves[fin_final[0]].line))
     elif cutting:
         problems.append(Finding.at_line(IssueCode.NO_FINISH_PASS, "no horizontal cutting moves at final depth"))
+    if curve_points is None and part_curve is None:
+        notes.append("no exact curve given: coverage of the whole contour not checked")
+    if job is not None:
+        problems.extend(depth_findings(moves, cutting, fin_final, zf, job, top_z, tol))
 
     # -- rapids --------------------------------------------------------------------------------------
     rapids = [i for i, m in enumerate(moves) if m.kind == "rapid"]
@@ -287,7 +365,7 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
             problems.append(Finding.at_line(IssueCode.RAPID_INTO_STOCK, f"rapid descends to Z{e[2]:.4f}, below the "
                                           f"stock top Z{top_z:.4f}", m.line))
     if rapids:
-        smp = sample([moves[i] for i in rapids], step)
+        smp = sample([moves[i] for i in rapids], step, K)
         pts, idx = smp.points, np.asarray(rapids)[smp.index]
         below = pts[:, 2] < top_z - _EPS_Z
         if below.any():
@@ -303,8 +381,99 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
                         finish_moves=len(fin_final), notes=tuple(notes))
 
 
+def _uncovered_probe(part: IndexedContourDistance, pts: np.ndarray, idx: np.ndarray, r_tool: float,
+                     tol: float) -> np.ndarray:
+    """Points of the ``part`` contour to measure the coverage at: 4096 spread evenly, and up to 64 in every
+    stretch that no part of the finishing pass projects onto.
+
+    Consecutive samples ``pts`` (xy, of moves ``idx``, in program order) belong to one continuous cut when
+    they come from one move or coincide (where one move ends and the next begins); the stretch of the part
+    between their nearest points is covered unless it is much longer than the cut between them (a cut
+    near two branches of the contour does not cover what lies between them).
+    """
+    L = part.length
+    even = np.linspace(0.0, L, 4096, endpoint=False)
+    if len(pts) < 2 or L <= 0:
+        return part.at_position(even)
+    d, s = part.project(pts)
+    chord = np.hypot(*np.diff(pts, axis=0).T)
+    ds = np.mod(np.diff(s) + 0.5 * L, L) - 0.5 * L  # the short way round
+    reach = 2.0 * chord + 4.0 * (d[1:] + d[:-1] + r_tool) + 1e-9
+    ok = ((idx[1:] == idx[:-1]) | (chord <= 1e-9)) & (np.abs(ds) <= reach)
+    lo = np.mod(np.where(ds >= 0, s[:-1], s[1:]), L)[ok]
+    hi = lo + np.abs(ds)[ok]
+    # the circle [0, L): split the stretches that pass L, then merge
+    wrap = hi > L
+    lo, hi = np.concatenate([lo, np.zeros(int(wrap.sum()))]), np.concatenate([np.minimum(hi, L), hi[wrap] - L])
+    order = np.argsort(lo, kind="stable")
+    lo, hi = lo[order], np.maximum.accumulate(hi[order]) if len(hi) else hi
+    gaps_lo, gaps_hi = np.concatenate([[0.0], hi]), np.concatenate([lo, [L]])
+    probe = [even]
+    for a, b in zip(gaps_lo, gaps_hi, strict=True):
+        if b - a > 1e-9:
+            probe.append(np.linspace(a, b, int(min(64, max(3, math.ceil((b - a) / max(tol, 1e-9)))))))
+    return part.at_position(np.concatenate(probe))
+
+
+def verify_program(text: str | bytes, *, post: str | Post | None = None, default_post: str | None = None,
+                   **kw) -> VerifyReport:
+    """Read and :func:`verify` a program; one that cannot be read is a ``PARSE_ERROR`` finding, not an error.
+
+    Parameters
+    ----------
+    text : str or bytes
+        The program (bytes are decoded as UTF-8; undecodable bytes are a parse error at their line).
+    post : str or Post, optional
+        The controller the program is for; default: the one its header comment declares
+        (``(post: grbl, ...)``, as camfab's posts write), else ``default_post``.
+    default_post : str, optional
+        The controller assumed when neither ``post`` nor the program names one.
+    **kw
+        The keywords of :func:`verify` (``tol`` required).
+
+    Returns
+    -------
+    VerifyReport
+    """
+    tol = float(kw["tol"])
+    try:
+        if isinstance(text, bytes):
+            raw = text
+            try:
+                text = raw.decode("utf-8")
+            except UnicodeDecodeError as exc:
+                line = raw[:exc.start].count(b"\n") + 1
+                raise GcodeError(line, f"not UTF-8 text (byte 0x{raw[exc.start]:02x})") from None
+        backplot = parse(text)
+    except GcodeError as exc:
+        return VerifyReport(max_deviation_mm=None, gouge=False, gouge_at=None, tolerance_mm=tol,
+                            problems=(Finding.at_line(IssueCode.PARSE_ERROR, f"the program cannot be read: {exc}",
+                                                      exc.line),),
+                            notes=("nothing else was checked: a controller stops at (or misreads) this line",))
+    how = "given"
+    if post is None:
+        post, how = declared_post(backplot.comments), "declared by the program"
+    if post is None:
+        post, how = default_post, "assumed"
+    rep = verify(backplot, post=post, **kw)
+    if post is None:
+        return rep
+    name = post if isinstance(post, str) else post.name
+    return replace(rep, notes=rep.notes + (f"checked as a {name} program ({how})",))
+
+
+def declared_post(comments) -> str | None:
+    """The post-processor a program's header comment names (``post: NAME``), if it is a known one."""
+    for c in comments[:40]:
+        m = _POST_COMMENT.match(c)
+        if m and m.group(1).lower() in POSTS:
+            return m.group(1).lower()
+    return None
+
+
+_POST_COMMENT = re.compile(r"^\s*post:\s*([A-Za-z]+)", re.IGNORECASE)
 def _wrong_side(comp_path: CompensatedPath, programmed, worst: dict, part_distance, r_tool: float,
-                r_comp: float, tol: float, top_z: float, step: float, join_tol: float) -> list[Finding]:
+                r_comp: float, tol: float, top_z: float, step: float, join_tol: float, K: int) -> list[Finding]:
     """``COMP_WRONG_SIDE`` for each gouging G41/G42 stretch that would not gouge on the other side."""
     swapped = simulate_compensation(programmed, r_comp, swap_side=True, join_tol=join_tol)
     out = []
@@ -313,7 +482,7 @@ def _wrong_side(comp_path: CompensatedPath, programmed, worst: dict, part_distan
         sel = [i for i, m in enumerate(swapped.moves) if swapped.run[i] == run and m.is_cutting]
         if not sel:
             continue
-        smp = sample([swapped.moves[i] for i in sel], step)
+        smp = sample([swapped.moves[i] for i in sel], step, K)
         below = smp.points[:, 2] < top_z - _EPS_Z
         if not below.any():
             continue
@@ -326,51 +495,3 @@ def _wrong_side(comp_path: CompensatedPath, programmed, worst: dict, part_distan
             f"wrong side of the contour: the tool cuts up to {pen_now:.4f} mm into the part; with {other} "
             "it would not gouge", info.entry_line if info.entry_line is not None else info.first_line))
     return out
-
-
-def _line_list(lines: Sequence[int], limit: int = 8) -> str:
-    head = ", ".join(str(v) for v in lines[:limit])
-    return head + (f" and {len(lines) - limit} more" if len(lines) > limit else "")
-
-
-def _coverage_gap(curve: np.ndarray, pts: np.ndarray, idx: np.ndarray, step: float) -> float:
-    """Largest distance from curve points to the polyline through the back-plot samples.
-
-    Consecutive samples are joined when they belong to one move, or to consecutive moves that meet (at
-    most ``step`` apart once repeated junction points are dropped).  Each curve point is measured to the
-    polyline segments at its few nearest samples, so a junction visited twice (the start and end of a
-    closed contour) or a very short move between two long ones (a corner arc of a compensated path) does
-    not hide the segment it lies on.
-    """
-    from scipy.spatial import cKDTree
-
-    if len(pts) == 0 or len(curve) == 0:
-        return math.inf
-    keep = np.ones(len(pts), dtype=bool)
-    keep[1:] = np.hypot(*np.diff(pts, axis=0).T) > 1e-9
-    pts, idx = pts[keep], idx[keep]
-    n = len(pts)
-    best = np.full(len(curve), np.inf)
-    if n == 1:
-        return float(np.hypot(*(curve - pts[0]).T).max())
-    seg = np.hypot(*np.diff(pts, axis=0).T)
-    link = (idx[1:] == idx[:-1]) | ((idx[1:] > idx[:-1]) & (seg <= step * (1 + 1e-9) + 1e-9))
-    k = min(8, n)
-    _, near = cKDTree(pts).query(curve, k=k)
-    near = near.reshape(len(curve), k)
-    for j in range(k):
-        a = near[:, j]
-        best = np.minimum(best, np.hypot(*(curve - pts[a]).T))
-        for off in (-1, 0):  # the segments (a-1, a) and (a, a+1)
-            s0 = a + off
-            ok = (s0 >= 0) & (s0 < n - 1)
-            s0 = np.clip(s0, 0, n - 2)
-            ok &= link[s0]
-            pa, pb = pts[s0], pts[s0 + 1]
-            ab = pb - pa
-            L2 = np.einsum("ij,ij->i", ab, ab)
-            t = np.where(L2 > 0, np.einsum("ij,ij->i", curve - pa, ab) / np.where(L2 > 0, L2, 1), 0)
-            q = pa + np.clip(t, 0, 1)[:, None] * ab
-            d = np.hypot(*(curve - q).T)
-            best = np.where(ok, np.minimum(best, d), best)
-    return float(best.max())

@@ -91,7 +91,7 @@ def test_cutter_larger_than_concave_radius_gouges(programs):
     r = 50.0
     pts = offset_curve(contact, r).point(np.linspace(0, 2 * np.pi, 3601))
     body = [f"G1 X{x:.4f} Y{y:.4f}" for x, y in pts]
-    text = "\n".join(["G21 G90 G17", "S3000 M3", "G0 Z25", f"G0 X{pts[0, 0]:.4f} Y{pts[0, 1]:.4f}",
+    text = "\n".join(["G17 G21 G40 G54 G90 G94", "S3000 M3", "G0 Z25", f"G0 X{pts[0, 0]:.4f} Y{pts[0, 1]:.4f}",
                       "G1 Z-10 F200", "(FINISH CONTOUR)", "F600", *body, "G0 Z25", "M5", "M2"]) + "\n"
     # the offset by 50 mm folds over itself; measure the centre path against the part distance - r
     part = _distances(contact, R_TOOL)[0]

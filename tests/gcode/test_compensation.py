@@ -296,7 +296,7 @@ def test_notch_wider_than_the_tool_is_fine():
 
 def _hand_program(segs, comp, entry_from, exit_to, z=-4.0):
     """A minimal compensated program through the closed contour ``segs`` (traversed as given)."""
-    out = ["G21 G90 G17", "S3000 M3", "G0 Z25", f"G0 X{entry_from[0]:.4f} Y{entry_from[1]:.4f}", "G0 Z2",
+    out = ["G17 G21 G40 G54 G90 G94", "S3000 M3", "G0 Z25", f"G0 X{entry_from[0]:.4f} Y{entry_from[1]:.4f}", "G0 Z2",
            f"G1 Z{z:.4f} F200", "(FINISH LEAD-IN)",
            f"G1 {comp} D1 X{segs[0].start[0]:.4f} Y{segs[0].start[1]:.4f} F600", f"({FINISH})"]
     for s in segs:
@@ -374,7 +374,7 @@ def test_exit_move_that_controllers_refuse_is_reported(exit_move, what):
 
 def test_linuxcnc_entry_is_tangent_to_the_circle_about_the_programmed_point():
     # G41 travelling +X, then a right turn: a convex corner after the entry
-    text = "G21 G90\nG0 X0 Y0 Z-1\nG1 G41 D1 X10 Y0 F100\nG1 X10 Y-10\nG1 G40 X0 Y-10\nM2\n"
+    text = "G17 G21 G40 G54 G90 G94\nG0 X0 Y0 Z-1\nG1 G41 D1 X10 Y0 F100\nG1 X10 Y-10\nG1 G40 X0 Y-10\nM2\n"
     path = simulate_compensation(parse(text).moves, 2.0)
     entry = next(m for m, k in zip(path.moves, path.kind, strict=True) if k == "entry")
     E, C, P = np.array(entry.end[:2]), np.array(entry.start[:2]), np.array([10.0, 0.0])
@@ -392,7 +392,7 @@ def test_linuxcnc_entry_is_tangent_to_the_circle_about_the_programmed_point():
 
 def test_entry_into_a_concave_corner_is_trimmed():
     # G41 travelling +X, then a left turn: concave; the entry is cut short where it meets X = 10 - r
-    text = "G21 G90\nG0 X0 Y0 Z-1\nG1 G41 D1 X10 Y0 F100\nG1 X10 Y10\nG1 G40 X0 Y10\nM2\n"
+    text = "G17 G21 G40 G54 G90 G94\nG0 X0 Y0 Z-1\nG1 G41 D1 X10 Y0 F100\nG1 X10 Y10\nG1 G40 X0 Y10\nM2\n"
     path = simulate_compensation(parse(text).moves, 2.0)
     assert "corner" not in path.kind and path.corners["trimmed"] == 1
     entry = next(m for m, k in zip(path.moves, path.kind, strict=True) if k == "entry")
@@ -404,7 +404,7 @@ def test_entry_into_a_concave_corner_is_trimmed():
 
 
 def test_reversal_rolls_half_a_turn_round_the_end():
-    text = "G21 G90\nG0 X-20 Y0 Z-1\nG1 G41 D1 X0 Y0 F100\nG1 X20\nG1 X0\nG1 G40 X-20\nM2\n"
+    text = "G17 G21 G40 G54 G90 G94\nG0 X-20 Y0 Z-1\nG1 G41 D1 X0 Y0 F100\nG1 X20\nG1 X0\nG1 G40 X-20\nM2\n"
     path = simulate_compensation(parse(text).moves, 2.0)
     c = [m for m, k in zip(path.moves, path.kind, strict=True) if k == "corner" and m.line == 5]
     assert len(c) == 1 and c[0].center == (20.0, 0.0) and c[0].sweep == pytest.approx(-math.pi)
@@ -412,14 +412,14 @@ def test_reversal_rolls_half_a_turn_round_the_end():
 
 
 def test_side_change_without_g40_is_reported():
-    text = "G21 G90\nG0 X0 Y0 Z-1\nG1 G41 D1 X10 Y0 F100\nG1 X20\nG1 G42 D1 X30\nG1 X40\nG1 G40 X50\nM2\n"
+    text = "G17 G21 G40 G54 G90 G94\nG0 X0 Y0 Z-1\nG1 G41 D1 X10 Y0 F100\nG1 X20\nG1 G42 D1 X30\nG1 X40\nG1 G40 X50\nM2\n"
     path = simulate_compensation(parse(text).moves, 2.0)
     assert [(p.code, p.line) for p in path.problems] == [("COMP_SIDE_CHANGE", 5)]
     assert len(path.runs) == 2
 
 
 def test_z_only_moves_keep_the_compensated_position():
-    text = ("G21 G90\nG0 X0 Y-10 Z5\nG1 G41 D1 X0 Y0 F100\nG1 Z-1\nG1 X20\nG1 Z5\nG1 G40 X20 Y-10\n"
+    text = ("G17 G21 G40 G54 G90 G94\nG0 X0 Y-10 Z5\nG1 G41 D1 X0 Y0 F100\nG1 Z-1\nG1 X20\nG1 Z5\nG1 G40 X20 Y-10\n"
             "G0 Z25\nM2\n")
     path = simulate_compensation(parse(text).moves, 2.0)
     z = [m for m, k in zip(path.moves, path.kind, strict=True) if k == "z"]

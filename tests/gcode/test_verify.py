@@ -153,7 +153,7 @@ def test_skipped_contour_fails_coverage():
 
 
 def test_rapid_before_z_is_known():
-    text = "G21 G90\nG0 X10 Y10\nG0 Z25\nM2\n"
+    text = "G17 G21 G40 G54 G90 G94\nG0 X10 Y10\nG0 Z25\nM2\n"
     rep = _verify(text)
     assert "RAPID_BELOW_SAFE" in rep.codes() and "NO_CUTTING_MOVES" in rep.codes()
 
