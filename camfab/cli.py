@@ -176,7 +176,7 @@ def cmd_export(args: argparse.Namespace) -> int:
         ents = "-" if a.entities is None else str(a.entities)
         dev = "-" if a.deviation_mm is None else f"{a.deviation_mm:.3g}"
         print(f"  {str(p):<32}{ents:>10}{dev:>22}")
-    return EXIT_OK
+    return _exit(cam.verdict)  # forced files of an unacceptable design: written, and still exit 1
 
 
 # ---------------------------------------------------------------------------
@@ -239,7 +239,7 @@ def cmd_gcode(args: argparse.Namespace) -> int:
     if lift is not None:
         atomic_write(args.lift_table, lift.data)
         print(f"wrote {args.lift_table}")
-    return EXIT_OK
+    return _exit(cam.verdict)  # forced files of an unacceptable design: written, and still exit 1
 
 
 def _refuse_compensation(post: str, compensation: str | None, flag: str | None) -> None:

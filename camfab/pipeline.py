@@ -34,7 +34,7 @@ from .errors import GeometryError, InputError, Problem, SpecError
 from .formats import EXAMPLES_DIR, load_design, resolve_design_path
 from .io import atomic_write, inside, output_folder, safe_stem, write_all
 from .limits import MAX_SIZE_OVER_TOL
-from .results import CheckReport, Verdict
+from .results import CheckReport, IssueCode, Severity, Verdict
 
 __all__ = ["Output", "SHOP_OUTPUTS", "Request", "RunResult", "Cam", "EXPORTERS", "gcode_job", "run", "load",
            "examples", "shop_file_names"]
@@ -194,9 +194,12 @@ class Cam:
         return t
 
     def shapes(self, tol: float | None = None) -> CamShapes:
-        """Every profile arc-fitted within ``tol`` (and the pitch curves), measured; once per tolerance."""
+        """Every profile arc-fitted within ``tol`` (and the pitch curves), measured; once per tolerance.
+
+        Raises GeometryError at once for a profile no file can follow (an undercut or cusp ``check`` found)."""
         t = self.tolerance(tol)
         if t not in self._shapes:
+            require_followable(self.check())
             self._shapes[t] = cam_shapes(self.geometry, tol=t)
         return self._shapes[t]
 
@@ -258,6 +261,29 @@ class Cam:
             tol: float | None = None) -> RunResult:
         """Everything the design's ``[outputs]`` (or ``outputs``) asks for, written into ``outdir``."""
         return run(self, outdir, Request.from_design(self.spec, outputs, force=force, tol=tol))
+
+
+#: check findings whose profile no file can follow, forced or not: the envelope crosses itself (undercut) or
+#: comes to a point (cusp)
+UNFOLLOWABLE = (IssueCode.UNDERCUT, IssueCode.CUSP)
+
+
+def require_followable(report: CheckReport) -> None:
+    """Refuse, before any fitting, a profile that ``check`` found undercut or cusped (GeometryError, exit 2).
+
+    ``--force`` writes an unacceptable design's files, but an undercut profile (the roller's or the face's
+    envelope crosses itself) or a cusp has no curve a file could lie within the tolerance of: searching for
+    one only costs time and memory (minutes and gigabytes for a thousand undercut segments) before failing.
+    """
+    bad = [f for f in report.findings if f.code in UNFOLLOWABLE and f.severity == Severity.ERROR]
+    if not bad:
+        return
+    where = ", ".join(f"{f.code} {f.from_deg:.6g}–{f.to_deg:.6g}" if f.from_deg != f.to_deg
+                      else f"{f.code} at {f.from_deg:.6g}" for f in bad[:5])
+    more = f" and {len(bad) - 5} more" if len(bad) > 5 else ""
+    raise GeometryError(f"no file can follow this profile, even with --force: check finds {where}{more} (cam angle "
+                        f"in degrees, travel in mm for a translating cam), where the profile crosses itself or comes "
+                        f"to a point. {bad[0].message}")
 
 
 def load(design: str | Path, *, allow_outside_files: bool = False) -> Cam:
@@ -340,6 +366,7 @@ def _gcode(cam: Cam, req: Request) -> list[Artifact]:
     from .gcode.cam import cam_program
 
     tol = cam.tolerance(req.tol)
+    require_followable(cam.check())
     job = gcode_job(cam.spec, tol=tol, overrides=req.machining)
     m = machining_of(cam.spec, req.machining)
     n = len(cam.geometry.profiles)

@@ -23,6 +23,48 @@ EJEMPLO11RO = [("dwell", 0, 90), ("poly4567", 25, 90), ("poly4567", -10, 45), ("
                ("poly4567", -25, 90)]
 
 
+#: the commonest unacceptable design: constant-velocity rise and return beside dwells (the velocity jumps at
+#: every junction); placeholders ``follower``, ``roller`` (a ``roller_radius_mm = ...`` line or ""),
+#: ``rotation``, ``offset`` and ``tool``
+CV_JUMP = """name = "cv_jump"
+[cam]
+kind = "disc"
+rotation = "{rotation}"
+omega_rad_s = 1.0
+[follower]
+type = "{follower}"
+motion = "translating"
+base_radius_mm = 40.0
+{roller}offset_mm = {offset}
+[[motion]]
+law = "constant_velocity"
+lift = 10.0
+angle_deg = 120.0
+[[motion]]
+law = "dwell"
+angle_deg = 60.0
+[[motion]]
+law = "constant_velocity"
+lift = -10.0
+angle_deg = 120.0
+[[motion]]
+law = "dwell"
+angle_deg = 60.0
+[manufacturing]
+thickness_mm = 10.0
+bore_mm = 12.0
+tool_diameter_mm = {tool}
+tolerance_mm = 0.01
+"""
+
+
+def cv_jump(follower: str = "roller", roller: float = 8.0, rotation: str = "cw", offset: float = 0.0,
+            tool: float = 6.0) -> str:
+    """:data:`CV_JUMP` filled in (``roller`` ignored for a knife edge)."""
+    line = f"roller_radius_mm = {roller}\n" if follower == "roller" else ""
+    return CV_JUMP.format(follower=follower, roller=line, rotation=rotation, offset=offset, tool=tool)
+
+
 def base_design(**over):
     """A valid design dict (Ejemplo9RT) with top-level sections replaced by ``over``."""
     d = {

@@ -17,6 +17,7 @@ from pathlib import Path
 from ..design.kinds import ContactKind
 from ..discretize import ArcDiscretisation, arcs, measure_deviation, validate_tol
 from ..discretize.curve import discontinuities
+from ..discretize.tolerance import within
 from ..errors import GeometryError
 from ..geom2d import ArcChain
 from ..io import atomic_write, inside, safe_stem
@@ -96,7 +97,7 @@ def _pitch_loop(profile: ArcChain, roller_radius: float, pitch, tol: float) -> A
     loop = profile.offset_g1(roller_radius)
     if loop is not None:
         dev = float(measure_deviation(loop, pitch).max)
-        if dev <= tol:
+        if within(dev, tol):
             return loop.with_deviation(dev)
         log.info("pitch curve: the profile's arcs offset by the roller radius %g mm deviate %.3g mm > tol = %g mm "
                  "from it; falling back to a fit of its own", roller_radius, dev, tol)

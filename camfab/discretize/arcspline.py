@@ -24,6 +24,7 @@ from .measure import measure_deviation
 from .spanmodel import SpanModel, cumtrapz, equioscillate
 from .spans import Span, cut_spans, span_density, span_ends
 from .surrogate import HermiteSurrogate
+from .tolerance import within
 
 __all__ = ["fit_spline"]
 
@@ -319,7 +320,7 @@ def fit_spline(curve: ParametricCurve, surrogate: tuple[HermiteSurrogate, float]
             chain, labels = _merge_wrap(chain, labels)
         merged = merge_cocircular(chain, labels)
         dev = measure_deviation(merged, curve)
-        if dev.max <= tol:
+        if within(dev.max, tol):
             return merged, dev.max, params
         worst = _span_deviations(curve, spans, parts, merged, dev)
         for j in np.flatnonzero(worst > 0.99 * tol):

@@ -137,7 +137,10 @@ def derivatives_at(curve: ParametricCurve, t, lo, hi) -> np.ndarray:
                                  "return np.column_stack([dx, dy])")
             return d
 
-        delta = 1e-7 * width
+        # δ = 1e-7 of the piece, but at least a few ulps of the parameter (a piece 1e-9° wide would
+        # otherwise put t1 and t2 on the same float) and at most an eighth of the piece
+        ulps = 8 * np.spacing(np.maximum(np.abs(lo), np.abs(hi)))
+        delta = np.minimum(np.maximum(1e-7 * width, ulps), width / 8)
         near_lo = t - lo < 2 * delta
         near_hi = (hi - t < 2 * delta) & ~near_lo
         near = near_lo | near_hi
@@ -149,7 +152,8 @@ def derivatives_at(curve: ParametricCurve, t, lo, hi) -> np.ndarray:
         out = vals[:t.size]
         if near.any():
             d1, d2 = vals[t.size:t.size + t1.size], vals[t.size + t1.size:]
-            frac = ((t[near] - t1) / (t2 - t1))[:, None]
+            step = t2 - t1
+            frac = np.where(step != 0, (t[near] - t1) / np.where(step != 0, step, 1.0), 0.0)[:, None]
             out[near] = d1 + frac * (d2 - d1)
         return out.reshape(shape + (2,))
     h = np.minimum(1e-6 * curve.period, width / 8.0)
@@ -204,12 +208,14 @@ def discontinuities(curve: ParametricCurve, tol: float) -> list[tuple[float, flo
     """The breakpoints where ``P`` itself jumps by more than ``tol / 100`` mm (the protocol wants it
     continuous): ``(parameter, gap in mm)`` each, the closure of a closed curve included."""
     bp = np.asarray(curve.breakpoints, dtype=float)
-    h = 1e-9 * curve.period
     inner = bp[(bp > 0) & (bp < curve.period)]
     ends = [curve.period] if curve.closed else []
     at = np.concatenate([inner, ends])
     if at.size == 0:
         return []
+    # the two samples stay inside the piece to the left (a piece may be far shorter than 1e-9 of the period)
+    width = at - bp[np.searchsorted(bp, at) - 1]
+    h = np.maximum(np.minimum(1e-9 * curve.period, width / 4), 4 * np.spacing(at))
     left = 2.0 * points_at(curve, at - h) - points_at(curve, at - 2.0 * h)  # the limit from the left, O(h²)
     right = points_at(curve, np.where(at == curve.period, 0.0, at))
     gap = np.hypot(*(right - left).T)

@@ -47,7 +47,7 @@ from .interpolate import biarc_chain, fit_grid
 from .measure import measure_deviation
 from .results import ArcDiscretisation, Discretisation
 from .surrogate import fit_surrogate
-from .tolerance import validate_tol
+from .tolerance import validate_tol, within
 
 __all__ = ["polyline", "arcs"]
 
@@ -111,7 +111,7 @@ class _BiarcGrids:
         if merged is chain:
             return chain, measure_deviation(chain, self.curve).max
         measured = measure_deviation(merged, self.curve).max
-        return (merged, measured) if measured <= self.tol else (chain, measure_deviation(chain, self.curve).max)
+        return (merged, measured) if within(measured, self.tol) else (chain, measure_deviation(chain, self.curve).max)
 
 
 def arcs(curve: ParametricCurve, *, tol: float = DEFAULT_EXPORT_TOL_MM) -> ArcDiscretisation:

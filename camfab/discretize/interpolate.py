@@ -21,7 +21,7 @@ from .chain import Chain
 from .curve import ParametricCurve, derivatives_at, discontinuities, piece_index, points_at
 from .entities import MAX_TURNING_RAD, biarc, entity_distance, entity_point
 from .surrogate import HermiteSurrogate, fit_surrogate
-from .tolerance import MARGIN
+from .tolerance import MARGIN, within
 
 __all__ = ["fit_grid", "biarc_chain"]
 
@@ -317,7 +317,7 @@ def fit_grid(curve: ParametricCurve, tol: float, kind: str, verify: Callable[[np
             nodes, dev = alt, alt_dev
     for _ in range(6):
         measured = verify(nodes)
-        if measured <= tol:
+        if within(measured, tol):
             return nodes, measured
         target *= 0.7
         nodes, dev = _refine(curve, nodes, target, kind, dev)

@@ -6,10 +6,20 @@ import math
 from ..errors import InputError
 from ..tolerances import DEFAULT_EXPORT_TOL_MM, MAX_EXPORT_TOL_MM, MIN_EXPORT_TOL_MM
 
-__all__ = ["MARGIN", "ToleranceError", "validate_tol"]
+__all__ = ["MARGIN", "WRITE_ROOM_MM", "ToleranceError", "validate_tol", "within"]
 
 #: refinement stops when the measured deviation is below ``tol * (1 - MARGIN)``
 MARGIN = 0.05
+#: a fit is accepted when its measured deviation is at most ``tol - WRITE_ROOM_MM`` (mm): the room the writers'
+#: rounding and a reader's reconstruction need (17 significant digits, bulges back to arcs: ~1e-14 mm on a
+#: 100 mm cam), so that a fit landing exactly on ``tol`` (a 1 µm bump left out at tol = 1 µm) still reads back
+#: within it.  A thousandth of the smallest accepted tolerance.
+WRITE_ROOM_MM = 1e-9
+
+
+def within(measured: float, tol: float) -> bool:
+    """True when a measured deviation is acceptable for ``tol``: at most ``tol - WRITE_ROOM_MM``."""
+    return measured <= tol - WRITE_ROOM_MM
 
 
 class ToleranceError(InputError):

@@ -12,6 +12,7 @@ are refused with their angle ranges and the largest cutter that fits.
 """
 from __future__ import annotations
 
+import logging
 import math
 from dataclasses import dataclass
 
@@ -20,10 +21,13 @@ import numpy as np
 from ..discretize import ArcDiscretisation, ParametricCurve, arcs, measure_deviation, polyline, validate_tol
 from ..errors import GeometryError
 from ..tolerances import DEFAULT_EXPORT_TOL_MM
+from .corners import corner_note, cornered_curve, roller_corners
 from .outline import translating_outline
 
 __all__ = ["profile_curve", "pitch_curve", "offset_curve", "concave_limit", "ToolCentrePath",
            "tool_centre_path", "shapely_offset", "roller_envelope_deviation", "QUAD_SEGS", "JOIN_STYLE"]
+
+log = logging.getLogger(__name__)
 
 #: shapely buffer resolution (segments per quarter circle) and join style, always explicit
 QUAD_SEGS = 64
@@ -47,6 +51,11 @@ def profile_curve(contact) -> ParametricCurve:
     """
     if not contact.closed:
         return translating_outline(contact)
+    corners = roller_corners(contact)
+    if corners:  # a velocity jump (only under --force): the profile the roller really makes there
+        log.info("profile: the pitch curve turns abruptly at %s; the profile follows the roller round it",
+                 corner_note(contact, corners))
+        return cornered_curve(contact, corners)
     return ParametricCurve(lambda t: contact.evaluate(t).point, contact.breakpoints, contact.period,
                            lambda t: contact.evaluate(t).point_d1)
 
@@ -70,6 +79,9 @@ def offset_curve(contact, distance: float) -> ParametricCurve:
     """
     if not contact.closed:
         return translating_outline(contact, distance)
+    corners = roller_corners(contact)
+    if corners:  # a velocity jump (only under --force): the offset of the profile the roller really makes
+        return cornered_curve(contact, corners, distance)
 
     def point(t):
         s = contact.evaluate(t)

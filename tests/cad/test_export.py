@@ -125,7 +125,7 @@ def test_cli_export_refuses_unacceptable_unless_forced(tmp_path, capsys):
     assert main(["export", str(d), "--dxf", "-o", str(out)]) == 1
     assert "nothing written" in capsys.readouterr().err
     assert not out.exists()
-    assert main(["export", str(d), "--dxf", "--force", "-o", str(out)]) == 0
+    assert main(["export", str(d), "--dxf", "--force", "-o", str(out)]) == 1  # written, still unacceptable
     assert (out / "Ejemplo9RT.dxf").exists()
 
 
