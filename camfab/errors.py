@@ -18,6 +18,8 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+from .textsafe import excerpt
+
 __all__ = [
     "CamfabError",
     "Problem",
@@ -29,24 +31,6 @@ __all__ = [
     "ApiError",
     "InternalError",
 ]
-
-
-SHOWN_CHARS = 80
-"""How much of a value a message repeats: a problem names the value it refuses, not a copy of a 5 MB string."""
-
-
-def shown(value: Any, limit: int = SHOWN_CHARS) -> str:
-    """``repr(value)`` cut to ``limit`` characters with the length of what was left out, for messages.
-
-    >>> shown("ab" * 500, limit=20)
-    "'abababab... (1002 characters)"
-    >>> shown(3.5)
-    '3.5'
-    """
-    text = repr(value)
-    if len(text) <= limit:
-        return text
-    return f"{text[:limit - 11]}... ({len(text)} characters)"
 
 
 class CamfabError(Exception):
@@ -63,7 +47,7 @@ class Problem:
     fix: str = ""
 
     def __str__(self) -> str:
-        text = f"{self.path} = {shown(self.value)}: {self.rule}"
+        text = f"{self.path} = {excerpt(repr(self.value))}: {self.rule}"  # a 5 MB value is not repeated
         return f"{text}; {self.fix}" if self.fix else text
 
     def to_dict(self) -> dict[str, Any]:

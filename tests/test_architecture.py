@@ -19,7 +19,7 @@ BASE = ("camfab.version", "camfab.errors", "camfab.units", "camfab.tolerances", 
         "camfab.geom2d", "camfab.textsafe", "camfab.limits")
 LAYERS: dict[str, tuple[str, ...]] = {
     "camfab.version": (),
-    "camfab.errors": (),
+    "camfab.errors": ("camfab.textsafe",),  # messages quote values through textsafe.excerpt
     "camfab.units": (),
     "camfab.tolerances": (),
     "camfab.limits": ("camfab.errors",),

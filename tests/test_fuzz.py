@@ -42,7 +42,7 @@ EXAMPLES = Path(camfab.__file__).resolve().parent / "examples"
 BASES = {p.stem: tomllib.loads(p.read_text()) for p in sorted(EXAMPLES.glob("*.toml"))
          if "motion_table" not in tomllib.loads(p.read_text())}
 BUDGET = 2 << 30  # bytes of address space each example may add
-EXAMPLES_PER_TEST = int(os.environ.get("CAMFAB_FUZZ_EXAMPLES", "60"))  # more for a deeper local run
+EXAMPLES_PER_TEST = int(os.environ.get("CAMFAB_FUZZ_EXAMPLES", "200"))  # more for a deeper local run
 SETTINGS = settings(max_examples=EXAMPLES_PER_TEST, deadline=None, derandomize=True, database=None,
                     suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 
