@@ -286,9 +286,7 @@ _VERIFY_JOB_FLAGS = {"tool_diameter": "tool_diameter_mm", "safe_z": "safe_z_mm",
 
 @register("verify", "back-plot a G-code program and check it against the exact design and its job", _verify_args)
 def cmd_verify(args: argparse.Namespace) -> int:
-    from .gcode.cam import signed_distance
-    from .gcode.verify import verify_program
-    from .offset import profile_curve
+    from .gcode.cam import verify_cam_program
 
     cam = _cam(args.design)
     tol = _tol(cam, args.tol)
@@ -300,13 +298,8 @@ def cmd_verify(args: argparse.Namespace) -> int:
     job = pipeline.gcode_job(cam.spec, tol=tol, overrides={key: getattr(args, flag)
                                                             for flag, key in _VERIFY_JOB_FLAGS.items()})
     data = Path(args.program).read_bytes()  # a missing file is an I/O error (3); an unreadable one a finding
-    contact, r = profiles[args.profile - 1], job.tool_radius_mm
-    part = signed_distance(profile_curve(contact), tol=tol)
-    # the exact tool-centre curve is the set of points r from the part: its distance is |part distance - r|
-    rep = verify_program(data, post=args.post, default_post=cam.spec.outputs.gcode or "linuxcnc",
-                         exact_curve_distance=lambda p: part(p) - r, part_distance=part, part_curve=part,
-                         tool_radius=r, tol=tol, safe_z=job.safe_z_mm, top_z=0.0, comp_radius=args.comp_radius,
-                         job=job)
+    rep = verify_cam_program(data, profiles[args.profile - 1], job, tol=tol, post=args.post,
+                             default_post=cam.spec.outputs.gcode or "linuxcnc", comp_radius=args.comp_radius)
     if args.json:
         print(json.dumps(rep.to_dict(), indent=2))
     else:

@@ -117,6 +117,7 @@ class IssueCode(StrEnum):
     TOO_DEEP = "TOO_DEEP"
     STEP_DOWN = "STEP_DOWN"
     DIRECTION = "DIRECTION"
+    RETRACT_MISSING = "RETRACT_MISSING"
     # cutter-radius compensation (simulated as the controller runs it)
     COMP_ENTRY = "COMP_ENTRY"
     COMP_EXIT = "COMP_EXIT"

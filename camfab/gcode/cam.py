@@ -8,16 +8,20 @@ reaches the toolpath builder as an :class:`~camfab.geom2d.ArcChain`.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
+
+import numpy as np
 
 from ..discretize import ParametricCurve, arcs, polyline
 from ..geom2d import ArcChain
 from ..offset.cutter import offset_curve, profile_curve, tool_centre_path
-from .distance import IndexedContourDistance
+from .distance import CurveDistance
 from .model import Job, Program
 from .toolpath import contour_toolpath
+from .verify import VerifyReport, verify_program
 
-__all__ = ["FIT_SHARE", "CamProgram", "cam_program", "signed_distance"]
+__all__ = ["FIT_SHARE", "CamProgram", "cam_program", "signed_distance", "verify_cam_program"]
 
 
 @dataclass(frozen=True)
@@ -70,13 +74,37 @@ def _rough(contact, job: Job, tol: float) -> list[ArcChain]:
     return out
 
 
-def signed_distance(curve: ParametricCurve, *, tol: float) -> IndexedContourDistance:
+def signed_distance(curve: ParametricCurve, *, tol: float, exact_within: float = math.inf) -> CurveDistance:
     """``f(points (n, 2)) -> (n,)``: signed distance to a closed exact curve, positive outside.
 
-    Measures against a polyline within ``tol/50`` of the curve (so distances are exact to ``tol/50``),
-    through :class:`~camfab.gcode.distance.IndexedContourDistance`: each point costs an R-tree query for
-    its nearest segment, not a pass over every vertex.
-    The returned object also gives points along the curve (``.points(spacing, max_per_entity)``, for the
-    verifier's coverage check).
+    Exact (to rounding: the nearest point of the curve itself, :class:`~camfab.gcode.distance.CurveDistance`),
+    at a cost that follows the number of points, not the size of the curve.  ``tol`` is the caller's
+    tolerance, kept for the signature (the distance no longer depends on it); points farther than
+    ``exact_within`` may get a value off by at most 0.01 mm, with the right sign.
     """
-    return IndexedContourDistance(polyline(curve, tol=max(tol / 50, 1e-6)).arc_chain())
+    return CurveDistance(curve, exact_within=exact_within)
+
+
+def verify_cam_program(program: str | bytes, contact, job: Job, *, tol: float, post: str | None = None,
+                       default_post: str | None = None, comp_radius: float | None = None,
+                       part: CurveDistance | None = None) -> VerifyReport:
+    """What ``camfab verify`` checks: ``program`` (text or bytes) against the exact profile ``contact`` and
+    the ``job`` (final depth, step-down, feeds, spindle, coolant, tool, direction, safe height), with
+    coverage of the whole contour; a program that cannot be read is a ``PARSE_ERROR`` finding.
+
+    The exact tool-centre curve is the set of points ``job.tool_radius_mm`` from the part, so its distance
+    is ``|part distance - r|`` (one exact distance serves the deviation, the gouge and the coverage).
+    ``part`` is :func:`signed_distance` of the profile (built when not given): exact up to ``r + tol`` and
+    a little more, which every judgement needs (gouge below ``r - tol``, deviation ``|d - r| <= tol``).
+    """
+    if part is None:
+        part = signed_distance(profile_curve(contact), tol=tol, exact_within=job.tool_radius_mm + tol + 0.05)
+    r = job.tool_radius_mm
+    dist = part
+
+    def centre(p: np.ndarray) -> np.ndarray:
+        return dist(p) - r
+
+    return verify_program(program, post=post, default_post=default_post, exact_curve_distance=centre,
+                          part_distance=part, part_curve=part, tool_radius=r, tol=tol, safe_z=job.safe_z_mm,
+                          top_z=0.0, comp_radius=comp_radius, job=job)

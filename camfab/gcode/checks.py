@@ -16,7 +16,7 @@ from camfab.gcode.posts.base import Post
 from camfab.results import Finding, IssueCode
 
 __all__ = ["EPS_Z", "FEED_ATOL", "FEED_RTOL", "depth_findings", "direction_findings", "feed_findings", "line_list",
-           "machine_state_findings", "modal_state", "xy_travel"]
+           "machine_state_findings", "modal_state", "retract_findings", "xy_travel"]
 
 #: heights closer than this (mm) are the same level
 EPS_Z = 1e-6
@@ -153,6 +153,17 @@ def depth_findings(moves, cutting, fin_final, zf: float, job: Job, top_z: float,
             IssueCode.STEP_DOWN, f"cutting up to {worst:.4f} mm deeper than anything cut before; the job's step-down "
             f"is {job.step_down_mm:g} mm: lines {line_list(lines)}", lines[0]))
     return out
+
+
+def retract_findings(moves, top_z: float) -> list[Finding]:
+    """RETRACT_MISSING: the program ends with the tool below the stock top (in the material)."""
+    if not moves:
+        return []
+    z = moves[-1].end[2]
+    if not (math.isfinite(z) and z < top_z - EPS_Z):
+        return []
+    return [Finding.at_line(IssueCode.RETRACT_MISSING, f"the program ends with the tool at Z{z:.4f}, below the stock "
+                            f"top Z{top_z:.4f}: retract it before the spindle stops", moves[-1].line)]
 
 
 def direction_findings(pts: np.ndarray, job: Job, line: int) -> list[Finding]:

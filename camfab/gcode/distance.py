@@ -32,7 +32,7 @@ from camfab.errors import ApiError, GeometryError
 from camfab.gcode.contour import Segment, as_contour
 from camfab.geom2d import TWO_PI, ArcChain
 
-__all__ = ["Entities", "IndexedContourDistance", "SAMPLES_PER_CHAIN"]
+__all__ = ["CurveDistance", "Entities", "IndexedContourDistance", "SAMPLES_PER_CHAIN"]
 
 #: samples spread along a chain for the candidate search (the spacing is the chain's length over this)
 SAMPLES_PER_CHAIN = 4096
@@ -40,6 +40,10 @@ SAMPLES_PER_CHAIN = 4096
 _K = 16
 #: the most nearest samples tried (16, 128) before a ball query gathers every candidate of a point
 _K_MAX = 128
+#: sub-intervals of a coarse segment where the nearest point of the curve is looked for
+_SUB = 4
+#: the most Illinois steps (it converges with order 1.44: ~12 from a grid bracket to 1e-13)
+_ILLINOIS_STEPS = 60
 #: point-entity pairs measured at once (bounds the memory)
 _PAIRS = 1 << 18
 #: points per ball query (bounds the memory of the candidate lists)
@@ -297,7 +301,9 @@ class IndexedContourDistance:
         self.clockwise = bool(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y) < 0)
         self.polygon = shapely.Polygon(poly)
         shapely.prepare(self.polygon)
-        self._lines = None if e.arc.any() else shapely.STRtree(shapely.linestrings(np.stack([e.a, e.b], axis=1)))
+        #: an R-tree of the segments when the contour is a polyline (None with arcs)
+        self.segments_tree = None if e.arc.any() else shapely.STRtree(
+            shapely.linestrings(np.stack([e.a, e.b], axis=1)))
         self._cum = np.concatenate([[0.0], np.cumsum(e.length)])
 
     def __call__(self, points) -> np.ndarray:
@@ -310,8 +316,8 @@ class IndexedContourDistance:
             out = np.full(len(p), np.nan)
             out[ok] = self(p[ok])
             return out
-        if self._lines is not None and len(p):  # a polyline: GEOS's R-tree finds the nearest segment exactly
-            (i, j), _ = self._lines.query_nearest(shapely.points(p), return_distance=True, all_matches=False)
+        if self.segments_tree is not None and len(p):  # a polyline: GEOS's R-tree finds the nearest segment exactly
+            (i, j), _ = self.segments_tree.query_nearest(shapely.points(p), return_distance=True, all_matches=False)
             d, interior, inside = self.entities.pair(p, j[np.argsort(i, kind="stable")], not self.clockwise)
         else:
             d, _, interior, inside = self.entities.nearest(p, ccw=not self.clockwise)
@@ -335,17 +341,194 @@ class IndexedContourDistance:
         import shapely
 
         p = np.asarray(points, dtype=float).reshape(-1, 2)
-        if self._lines is not None and len(p):
-            (i, j), _ = self._lines.query_nearest(shapely.points(p), return_distance=True, all_matches=False)
+        if self.segments_tree is not None and len(p):
+            (i, j), _ = self.segments_tree.query_nearest(shapely.points(p), return_distance=True, all_matches=False)
             j = j[np.argsort(i, kind="stable")]
             d = self.entities.pair(p, j)[0]
         else:
             d, j, _, _ = self.entities.nearest(p)
         return d, self._cum[j] + self.entities.fraction(p, j) * self.entities.length[j]
 
-    def at_position(self, s) -> np.ndarray:
-        """Points of the contour at arc-length positions ``s`` (wrapped into ``[0, length)``)."""
+    def locate(self, s) -> tuple[np.ndarray, np.ndarray]:
+        """Entity and fraction along it of the arc-length positions ``s`` (wrapped into ``[0, length)``)."""
         s = np.mod(np.asarray(s, dtype=float).reshape(-1), self.length)
         j = np.clip(np.searchsorted(self._cum, s, side="right") - 1, 0, len(self.entities) - 1)
         L = self.entities.length[j]
-        return self.entities.at(j, np.clip((s - self._cum[j]) / np.where(L > 0, L, 1.0), 0.0, 1.0))
+        return j, np.clip((s - self._cum[j]) / np.where(L > 0, L, 1.0), 0.0, 1.0)
+
+    def at_position(self, s) -> np.ndarray:
+        """Points of the contour at arc-length positions ``s`` (wrapped into ``[0, length)``)."""
+        return self.entities.at(*self.locate(s))
+
+
+class CurveDistance:
+    """Exact signed distance to a closed exact curve (negative inside), at a cost that follows the points.
+
+    A coarse polyline of the curve (within ``coarse_tol``; its vertices include every breakpoint) only
+    brackets the answer: for each point, every coarse segment within ``2 * coarse_tol`` of the nearest one
+    (an R-tree query) is a candidate, and on each candidate's parameter interval - one smooth piece of the
+    curve - the nearest point of the curve itself is found from the distance and its slope at ``_SUB + 1``
+    points of the segment's interval and Illinois regula falsi on ``(P(t) - p) . P'(t)`` where it
+    brackets a minimum (to ``1e-13`` of the bracket).  The exact curve's nearest point
+    lies on a candidate (every piece lies within ``coarse_tol`` of its segment), so the distance is the
+    curve's, to rounding: no stand-in polyline of ``tol / 50`` whose size grows with the part.  The side
+    comes from the curve's normal at the nearest point, or from the coarse polygon where that point is a
+    piece's end (a kink), which can only be wrong within ``coarse_tol`` of the curve.
+
+    Points whose distance exceeds ``exact_within`` by more than ``coarse_tol`` get the distance to the
+    coarse polyline instead (off by at most ``coarse_tol``, with the right sign): a caller that only needs
+    exact values near a threshold saves the refinement elsewhere.
+
+    Parameters
+    ----------
+    curve : ParametricCurve
+        Closed.
+    coarse_tol : float
+        Tolerance of the bracketing polyline, mm (default 0.01).
+    exact_within : float
+        Distances up to this are exact (default: all).
+    """
+
+    def __init__(self, curve, coarse_tol: float = 0.01, exact_within: float = math.inf):
+        from camfab.discretize import polyline
+
+        self.curve = curve
+        self.exact_within = float(exact_within)
+        disc = polyline(curve, tol=coarse_tol)
+        self.coarse_tol = float(disc.max_deviation if disc.max_deviation > 0 else coarse_tol)
+        self.params = np.asarray(disc.params, dtype=float)
+        self.coarse = IndexedContourDistance(disc.arc_chain())
+        self._ccw = not self.coarse.clockwise
+
+    @property
+    def length(self) -> float:
+        """Length of the coarse polyline, mm (within ``coarse_tol`` of the curve's)."""
+        return self.coarse.length
+
+    def _nearest(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Exact distance, curve parameter and 'at a piece end' of the nearest point of the curve."""
+        import shapely
+
+        geoms = shapely.points(p)
+        tree = self.coarse.segments_tree
+        (i0, j0), d0 = tree.query_nearest(geoms, return_distance=True, all_matches=False)
+        reach = np.empty(len(p))
+        reach[i0] = d0 + 2.0 * self.coarse_tol * (1 + 1e-9) + 1e-12
+        qi, qj = tree.query(geoms, predicate="dwithin", distance=reach)
+        qi, qj = np.concatenate([qi, i0]), np.concatenate([qj, j0])  # the nearest always, whatever the rounding
+        d, t, end = self._refine(p[qi], self.params[qj], self.params[qj + 1])
+        order = np.lexsort((t, d, qi))  # per point: the smallest distance
+        qi, d, t, end = qi[order], d[order], t[order], end[order]
+        first = np.ones(len(qi), dtype=bool)
+        first[1:] = qi[1:] != qi[:-1]
+        return d[first], t[first], end[first]
+
+    def _refine(self, p: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Nearest point of the curve on ``[a, b]`` (one smooth piece) to each ``p``: ``(distance, t, at an end)``.
+
+        The distance and ``g(t) = (P(t) - p) . P'(t)`` at ``_SUB + 1`` points across the interval; every change
+        of sign of ``g`` from - to + between two of them (a local minimum) that could beat the nearest of
+        those points (the distance is 1-Lipschitz along the arc) is refined by Illinois regula falsi.  A
+        point near a centre of curvature sees a nearly flat distance with several extrema: all are looked at.
+        """
+        from camfab.discretize.curve import points_at
+
+        curve = self.curve
+        n = len(p)
+        grid = a[:, None] + (b - a)[:, None] * (np.arange(_SUB + 1) / _SUB)[None, :]  # (n, SUB+1)
+        rep = np.repeat(np.arange(n), _SUB + 1)
+        tg = grid.reshape(-1)
+        q = points_at(curve, tg)
+        g = _slope(curve, p[rep], tg, a[rep], b[rep], q).reshape(n, _SUB + 1)
+        q = q.reshape(n, _SUB + 1, 2)
+        dg = np.hypot(q[..., 0] - p[:, None, 0], q[..., 1] - p[:, None, 1])
+        rows = np.arange(n)
+        k = np.argmin(dg, axis=1)
+        d, t = dg[rows, k], grid[rows, k]
+        chord = np.hypot(*np.moveaxis(np.diff(q, axis=1), -1, 0))
+        lower = np.minimum(dg[:, :-1], dg[:, 1:]) - 0.51 * chord - 1e-12
+        pi, si = np.nonzero((g[:, :-1] < 0.0) & (g[:, 1:] > 0.0) & (lower < d[:, None]))
+        if len(pi):
+            tk = self._illinois(p[pi], grid[pi, si], grid[pi, si + 1], g[pi, si], g[pi, si + 1], a[pi], b[pi])
+            dk = np.hypot(*(p[pi] - points_at(curve, tk)).T)
+            better = np.full(n, np.inf)
+            np.minimum.at(better, pi, dk)
+            hit = dk <= better[pi]
+            closer = better[pi[hit]] < d[pi[hit]]
+            d[pi[hit][closer]], t[pi[hit][closer]] = dk[hit][closer], tk[hit][closer]
+        return d, t, (t <= a) | (t >= b)
+
+    def _illinois(self, p, x0, x1, g0, g1, lo, hi) -> np.ndarray:
+        """The root of ``g`` in each bracket ``[x0, x1]`` (``g0 < 0 < g1``): Illinois regula falsi until a step
+        is below 1e-13 of the first bracket."""
+        x0, x1, g0, g1 = x0.copy(), x1.copy(), g0.copy(), g1.copy()
+        tol = 1e-13 * np.abs(x1 - x0) + 1e-300
+        t = x1.copy()
+        live = np.ones(len(p), dtype=bool)
+        for _ in range(_ILLINOIS_STEPS):
+            k = np.nonzero(live)[0]
+            if not len(k):
+                break
+            tk = np.clip(x1[k] - g1[k] * (x1[k] - x0[k]) / (g1[k] - g0[k]), np.minimum(x0[k], x1[k]),
+                         np.maximum(x0[k], x1[k]))
+            gk = _slope(self.curve, p[k], tk, lo[k], hi[k])
+            flip = np.sign(gk) != np.sign(g1[k])
+            # the bracket [x0, x1] keeps opposite signs: on a flip the old x1 becomes x0, else x0 stays with
+            # its value halved (Illinois)
+            g0[k] = np.where(flip, g1[k], 0.5 * g0[k])
+            x0[k] = np.where(flip, x1[k], x0[k])
+            step = np.abs(tk - t[k])
+            x1[k], g1[k], t[k] = tk, gk, tk
+            live[k[(step <= tol[k]) | (gk == 0.0)]] = False
+        return t
+
+    def __call__(self, points) -> np.ndarray:
+        """Signed distance of ``points`` (array ``(n, 2)``) in mm; negative inside."""
+        import shapely
+
+        from camfab.discretize.curve import derivatives_at, piece_index, points_at
+
+        p = np.asarray(points, dtype=float).reshape(-1, 2)
+        ok = np.all(np.isfinite(p), axis=1)
+        out = np.full(len(p), np.nan)
+        if not ok.any():
+            return out
+        coarse = self.coarse(p[ok])
+        near = np.abs(coarse) <= self.exact_within + self.coarse_tol
+        out[np.nonzero(ok)[0][~near]] = coarse[~near]
+        if not near.any():
+            return out
+        pk = p[ok][near]
+        d, t, end = self._nearest(pk)
+        piece = piece_index(self.curve, t)
+        bp = self.curve.breakpoints
+        tangent = derivatives_at(self.curve, t, bp[piece], bp[piece + 1])
+        q = points_at(self.curve, t)
+        cross = tangent[:, 0] * (pk[:, 1] - q[:, 1]) - tangent[:, 1] * (pk[:, 0] - q[:, 0])
+        inside = cross > 0 if self._ccw else cross < 0
+        if end.any():
+            e = np.nonzero(end)[0]
+            inside[e] = shapely.contains_xy(self.coarse.polygon, pk[e, 0], pk[e, 1])
+        out[np.nonzero(ok)[0][near]] = np.where(inside, -d, d)
+        return out
+
+    def project(self, points) -> tuple[np.ndarray, np.ndarray]:
+        """Distance to the coarse polyline and the arc-length position along it of each point's nearest point."""
+        return self.coarse.project(points)
+
+    def at_position(self, s) -> np.ndarray:
+        """Points of the exact curve at arc-length positions ``s`` of the coarse polyline (wrapped)."""
+        from camfab.discretize.curve import points_at
+
+        j, u = self.coarse.locate(s)
+        return points_at(self.curve, self.params[j] + u * (self.params[j + 1] - self.params[j]))
+
+
+def _slope(curve, p: np.ndarray, t: np.ndarray, lo: np.ndarray, hi: np.ndarray, q: np.ndarray | None = None
+           ) -> np.ndarray:
+    """``(P(t) - p) . P'(t)``: half the derivative of the squared distance along the curve (``q = P(t)`` if known)."""
+    from camfab.discretize.curve import derivatives_at, points_at
+
+    if q is None:
+        q = points_at(curve, t)
+    return np.einsum("ij,ij->i", q - p, derivatives_at(curve, t, lo, hi))

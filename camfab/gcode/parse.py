@@ -28,7 +28,7 @@ import numpy as np
 from camfab.errors import CamfabError, InputError
 from camfab.geom2d import arc_sweep
 
-__all__ = ["GcodeError", "Move", "Backplot", "Samples", "parse", "backplot", "sample"]
+__all__ = ["GcodeError", "Move", "Backplot", "Samples", "parse", "backplot", "points_along", "sample"]
 
 MM_PER_INCH = 25.4
 
@@ -155,10 +155,12 @@ class Backplot:
 
 @dataclass(frozen=True)
 class Samples:
-    """Points along moves: ``points`` ``(n, 3)`` mm and ``index`` ``(n,)`` of the move each came from."""
+    """Points along moves: ``points`` ``(n, 3)`` mm, ``index`` ``(n,)`` of the move each came from and ``param``
+    ``(n,)``, where along it (0 at its start, 1 at its end)."""
 
     points: np.ndarray
     index: np.ndarray
+    param: np.ndarray | None = None
 
 
 def _strip_comments(raw: str, lineno: int) -> tuple[str, list[str]]:
@@ -508,32 +510,40 @@ class _State:
                     radius_start=rs, radius_end=re_, **common)
 
 
-def _move_points(m: Move, step: float, max_per_move: int | None = None) -> np.ndarray:
-    s = np.array(m.start, dtype=float)
-    e = np.array(m.end, dtype=float)
+def _move_params(m: Move, step: float, max_per_move: int | None = None) -> np.ndarray:
+    """Fractions along ``m`` of its sample points: at most ``step`` mm apart, at most ``max_per_move`` intervals,
+    arcs at least one per 5.6 degrees."""
+    s, e = np.array(m.start, dtype=float), np.array(m.end, dtype=float)
     if m.kind != "arc":
         if not np.all(np.isfinite(s)):
-            return e[None, :]
+            return np.ones(1)
         L = float(np.linalg.norm(e - s))
         k = max(1, int(math.ceil(L / step)))
         if max_per_move is not None:
             k = min(k, max_per_move)
-        u = np.linspace(0.0, 1.0, k + 1)
-        return s + u[:, None] * (e - s)
-    assert m.center is not None  # an arc always carries its centre (_State.arc)
-    cx, cy = m.center
+        return np.linspace(0.0, 1.0, k + 1)
     L = abs(m.sweep) * max(m.radius_start, m.radius_end)
     k = int(math.ceil(L / step))
     if max_per_move is not None:
         k = min(k, max_per_move)
     k = max(k, 2, int(math.ceil(abs(m.sweep) / (math.pi / 32))))
-    u = np.linspace(0.0, 1.0, k + 1)
-    a0 = math.atan2(s[1] - cy, s[0] - cx)
-    a = a0 + m.sweep * u
+    return np.linspace(0.0, 1.0, k + 1)
+
+
+def points_along(m: Move, u: np.ndarray) -> np.ndarray:
+    """Points ``(n, 3)`` of move ``m`` at fractions ``u`` of it (along the arc for arcs and spirals)."""
+    s, e = np.array(m.start, dtype=float), np.array(m.end, dtype=float)
+    u = np.asarray(u, dtype=float)
+    if m.kind != "arc":
+        if not np.all(np.isfinite(s)):
+            return np.repeat(e[None, :], len(u), axis=0)
+        return s + u[:, None] * (e - s)
+    assert m.center is not None  # an arc always carries its centre (_State.arc)
+    cx, cy = m.center
+    a = math.atan2(s[1] - cy, s[0] - cx) + m.sweep * u
     r = m.radius_start + (m.radius_end - m.radius_start) * u
-    z = s[2] + (e[2] - s[2]) * u
-    pts = np.column_stack([cx + r * np.cos(a), cy + r * np.sin(a), z])
-    pts[-1] = e
+    pts = np.column_stack([cx + r * np.cos(a), cy + r * np.sin(a), s[2] + (e[2] - s[2]) * u])
+    pts[u >= 1.0] = e
     return pts
 
 
@@ -558,12 +568,14 @@ def sample(moves: Sequence[Move], step: float = 0.05, max_per_move: int | None =
     """
     if step <= 0:
         raise InputError(f"step = {step!r}: must be > 0 (the largest distance between samples of a move, mm)")
-    chunks, idx = [], []
+    chunks, idx, par = [], [], []
     for i, m in enumerate(moves):
-        p = _move_points(m, step, max_per_move)
-        p = p[np.all(np.isfinite(p), axis=1)]
-        chunks.append(p)
-        idx.append(np.full(len(p), i, dtype=np.int64))
+        u = _move_params(m, step, max_per_move)
+        p = points_along(m, u)
+        ok = np.all(np.isfinite(p), axis=1)
+        chunks.append(p[ok])
+        idx.append(np.full(int(ok.sum()), i, dtype=np.int64))
+        par.append(u[ok])
     if not chunks:
-        return Samples(np.zeros((0, 3)), np.zeros(0, dtype=np.int64))
-    return Samples(np.concatenate(chunks), np.concatenate(idx))
+        return Samples(np.zeros((0, 3)), np.zeros(0, dtype=np.int64), np.zeros(0))
+    return Samples(np.concatenate(chunks), np.concatenate(idx), np.concatenate(par))

@@ -45,6 +45,7 @@ Checks (vectorised over the moves' sample points; each move is sampled every ``s
   nothing cut below it (``TOO_DEEP``), no cut deeper than one step-down below what was cut before
   (``STEP_DOWN``), and the finishing pass in the job's milling direction (``DIRECTION``: climb is
   clockwise around the part);
+* **end** - the program ends with the tool below the stock top (``RETRACT_MISSING``);
 * **arcs** - an arc whose start and end radius differ by more than ``tol`` (as programmed);
 * **coverage** (``curve_points``) - the largest distance from points of the exact tool-centre curve to
   the finishing moves at final depth (exact distances to the lines and arcs, simulated for compensated
@@ -57,7 +58,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -70,11 +71,12 @@ from camfab.gcode.checks import (
     line_list,
     machine_state_findings,
     modal_state,
+    retract_findings,
 )
 from camfab.gcode.compensation import CompensatedPath, simulate_compensation
-from camfab.gcode.distance import Entities, IndexedContourDistance
+from camfab.gcode.distance import CurveDistance, Entities, IndexedContourDistance
 from camfab.gcode.model import Job
-from camfab.gcode.parse import Backplot, GcodeError, parse, sample
+from camfab.gcode.parse import Backplot, GcodeError, Move, Samples, parse, points_along, sample
 from camfab.gcode.post import POSTS, get_post
 from camfab.gcode.posts.base import Post
 from camfab.results import Finding, IssueCode, Severity
@@ -84,6 +86,8 @@ __all__ = ["MAX_SAMPLES_PER_MOVE", "VerifyReport", "declared_post", "default_ste
 _EPS_Z = EPS_Z
 #: at most this many sample intervals per move: the cost follows the number of moves, not their length
 MAX_SAMPLES_PER_MOVE = 256
+#: how much finer the intervals around each move's worst sample are resolved
+_REFINE = 16
 
 
 @dataclass(frozen=True)
@@ -155,7 +159,7 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
            safe_z: float, top_z: float = 0.0, step: float | None = None,
            finish_label: str = "FINISH CONTOUR", curve_points: np.ndarray | None = None,
            comp_radius: float | None = None, job: Job | None = None, post: str | Post | None = None,
-           part_curve: IndexedContourDistance | None = None,
+           part_curve: IndexedContourDistance | CurveDistance | None = None,
            max_samples_per_move: int = MAX_SAMPLES_PER_MOVE) -> VerifyReport:
     """Check a back-plotted program.
 
@@ -193,7 +197,7 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
     post : str or Post, optional
         The controller the program is for (``"linuxcnc"``, ``"fanuc"``, ``"grbl"``): whether a tool change
         and a length offset are expected, and which code means mist coolant.
-    part_curve : IndexedContourDistance, optional
+    part_curve : IndexedContourDistance or CurveDistance, optional
         The finished part's contour (e.g. :func:`camfab.gcode.cam.signed_distance` of it, which may serve as
         ``part_distance`` too); enables the coverage check at a cost that follows the program: the
         finishing samples are projected onto the part, the stretches between consecutive ones marked
@@ -228,6 +232,7 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
     # -- feed, spindle, coolant, tool: every cutting move --------------------------------------------
     problems.extend(feed_findings(moves, cutting, job))
     problems.extend(machine_state_findings(moves, cutting, top_z, job, the_post))
+    problems.extend(retract_findings(moves, top_z))
     if job is None:
         notes.append("no job given: depth, step-down, feeds, spindle speed, coolant, tool and milling direction "
                      "were not checked against one")
@@ -257,14 +262,18 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
     # -- gouge ---------------------------------------------------------------------------------------
     gouge_at = None
     if cutting:
-        smp = sample([moves[i] for i in cutting], step, K)
-        pts, idx = smp.points, np.asarray(cutting)[smp.index]
-        below = pts[:, 2] < top_z - _EPS_Z
+        sub = [moves[i] for i in cutting]
+        smp = sample(sub, step, K)
+        below = smp.points[:, 2] < top_z - _EPS_Z
         if below.any():
-            p = pts[below]
-            ii = idx[below]
-            d = np.asarray(part_distance(p[:, :2]), dtype=float)
-            pen = r_tool - d
+            smp = _subset(smp, below)
+            pen = r_tool - np.asarray(part_distance(smp.points[:, :2]), dtype=float)
+            extra = _around_peaks(sub, smp, pen)  # each move's deepest sample, resolved 16 times finer
+            keep = extra.points[:, 2] < top_z - _EPS_Z
+            extra = _subset(extra, keep)
+            pen = np.concatenate([pen, r_tool - np.asarray(part_distance(extra.points[:, :2]), dtype=float)])
+            p = np.concatenate([smp.points, extra.points])
+            ii = np.asarray(cutting)[np.concatenate([smp.index, extra.index])]
             bad = pen > tol
             if bad.any():
                 w = int(np.argmax(np.where(bad, pen, -np.inf)))
@@ -297,21 +306,32 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
         fin_final = [i for i in fin
                      if abs(moves[i].start[2] - zf) <= _EPS_Z and abs(moves[i].end[2] - zf) <= _EPS_Z]
     if fin_final:
-        smp = sample([moves[i] for i in fin_final], step, K)
-        pts, idx = smp.points, np.asarray(fin_final)[smp.index]
-        # simulated compensated moves: the exact tool-centre curve is where the part is tool_radius away
-        comp = np.array([moves[i].comp != "G40" for i in idx])
-        dev = np.empty(len(pts))
-        if (~comp).any():
-            dev[~comp] = np.abs(np.asarray(exact_curve_distance(pts[~comp, :2]), dtype=float))
-        if comp.any():
-            dev[comp] = np.abs(np.asarray(part_distance(pts[comp, :2]), dtype=float) - r_tool)
-        w = int(np.argmax(dev))
-        max_dev = _r(dev[w])
-        if dev[w] > tol:
+        sub = [moves[i] for i in fin_final]
+
+        def deviation(pts: np.ndarray, idx: np.ndarray) -> np.ndarray:
+            # simulated compensated moves: the exact tool-centre curve is where the part is tool_radius away
+            comp = np.array([moves[i].comp != "G40" for i in idx], dtype=bool)
+            dev = np.empty(len(pts))
+            if (~comp).any():
+                dev[~comp] = np.abs(np.asarray(exact_curve_distance(pts[~comp, :2]), dtype=float))
+            if comp.any():
+                dev[comp] = np.abs(np.asarray(part_distance(pts[comp, :2]), dtype=float) - r_tool)
+            return dev
+
+        smp = sample(sub, step, K)
+        dev = deviation(smp.points, np.asarray(fin_final)[smp.index])
+        extra = _around_peaks(sub, smp, dev)  # each move's worst sample, resolved 16 times finer
+        dev_x = deviation(extra.points, np.asarray(fin_final)[extra.index])
+        pts, idx = smp.points, np.asarray(fin_final)[smp.index]  # (coverage: the evenly spaced samples)
+        dev_all = np.concatenate([dev, dev_x])
+        pts_all = np.concatenate([pts, extra.points])
+        idx_all = np.concatenate([idx, np.asarray(fin_final)[extra.index]])
+        w = int(np.argmax(dev_all))
+        max_dev = _r(dev_all[w])
+        if dev_all[w] > tol:
             problems.append(Finding.at_line(
-                IssueCode.DEVIATION, f"the finishing pass deviates {dev[w]:.4f} mm from the exact curve "
-                f"(> tol {tol} mm) at X{pts[w, 0]:.4f} Y{pts[w, 1]:.4f}", moves[int(idx[w])].line))
+                IssueCode.DEVIATION, f"the finishing pass deviates {dev_all[w]:.4f} mm from the exact curve "
+                f"(> tol {tol} mm) at X{pts_all[w, 0]:.4f} Y{pts_all[w, 1]:.4f}", moves[int(idx_all[w])].line))
         # coverage: the largest distance from the exact tool-centre curve to the finishing pass (points of it
         # given), or the thickest material the pass leaves on the part (the part's curve given)
         fin_ent = Entities.from_moves([moves[i] for i in fin_final]) if (
@@ -381,7 +401,39 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
                         finish_moves=len(fin_final), notes=tuple(notes))
 
 
-def _uncovered_probe(part: IndexedContourDistance, pts: np.ndarray, idx: np.ndarray, r_tool: float,
+def _subset(smp: Samples, keep: np.ndarray) -> Samples:
+    return Samples(smp.points[keep], smp.index[keep], None if smp.param is None else smp.param[keep])
+
+
+def _around_peaks(moves: Sequence[Move], smp: Samples, value: np.ndarray, n: int = _REFINE) -> Samples:
+    """``n + 1`` points across the two sample intervals around each move's largest ``value``.
+
+    Sampled at most ``max_samples_per_move`` times, a long move's worst point lies between two samples;
+    the quantities measured (deviation, penetration) are smooth along a line or an arc, so resolving the
+    intervals around each move's worst sample ``n`` times finer brings the maximum to its true value.
+    """
+    if not len(value) or smp.param is None:
+        return Samples(np.zeros((0, 3)), np.zeros(0, dtype=np.int64), np.zeros(0))
+    order = np.lexsort((-value, smp.index))
+    first = np.ones(len(order), dtype=bool)
+    first[1:] = smp.index[order][1:] != smp.index[order][:-1]
+    pts, ind, par = [], [], []
+    for j in order[first]:
+        i, u = int(smp.index[j]), smp.param
+        lo = u[j - 1] if j > 0 and smp.index[j - 1] == i else u[j]
+        hi = u[j + 1] if j + 1 < len(u) and smp.index[j + 1] == i else u[j]
+        if hi <= lo:
+            continue
+        uu = np.linspace(lo, hi, n + 1)
+        pts.append(points_along(moves[i], uu))
+        ind.append(np.full(n + 1, i, dtype=np.int64))
+        par.append(uu)
+    if not pts:
+        return Samples(np.zeros((0, 3)), np.zeros(0, dtype=np.int64), np.zeros(0))
+    return Samples(np.concatenate(pts), np.concatenate(ind), np.concatenate(par))
+
+
+def _uncovered_probe(part: IndexedContourDistance | CurveDistance, pts: np.ndarray, idx: np.ndarray, r_tool: float,
                      tol: float) -> np.ndarray:
     """Points of the ``part`` contour to measure the coverage at: 4096 spread evenly, and up to 64 in every
     stretch that no part of the finishing pass projects onto.
@@ -471,7 +523,7 @@ def declared_post(comments) -> str | None:
     return None
 
 
-_POST_COMMENT = re.compile(r"^\s*post:\s*([A-Za-z]+)", re.IGNORECASE)
+_POST_COMMENT = re.compile(r"^\s*post:?\s+([A-Za-z]+)", re.IGNORECASE)
 def _wrong_side(comp_path: CompensatedPath, programmed, worst: dict, part_distance, r_tool: float,
                 r_comp: float, tol: float, top_z: float, step: float, join_tol: float, K: int) -> list[Finding]:
     """``COMP_WRONG_SIDE`` for each gouging G41/G42 stretch that would not gouge on the other side."""
