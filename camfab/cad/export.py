@@ -76,18 +76,18 @@ def cam_shapes(geometry, *, tol: float, with_pitch: bool = True) -> CamShapes:
 
 
 def _require_continuous(curve, tol: float) -> None:
-    """Refuse a profile that jumps: where the follower's velocity jumps the pitch curve has a corner, and a
-    roller's profile (its envelope) is not built around one — no file could be within ``tol`` of it."""
+    """Refuse a profile that still jumps.  Where the follower's velocity jumps, :func:`profile_curve` builds the
+    profile the follower makes (camfab.offset.corners: rollers, curved and flat faces); a jump left after that
+    has no curve a file could follow within ``tol``."""
     gaps = discontinuities(curve, tol)
     if not gaps:
         return
     scale = 180.0 / math.pi if math.isclose(curve.period, 2 * math.pi) else 1.0
-    unit = "°" if scale != 1.0 else " mm"
+    unit = "°" if scale != 1.0 else " (curve parameter)"
     where = ", ".join(f"{(t % curve.period) * scale:.6g}{unit} (gap {g:.3g} mm)" for t, g in gaps)
-    raise GeometryError(f"the profile is not continuous at {where}: the follower's velocity jumps there, so the "
-                        "pitch curve has a corner that a roller's profile does not follow; no file can be made "
-                        "within the tolerance even with --force: match the velocities at the junctions "
-                        "(e.g. cycloidal or modified-sine rises instead of constant velocity)")
+    raise GeometryError(f"the profile is not continuous at {where}: no file can be made within the tolerance "
+                        "even with --force; check the design for a velocity jump and match the velocities at the "
+                        "junctions (e.g. cycloidal or modified-sine rises instead of constant velocity)")
 
 
 def _pitch_loop(profile: ArcChain, roller_radius: float, pitch, tol: float) -> ArcChain:

@@ -206,17 +206,25 @@ def curvature_at(curve: ParametricCurve, t) -> np.ndarray:
 
 def discontinuities(curve: ParametricCurve, tol: float) -> list[tuple[float, float]]:
     """The breakpoints where ``P`` itself jumps by more than ``tol / 100`` mm (the protocol wants it
-    continuous): ``(parameter, gap in mm)`` each, the closure of a closed curve included."""
+    continuous): ``(parameter, gap in mm)`` each, the closure of a closed curve included.
+
+    Both one-sided limits are extrapolated from inside their pieces (a curve may give either side's value at
+    the breakpoint itself), each from two samples at most a quarter of its piece away."""
     bp = np.asarray(curve.breakpoints, dtype=float)
-    inner = bp[(bp > 0) & (bp < curve.period)]
-    ends = [curve.period] if curve.closed else []
-    at = np.concatenate([inner, ends])
-    if at.size == 0:
+    inner = np.flatnonzero((bp > 0) & (bp < curve.period))
+    ends = [bp.size - 1] if curve.closed else []
+    k = np.concatenate([inner, ends]).astype(int)
+    if k.size == 0:
         return []
-    # the two samples stay inside the piece to the left (a piece may be far shorter than 1e-9 of the period)
-    width = at - bp[np.searchsorted(bp, at) - 1]
-    h = np.maximum(np.minimum(1e-9 * curve.period, width / 4), 4 * np.spacing(at))
-    left = 2.0 * points_at(curve, at - h) - points_at(curve, at - 2.0 * h)  # the limit from the left, O(h²)
-    right = points_at(curve, np.where(at == curve.period, 0.0, at))
+    at = bp[k]
+    width = np.diff(bp)
+    w_left = width[k - 1]
+    w_right = width[np.where(k == bp.size - 1, 0, k)]  # the closure: the first piece is to the right
+    floor = 4 * np.spacing(np.maximum(at, 1.0))
+    h_l = np.maximum(np.minimum(1e-9 * curve.period, w_left / 4), floor)
+    h_r = np.maximum(np.minimum(1e-9 * curve.period, w_right / 4), floor)
+    right_at = np.where(k == bp.size - 1, 0.0, at)
+    left = 2.0 * points_at(curve, at - h_l) - points_at(curve, at - 2.0 * h_l)  # O(h²)
+    right = 2.0 * points_at(curve, right_at + h_r) - points_at(curve, right_at + 2.0 * h_r)
     gap = np.hypot(*(right - left).T)
     return [(float(t), float(g)) for t, g in zip(at, gap, strict=True) if g > 0.01 * tol]

@@ -268,8 +268,9 @@ def _refine(curve: ParametricCurve, nodes: np.ndarray, target: float, kind: str,
         j = np.arange(a.size) - group_start
         nodes = np.append(a + w * j / np.repeat(parts, parts), curve.period)
         dev = np.repeat(np.where(bad, np.nan, dev), parts)
-    raise GeometryError("the discretisation did not converge: the curve may have a cusp or cross itself "
-                        "(an undercut profile cannot be exported)")
+    raise GeometryError(f"the discretisation did not converge within {_MAX_ROUNDS} rounds of refinement: a curve "
+                        "with a cusp, or one that crosses itself, cannot be followed (camfab check reports such a "
+                        "profile as CUSP or UNDERCUT); otherwise try a larger tolerance")
 
 
 def _equidistribute(curve: ParametricCurve, nodes: np.ndarray, dev: np.ndarray, target: float,
@@ -321,8 +322,9 @@ def fit_grid(curve: ParametricCurve, tol: float, kind: str, verify: Callable[[np
             return nodes, measured
         target *= 0.7
         nodes, dev = _refine(curve, nodes, target, kind, dev)
-    raise GeometryError(f"could not verify the tolerance {tol:g} mm (measured {measured:.3g} mm): the curve "
-                        "may have a cusp or cross itself (an undercut profile cannot be exported)")
+    raise GeometryError(f"could not verify the tolerance {tol:g} mm (measured {measured:.3g} mm after refining): "
+                        "a curve with a cusp, or one that crosses itself, cannot be followed (camfab check reports "
+                        "such a profile as CUSP or UNDERCUT); otherwise try a larger tolerance")
 
 
 def biarc_chain(curve: ParametricCurve, nodes: np.ndarray, fit_curve: ParametricCurve | None = None

@@ -1,23 +1,25 @@
-"""The profile a roller really makes where its centre's path has a corner (a velocity jump, under ``--force``).
+"""The profile a follower really makes where its velocity jumps (a design written under ``--force``).
 
-Where the follower's velocity jumps, the pitch curve (the roller centre's path) keeps its point ``C`` but turns
-abruptly: its outward normal goes from ``n_L`` to ``n_R``.  The envelope formula ``P = C − R_r·n`` then jumps
-from ``C − R_r·n_L`` to ``C − R_r·n_R``.  The part a cutter makes, and the roller then rolls on, is what no
-roller position overlaps:
+Where the follower's velocity jumps, the envelope formula of the profile jumps too.  The part a cutter makes, and
+the follower then runs on, is what no follower position overlaps.  At such a junction (cam angle ``φc``):
 
-* a **concave corner** of the pitch curve (it turns away from the cam, e.g. where a constant-velocity rise
-  leaves a dwell) leaves a gap, which the roller fills by rolling about ``C``: the profile gets the **arc of
-  radius R_r centred at C** from ``C − R_r·n_L`` to ``C − R_r·n_R`` (tangent to both sides);
-* a **convex corner** (it turns towards the cam, where a rise meets the dwell after it) makes the two sides
-  overlap: each is cut back to the point ``K`` where they cross, a sharp corner of the profile.
+* **roller** (and curved face, a circle of radius R about its centre): the roller centre's path (the pitch curve)
+  keeps its point ``C`` but turns, its outward normal going from ``n_L`` to ``n_R``, and ``P = C − R·n`` jumps
+  from ``C − R·n_L`` to ``C − R·n_R``.  Where the pitch curve turns away from the cam (a constant-velocity rise
+  leaving a dwell) the two ends leave a gap, which the roller fills by rolling about ``C``: the profile gets the
+  **arc of radius R about C** between them, tangent to both sides;
+* **flat face**: the face line at ``φc`` is the same on both sides and the contact point jumps along it; where it
+  jumps forward the profile gets the **straight stretch of the face line** between the two contact points;
+* where the two ends overlap instead (the pitch curve turns towards the cam, the contact point jumps back), each
+  side is **cut back** to the point ``K`` where they cross: a sharp corner.
 
-An outward offset by ``d`` (a cutter's centre path) follows: the arc's radius becomes ``R_r − d`` (a cutter
-as large as the roller cannot cut it), and ``K`` gets the round join of radius ``d`` a cutter makes going
-round a corner.
+An outward offset by ``d`` (a cutter's centre path) follows: an arc's radius becomes ``R − d`` (a cutter as
+large as the roller cannot cut it), a face stretch moves out by ``d``, and ``K`` gets the round join of radius
+``d`` a cutter makes going round a corner.
 
-:func:`roller_corners` finds the corners (none for a design without a velocity jump, so nothing changes then);
-:func:`cornered_curve` builds the closed curve, parametrised piece by piece: the cam angle on the sides (minus
-the cut-back stretches), and an added stretch for each arc.
+:func:`profile_corners` finds the corners (none for a design without a velocity jump, which then keeps its
+plain curve); :func:`cornered_curve` builds the closed curve, parametrised piece by piece: the cam angle on the
+sides (minus the cut-back stretches), and an added stretch for each arc or face stretch.
 """
 from __future__ import annotations
 
@@ -31,122 +33,180 @@ from ..discretize import ParametricCurve
 from ..errors import GeometryError
 from ..geom2d import J, cross, dot, rotate, unit
 
-__all__ = ["RollerCorner", "roller_corners", "cornered_curve", "corner_note", "CORNER_GAP_MM"]
+__all__ = ["ProfileCorner", "profile_corners", "cornered_curve", "corner_note", "CORNER_GAP_MM"]
 
-#: a jump of the roller envelope below this (mm) is no corner (it is far below every accepted tolerance's
-#: hundredth, the continuity the discretisation asks of a curve)
+#: a jump of the envelope below this (mm) is no corner (a thousandth of the hundredth of the smallest accepted
+#: tolerance: the continuity the discretisation asks of a curve)
 CORNER_GAP_MM = 1e-9
 _NEWTON_ITERS = 30
+#: samples of each side when the crossing of a cut-back corner is searched on polylines
+_SIDE_SAMPLES = 257
+#: piece kinds of a cornered curve
+_SIDE, _ARC, _LINE = 0, 1, 2
 
 
 @dataclass(frozen=True)
-class RollerCorner:
-    """One corner of a roller's pitch curve and what the roller makes of it.
+class ProfileCorner:
+    """One corner of a profile at a velocity jump and what the follower makes of it.
 
-    ``at``: the parameter (cam angle, rad) of the corner; ``centre``: the pitch point C; ``n_left``,
-    ``n_right``: the unit outward normals either side; ``turn``: the signed angle from ``n_left`` to
-    ``n_right``; ``convex``: the sides overlap and are cut back to ``(t_left, t_right)``, whose common point is
-    ``point`` (``K``); for a concave corner ``t_left == t_right == at`` and ``point`` is None.
+    ``at``: the parameter (cam angle, rad) of the junction; ``fill``: ``"arc"`` (rollers: radius R about
+    ``centre``, the pitch point), ``"line"`` (flat faces: the face from ``p_left`` to ``p_right``) or ``"cut"``
+    (the sides cut back to ``(t_left, t_right)``, crossing at ``point``); ``p_left``, ``p_right``: the two
+    one-sided contact points; ``n_left``, ``n_right``: the unit outward normals there; ``turn``: the signed
+    angle from ``n_left`` to ``n_right``.
     """
 
     at: float
-    centre: np.ndarray
+    fill: str
+    p_left: np.ndarray
+    p_right: np.ndarray
     n_left: np.ndarray
     n_right: np.ndarray
     turn: float
-    convex: bool
     t_left: float
     t_right: float
-    point: np.ndarray | None
+    centre: np.ndarray | None = None
+    point: np.ndarray | None = None
+
+    @property
+    def convex(self) -> bool:
+        """The sides overlap and are cut back to a sharp corner."""
+        return self.fill == "cut"
 
 
 def _user_deg(contact, t: float) -> str:
     return f"{float(contact.axis.to_user(t)):.6g}{contact.axis.x_symbol}"
 
 
-def _orientation(contact) -> float:
-    """+1 when the profile runs counter-clockwise with its parameter, −1 clockwise (shoelace of samples)."""
-    t = np.linspace(0.0, contact.period, 4097)[:-1]
-    p = contact.evaluate(t).point
-    return 1.0 if float(cross(p, np.roll(p, -1, axis=0)).sum()) > 0 else -1.0
+def _circle(contact) -> bool:
+    """A follower whose profile is the envelope of a circle about its pitch point (roller, curved face)."""
+    return contact.kind is ContactKind.ROLLER and float(contact.roller_radius) > 0
 
 
-def roller_corners(contact) -> list[RollerCorner]:
-    """The corners of a closed roller contact's pitch curve where its envelope jumps by more than
-    :data:`CORNER_GAP_MM`; empty for anything else (flat or curved faces, knife edges, translating cams).
+def profile_corners(contact) -> list[ProfileCorner]:
+    """The junctions of a profile where its envelope jumps by more than :data:`CORNER_GAP_MM`, with what the
+    follower makes there; empty for a profile without a jump and for a knife edge (its profile is its path: a
+    corner, no jump).
 
     Raises
     ------
     GeometryError
-        When the two sides of a convex corner do not cross within the stretch to the next corner (the roller
-        could not make the profile there).
+        When the two sides of an overlapping corner do not cross within the pieces beside it, or are cut back
+        past the next corner (the jumps are too close for the follower).
     """
-    rr = float(contact.roller_radius)
-    if not contact.closed or rr <= 0 or contact.has_face or contact.kind is not ContactKind.ROLLER:
+    if not (_circle(contact) or contact.kind is ContactKind.FLAT):
         return []
     bp = np.asarray(contact.breakpoints, dtype=float)
-    at = bp[:-1]  # 0 (= the period) and every inner breakpoint
-    left_w = np.diff(bp)[np.arange(at.size) - 1]  # the piece before each (wrapping for 0)
-    delta = np.maximum(1e-7 * left_w, 8 * np.spacing(np.maximum(np.abs(bp[1:]), 1.0)[np.arange(at.size) - 1]))
+    first = 0 if contact.closed else 1  # an open profile (a translating cam) has no junction at its ends
+    at = bp[first:-1]  # (0 = the period of a closed profile and) every inner breakpoint
+    prev = np.arange(first, bp.size - 1) - 1  # the piece before each (wrapping for 0)
+    delta = np.maximum(1e-7 * np.diff(bp)[prev], 8 * np.spacing(np.maximum(bp[1:], 1.0)[prev]))
     before = np.where(at == 0.0, contact.period, at)
     right = contact.evaluate(at)
     s1, s2 = contact.evaluate(before - delta), contact.evaluate(before - 2 * delta)
-    p_left = 2 * s1.point - s2.point  # the limit from the left, O(δ²)
+    p_left = 2 * s1.point - s2.point  # the limits from the left, O(δ²)
     v_left = 2 * s1.point_d1 - s2.point_d1
-    gap = np.hypot(*(right.point - p_left).T)
-    idx = np.flatnonzero(gap > CORNER_GAP_MM)
+    n_left = unit(2 * s1.normal - s2.normal)
+    jump = right.point - p_left
+    idx = np.flatnonzero(np.hypot(*jump.T) > CORNER_GAP_MM)
     if idx.size == 0:
         return []
-    c = right.pitch[idx]
-    n_l = unit(c - p_left[idx])
-    n_r = right.normal[idx]
-    turn = np.arctan2(cross(n_l, n_r), dot(n_l, n_r))
-    convex = _orientation(contact) * turn > 0
+    if _circle(contact):  # the normals from the pitch point: exact for a circle about it
+        n_left[idx] = unit(right.pitch[idx] - p_left[idx])
+    along = unit(v_left[idx] + right.point_d1[idx])  # the direction the profile runs at the corner
+    ahead = dot(jump[idx], along) > 0  # the right side starts ahead of the left side's end: a gap to fill
     out = []
-    corners_at = at[idx]
     for j, i in enumerate(idx.tolist()):
         t = float(at[i])
-        if not convex[j]:
-            out.append(RollerCorner(t, c[j], n_l[j], n_r[j], float(turn[j]), False, t, t, None))
+        n_l, n_r = n_left[i], right.normal[i]
+        turn = float(np.arctan2(cross(n_l, n_r), dot(n_l, n_r)))
+        common = dict(p_left=p_left[i], p_right=right.point[i], n_left=n_l, n_right=n_r, turn=turn)
+        if ahead[j]:
+            fill = "arc" if _circle(contact) else "line"
+            centre = right.pitch[i] if fill == "arc" else None
+            out.append(ProfileCorner(t, fill, t_left=t, t_right=t, centre=centre, **common))
             continue
-        t1, t2, k = _crossing(contact, t, p_left[i], v_left[i], right.point[i], right.point_d1[i])
+        t1, t2, k = _crossing(contact, t, bp, p_left[i], v_left[i], right.point[i], right.point_d1[i])
         if not (t1 < t < t2):
-            raise GeometryError(f"the two sides of the roller profile at the velocity jump at {_user_deg(contact, t)} "
-                                "do not cross near it, so no roller could make this profile: match the velocities "
+            raise GeometryError(f"the two sides of the profile at the velocity jump at {_user_deg(contact, t)} do "
+                                "not cross near it, so no follower could make this profile: match the velocities "
                                 "there")
-        others = (corners_at - t + 0.5 * contact.period) % contact.period - 0.5 * contact.period
-        others = others[others != 0.0]
-        if np.any((others > t1 - t) & (others < t2 - t)):
-            raise GeometryError(f"the roller profile at the velocity jump at {_user_deg(contact, t)} is cut back "
-                                f"past the next velocity jump ({_user_deg(contact, t1 % contact.period)} to "
-                                f"{_user_deg(contact, t2 % contact.period)}): the jumps are too close for the "
-                                "roller; match the velocities there")
-        out.append(RollerCorner(t, c[j], n_l[j], n_r[j], float(turn[j]), True, t1, t2, k))
+        out.append(ProfileCorner(t, "cut", t_left=t1, t_right=t2, point=k, **common))
+    _refuse_overlapping(contact, out)
     return out
 
 
-def _crossing(contact, t: float, p_l, v_l, p_r, v_r) -> tuple[float, float, np.ndarray]:
-    """Where the side before ``t`` (ending at ``p_l`` with derivative ``v_l``) crosses the side after it:
-    ``(t1 < t, t2 > t, point)`` by Newton on ``P(t1) = P(t2)`` from the crossing of the two tangents."""
+def _refuse_overlapping(contact, corners: list[ProfileCorner]) -> None:
     period = contact.period
+    ats = np.array([c.at for c in corners])
+    for c in corners:
+        if not c.convex:
+            continue
+        rel = (ats - c.at + 0.5 * period) % period - 0.5 * period
+        rel = rel[rel != 0.0]
+        if np.any((rel > c.t_left - c.at) & (rel < c.t_right - c.at)):
+            raise GeometryError(f"the profile at the velocity jump at {_user_deg(contact, c.at)} is cut back past "
+                                f"the next velocity jump ({_user_deg(contact, c.t_left % period)} to "
+                                f"{_user_deg(contact, c.t_right % period)}): the jumps are too close for the "
+                                "follower; match the velocities there")
+
+
+def _crossing(contact, t: float, bp: np.ndarray, p_l, v_l, p_r, v_r) -> tuple[float, float, np.ndarray]:
+    """Where the side before ``t`` (ending at ``p_l`` with derivative ``v_l``) crosses the side after it:
+    ``(t1 < t, t2 > t, point)``, by Newton on ``P(t1) = P(t2)`` from the crossing of the two tangents, or,
+    when they are parallel (a flat face) or Newton fails, from the crossing of the two sides sampled over the
+    pieces beside the corner.  ``(t, t, p_r)`` when there is none."""
     m = np.column_stack([v_l, -v_r])
-    try:
+    if abs(float(np.linalg.det(m))) > 1e-9 * float(np.hypot(*v_l) * np.hypot(*v_r)):
         a, b = np.linalg.solve(m, p_r - p_l)
-    except np.linalg.LinAlgError:
+        found = _newton(contact, t, t + min(float(a), 0.0), t + max(float(b), 0.0), p_r)
+        if found[0] < t < found[1]:
+            return found
+    i = int(np.searchsorted(bp, t))
+    lo = bp[i - 1] if i > 0 else bp[-2] - contact.period  # (only a closed profile has a corner at 0)
+    hi = bp[i + 1]
+    guess = _sampled_crossing(contact, t, lo, hi)
+    if guess is None:
         return t, t, p_r
-    t1, t2 = t + min(float(a), 0.0), t + max(float(b), 0.0)
+    return _newton(contact, t, guess[0], guess[1], p_r)
+
+
+def _sampled_crossing(contact, t: float, lo: float, hi: float) -> tuple[float, float] | None:
+    """The crossing nearest the corner of the two sides sampled as polylines on ``[lo, t)`` and ``(t, hi]``."""
+    period = contact.period
+    ta = t - (t - lo) * np.linspace(1.0, 1e-6, _SIDE_SAMPLES)
+    tb = t + (hi - t) * np.linspace(1e-6, 1.0, _SIDE_SAMPLES)
+    a = contact.evaluate(np.mod(ta, period)).point
+    b = contact.evaluate(np.mod(tb, period)).point
+    a0, da = a[:-1, None], np.diff(a, axis=0)[:, None]
+    b0, db = b[None, :-1], np.diff(b, axis=0)[None, :]
+    den = cross(da, db)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s = cross(b0 - a0, db) / den
+        u = cross(b0 - a0, da) / den
+    hit = (s >= 0) & (s <= 1) & (u >= 0) & (u <= 1) & (den != 0)
+    if not hit.any():
+        return None
+    i, j = np.nonzero(hit)
+    t1 = ta[i] + s[i, j] * (ta[i + 1] - ta[i])
+    t2 = tb[j] + u[i, j] * (tb[j + 1] - tb[j])
+    best = int(np.argmin(t2 - t1))
+    return float(t1[best]), float(t2[best])
+
+
+def _newton(contact, t: float, t1: float, t2: float, p_r) -> tuple[float, float, np.ndarray]:
+    """Newton on ``P(t1) = P(t2)`` with ``t1 < t < t2`` (a step that would cross ``t`` is halved)."""
+    period = contact.period
     scale = max(1.0, float(np.abs(p_r).max()))
     for _ in range(_NEWTON_ITERS):
         s = contact.evaluate(np.array([t1 % period, t2 % period]))
         f = s.point[0] - s.point[1]
         if float(np.hypot(*f)) <= 1e-13 * scale:
             return t1, t2, 0.5 * (s.point[0] + s.point[1])
-        jac = np.column_stack([s.point_d1[0], -s.point_d1[1]])
         try:
-            da, db = np.linalg.solve(jac, -f)
+            da, db = np.linalg.solve(np.column_stack([s.point_d1[0], -s.point_d1[1]]), -f)
         except np.linalg.LinAlgError:
             break
-        # stay on each side of the corner (halve a step that would cross it)
         t1 = t1 + da if t1 + da < t else 0.5 * (t1 + t)
         t2 = t2 + db if t2 + db > t else 0.5 * (t2 + t)
     return t, t, p_r
@@ -154,79 +214,89 @@ def _crossing(contact, t: float, p_l, v_l, p_r, v_r) -> tuple[float, float, np.n
 
 @dataclass(frozen=True)
 class _Layout:
-    """The pieces of a cornered curve in order: ``kind`` 0 = a stretch of the contact (parameter ``t0`` at its
-    start, unit speed in the parameter), 1 = an arc (``centre``, ``radius``, start direction ``start`` from the
-    centre, signed ``sweep``); ``tau`` the starts of the pieces in the new parameter, then its period."""
+    """The pieces of a cornered curve in order: ``kind`` :data:`_SIDE` (a stretch of the contact from parameter
+    ``t0``, unit speed), :data:`_ARC` (``centre``, ``radius``, unit start direction ``vec`` from the centre,
+    signed ``sweep``) or :data:`_LINE` (from ``centre`` along ``vec``, whole); ``tau`` the starts of the pieces
+    in the new parameter, then its period."""
 
     kind: np.ndarray
     tau: np.ndarray
     t0: np.ndarray
     centre: np.ndarray
     radius: np.ndarray
-    start: np.ndarray
+    vec: np.ndarray
     sweep: np.ndarray
 
 
-def cornered_curve(contact, corners: list[RollerCorner], distance: float = 0.0) -> ParametricCurve:
-    """The closed profile of ``contact`` (``distance = 0``) or its outward offset by ``distance`` (a cutter's
-    centre path), made as a roller makes it at ``corners`` (see the module notes).
+def _fill(contact, c: ProfileCorner, d: float) -> tuple[int, np.ndarray, float, np.ndarray, float, float] | None:
+    """The piece a corner adds to the curve offset by ``d``: ``(kind, centre, radius, vec, sweep, length)``
+    (``length``: its arc length), or None (a cut-back corner of the profile itself: a sharp vertex)."""
+    if c.fill == "arc":
+        r = float(contact.roller_radius) - d
+        assert c.centre is not None
+        return _ARC, c.centre, r, -c.n_left, c.turn, r * abs(c.turn)
+    if c.fill == "line":
+        a, b = c.p_left + d * c.n_left, c.p_right + d * c.n_right
+        return _LINE, a, 0.0, b - a, 0.0, float(np.hypot(*(b - a)))
+    if d > 0:
+        assert c.point is not None
+        s = contact.evaluate(np.array([c.t_left % contact.period, c.t_right % contact.period]))
+        n1, n2 = s.normal[0], s.normal[1]
+        sweep = float(np.arctan2(cross(n1, n2), dot(n1, n2)))
+        return _ARC, np.asarray(c.point, dtype=float), d, n1, sweep, d * abs(sweep)
+    return None
+
+
+def cornered_curve(contact, corners: list[ProfileCorner], distance: float = 0.0) -> ParametricCurve:
+    """The profile of ``contact`` (``distance = 0``) or its outward offset by ``distance`` (a cutter's centre
+    path), made as the follower makes it at ``corners`` (see the module notes): closed for a disc cam, from
+    travel 0 to the cam length for a translating cam.
 
     Raises
     ------
     GeometryError
         A cutter (``distance``) at least as large as the roller: it cannot cut the roller-radius arcs.
     """
-    rr = float(contact.roller_radius)
     d = float(distance)
-    concave = [c for c in corners if not c.convex]
-    if concave and d >= rr:
-        raise GeometryError(f"the cutter radius {d:g} mm is not smaller than the roller radius {rr:g} mm: at the "
-                            f"velocity jump at {_user_deg(contact, concave[0].at)} the profile has a concave arc of "
-                            "the roller's radius, which it would gouge; choose a smaller tool")
+    arcs = [c for c in corners if c.fill == "arc"]
+    if arcs and d >= float(contact.roller_radius):
+        raise GeometryError(f"the cutter radius {d:g} mm is not smaller than the roller radius "
+                            f"{float(contact.roller_radius):g} mm: at the velocity jump at "
+                            f"{_user_deg(contact, arcs[0].at)} the profile has a concave arc of the roller's radius, "
+                            "which it would gouge; choose a smaller tool")
     period = contact.period
-    # the stretches of the contact between corners (from just after the first one), each followed by the next
-    # corner's arc (concave, or convex with a cutter's round join)
     order = sorted(corners, key=lambda c: c.at)
-    kinds: list[int] = []
-    t0s: list[float] = []
-    lens: list[float] = []
-    arcs: list[tuple] = []
-    speed = np.hypot(*contact.evaluate(np.array([c.at for c in order])).point_d1.T)
-    for i, c in enumerate(order):
-        nxt = order[(i + 1) % len(order)]
-        end = nxt.t_left + (period if i == len(order) - 1 or nxt.t_left <= c.t_right else 0.0)
-        kinds.append(0)
-        t0s.append(c.t_right)
-        lens.append(end - c.t_right)
-        arcs.append((np.zeros(2), 0.0, np.zeros(2), 0.0))
-        # then the corner nxt
-        v = max(float(speed[(i + 1) % len(order)]), 1e-300)
-        if not nxt.convex:
-            r = rr - d
-            if r * abs(nxt.turn) > 0:
-                kinds.append(1)
-                t0s.append(0.0)
-                lens.append(max(rr * abs(nxt.turn) / v, 1e-9 * period))
-                arcs.append((nxt.centre, r, -nxt.n_left, nxt.turn))
-        elif d > 0:
-            s = contact.evaluate(np.array([nxt.t_left % period, nxt.t_right % period]))
-            n1, n2 = s.normal[0], s.normal[1]
-            sweep = float(np.arctan2(cross(n1, n2), dot(n1, n2)))
-            kinds.append(1)
-            t0s.append(0.0)
-            lens.append(max(d * abs(sweep) / v, 1e-9 * period))
-            arcs.append((np.asarray(nxt.point, dtype=float), d, n1, sweep))
-    tau = np.concatenate([[0.0], np.cumsum(lens)])
-    lay = _Layout(np.array(kinds), tau, np.array(t0s), np.array([a[0] for a in arcs]), np.array([a[1] for a in arcs]),
-                  np.array([a[2] for a in arcs]), np.array([a[3] for a in arcs]))
-    # breakpoints: the ends of every piece and the contact's own breakpoints inside the stretches
+    rows: list[tuple] = []  # (kind, t0, length in the new parameter, centre, radius, vec, sweep)
+    # the sides between corners, each corner's piece between them; a closed profile starts just after its first
+    # corner and ends with that corner's piece (so the curve closes on the side values, not on a wrapped one),
+    # an open one starts at travel 0 and ends at the cam length
+    sides = [(c.t_right, nxt.t_left) for c, nxt in zip(order, order[1:], strict=False)]
+    if contact.closed:
+        sides.append((order[-1].t_right, order[0].t_left + period))
+        fills = order[1:] + order[:1]
+    else:
+        sides = [(0.0, order[0].t_left)] + sides + [(order[-1].t_right, period)]
+        fills = order
+    speed = np.hypot(*contact.evaluate(np.array([c.at for c in fills])).point_d1.T)
+    for i, (a, b) in enumerate(sides):
+        rows.append((_SIDE, a, b - a, np.zeros(2), 0.0, np.zeros(2), 0.0))
+        if i == len(fills):
+            break
+        piece = _fill(contact, fills[i], d)
+        if piece is not None and piece[5] > 0:
+            kind, centre, radius, vec, sweep, length = piece
+            v = max(float(speed[i]), 1e-300)
+            rows.append((kind, 0.0, max(length / v, 1e-9 * period), centre, radius, vec, sweep))
+    tau = np.concatenate([[0.0], np.cumsum([r[2] for r in rows])])
+    lay = _Layout(np.array([r[0] for r in rows]), tau, np.array([r[1] for r in rows]),
+                  np.array([r[3] for r in rows]), np.array([r[4] for r in rows]), np.array([r[5] for r in rows]),
+                  np.array([r[6] for r in rows]))
+    # breakpoints: the ends of every piece and the contact's own breakpoints inside the sides
     bp = np.asarray(contact.breakpoints, dtype=float)[:-1]
     inner = []
-    for k in np.flatnonzero(lay.kind == 0).tolist():
-        a = lay.t0[k]
-        rel = (bp - a) % period
-        rel = rel[(rel > 0) & (rel < lay.tau[k + 1] - lay.tau[k])]
-        inner.append(lay.tau[k] + rel)
+    for k in np.flatnonzero(lay.kind == _SIDE).tolist():
+        rel = (bp - lay.t0[k]) % period
+        inner.append(lay.tau[k] + rel[(rel > 0) & (rel < lay.tau[k + 1] - lay.tau[k])])
     breakpoints = np.unique(np.concatenate([tau] + inner))
 
     def evaluate(t, first: bool) -> np.ndarray:
@@ -234,31 +304,39 @@ def cornered_curve(contact, corners: list[RollerCorner], distance: float = 0.0) 
         t = np.asarray(t, dtype=float)
         k = np.clip(np.searchsorted(lay.tau, t, side="right") - 1, 0, lay.kind.size - 1)
         u = t - lay.tau[k]
+        w = lay.tau[k + 1] - lay.tau[k]
         out = np.empty((u.size, 2))
-        law = lay.kind[k] == 0
-        if law.any():
-            s = contact.evaluate((lay.t0[k[law]] + u[law]) % period)
+        side = lay.kind[k] == _SIDE
+        if side.any():
+            x = lay.t0[k[side]] + u[side]  # an open profile ends on its left limit (the motion wraps at its end)
+            s = contact.evaluate(x % period if contact.closed else np.minimum(x, np.nextafter(period, 0.0)))
             if first:
-                out[law] = s.point_d1 * (1.0 + d * s.curvature)[:, None] if d else s.point_d1
+                out[side] = s.point_d1 * (1.0 + d * s.curvature)[:, None] if d else s.point_d1
             else:
-                out[law] = s.point + d * s.normal if d else s.point
-        ka = k[~law]
-        if ka.size:
-            w = lay.tau[ka + 1] - lay.tau[ka]
-            direction = rotate(lay.start[ka], lay.sweep[ka] * u[~law] / w)
+                out[side] = s.point + d * s.normal if d else s.point
+        arc = lay.kind[k] == _ARC
+        if arc.any():
+            ka = k[arc]
+            direction = rotate(lay.vec[ka], lay.sweep[ka] * u[arc] / w[arc])
             if first:
-                out[~law] = (lay.radius[ka] * lay.sweep[ka] / w)[:, None] * J(direction)
+                out[arc] = (lay.radius[ka] * lay.sweep[ka] / w[arc])[:, None] * J(direction)
             else:
-                out[~law] = lay.centre[ka] + lay.radius[ka, None] * direction
+                out[arc] = lay.centre[ka] + lay.radius[ka, None] * direction
+        line = lay.kind[k] == _LINE
+        if line.any():
+            kl = k[line]
+            out[line] = lay.vec[kl] / w[line, None] if first else \
+                lay.centre[kl] + lay.vec[kl] * (u[line] / w[line])[:, None]
         return out
 
     return ParametricCurve(lambda t: evaluate(t, False), breakpoints, float(tau[-1]),
-                           lambda t: evaluate(t, True), True)
+                           lambda t: evaluate(t, True), contact.closed)
 
 
-def corner_note(contact, corners: list[RollerCorner]) -> str:
-    """One line for a log: where the corners are and what the roller makes of them."""
-    parts = [f"{_user_deg(contact, c.at)} ({'cut back to a corner' if c.convex else 'roller-radius arc'}, "
-             f"{math.degrees(abs(c.turn)):.3g}° turn)" for c in corners[:5]]
+def corner_note(contact, corners: list[ProfileCorner]) -> str:
+    """One line for a log: where the corners are and what the follower makes of them."""
+    words = {"arc": "an arc of the roller's radius", "line": "a stretch of the face", "cut": "cut back to a corner"}
+    parts = [f"{_user_deg(contact, c.at)} ({words[c.fill]}, {math.degrees(abs(c.turn)):.3g}° turn)"
+             for c in corners[:5]]
     more = f" and {len(corners) - 5} more" if len(corners) > 5 else ""
     return ", ".join(parts) + more

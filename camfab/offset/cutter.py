@@ -21,7 +21,7 @@ import numpy as np
 from ..discretize import ArcDiscretisation, ParametricCurve, arcs, measure_deviation, polyline, validate_tol
 from ..errors import GeometryError
 from ..tolerances import DEFAULT_EXPORT_TOL_MM
-from .corners import corner_note, cornered_curve, roller_corners
+from .corners import corner_note, cornered_curve, profile_corners
 from .outline import translating_outline
 
 __all__ = ["profile_curve", "pitch_curve", "offset_curve", "concave_limit", "ToolCentrePath",
@@ -51,9 +51,9 @@ def profile_curve(contact) -> ParametricCurve:
     """
     if not contact.closed:
         return translating_outline(contact)
-    corners = roller_corners(contact)
-    if corners:  # a velocity jump (only under --force): the profile the roller really makes there
-        log.info("profile: the pitch curve turns abruptly at %s; the profile follows the roller round it",
+    corners = profile_corners(contact)
+    if corners:  # a velocity jump (only under --force): the profile the follower really makes there
+        log.info("profile: the follower's velocity jumps at %s; the profile is the one the follower makes there",
                  corner_note(contact, corners))
         return cornered_curve(contact, corners)
     return ParametricCurve(lambda t: contact.evaluate(t).point, contact.breakpoints, contact.period,
@@ -79,8 +79,8 @@ def offset_curve(contact, distance: float) -> ParametricCurve:
     """
     if not contact.closed:
         return translating_outline(contact, distance)
-    corners = roller_corners(contact)
-    if corners:  # a velocity jump (only under --force): the offset of the profile the roller really makes
+    corners = profile_corners(contact)
+    if corners:  # a velocity jump (only under --force): the offset of the profile the follower really makes
         return cornered_curve(contact, corners, distance)
 
     def point(t):

@@ -29,6 +29,7 @@ import numpy as np
 
 from ..discretize import ParametricCurve
 from ..errors import ApiError, GeometryError
+from .corners import cornered_curve, profile_corners
 
 __all__ = ["Piece", "line_piece", "arc_piece", "chain_curve", "translating_outline"]
 
@@ -94,7 +95,11 @@ def chain_curve(pieces) -> ParametricCurve:
 
 
 def _profile_piece(contact, distance: float, reverse: bool) -> Piece:
-    """The (offset) profile over one cam length, traversed right to left."""
+    """The (offset) profile over one cam length, traversed right to left.  Where the follower's velocity jumps
+    (a design written under ``--force``), the profile it makes there (:mod:`camfab.offset.corners`)."""
+    corners = profile_corners(contact)
+    if corners:
+        return _cornered_piece(cornered_curve(contact, corners, distance), reverse)
     length = contact.period
 
     def travel(u):
@@ -114,12 +119,29 @@ def _profile_piece(contact, distance: float, reverse: bool) -> Piece:
     return Piece(length, point, derivative, tuple(float(b) for b in inner if 0 < b < length))
 
 
-def _ends(contact):
-    """Profile point and outward normal at travel 0⁺ and length⁻."""
+def _cornered_piece(curve: ParametricCurve, reverse: bool) -> Piece:
+    """An open cornered profile as a piece (its own parameter, reversed when asked)."""
+    length = curve.period
+
+    def point(u):
+        return curve.point(length - u if reverse else u)
+
+    def derivative(u):
+        d = curve.derivative(length - u if reverse else u)  # type: ignore[misc]
+        return -d if reverse else d
+
+    bp = np.asarray(curve.breakpoints, dtype=float)
+    inner = (length - bp) if reverse else bp
+    return Piece(length, point, derivative, tuple(float(b) for b in inner if 0 < b < length))
+
+
+def _ends(contact, limits: bool = False):
+    """Profile point and outward normal at travel 0⁺ and length⁻ (the point at the length itself, which the
+    motion takes from its start, unless ``limits``: a cornered profile ends on its left limit)."""
     length = contact.period
     s = contact.evaluate(np.array([0.0, np.nextafter(length, 0.0)]))
-    s_end = contact.evaluate(np.array([length]))
-    pts = np.array([s.point[0], s_end.point[0]])
+    s_end = s if limits else contact.evaluate(np.array([length]))
+    pts = np.array([s.point[0], s_end.point[-1]])
     return pts, s.normal
 
 
@@ -141,7 +163,7 @@ def translating_outline(contact, distance: float = 0.0) -> ParametricCurve:
         raise GeometryError("follower.base_height_mm = 0: the plate of a translating cam needs material "
                             "under the profile; set base_height_mm > 0 (the height of the S = 0 line "
                             "above the bottom edge)")
-    (p0, p1), n = _ends(contact)
+    (p0, p1), n = _ends(contact, limits=bool(profile_corners(contact)))
     reverse = p1[0] > p0[0]  # travel runs left to right: traverse the top edge backwards
     (left, n_left), (right, n_right) = ((p0, n[0]), (p1, n[1])) if reverse else ((p1, n[1]), (p0, n[0]))
     if not right[0] > left[0]:

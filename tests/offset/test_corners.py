@@ -20,7 +20,7 @@ import camfab
 from camfab.cli import main
 from camfab.discretize import Chain
 from camfab.errors import GeometryError
-from camfab.offset.corners import roller_corners
+from camfab.offset.corners import profile_corners
 from camfab.offset.cutter import offset_curve, profile_curve
 from tests.conftest import EXAMPLES, cv_jump
 
@@ -73,7 +73,7 @@ def test_force_writes_the_profile_a_roller_makes(tmp_path, capsys, rotation, off
     assert overlap <= 0.01 and untouched <= 0.01 and outside
     # the four corners: two concave ones filled by an arc of the roller radius about the corner,
     # two convex ones cut back to where the two sides cross
-    corners = roller_corners(contact)
+    corners = profile_corners(contact)
     assert sorted(round(math.degrees(c.at)) for c in corners) == [0, 120, 180, 300]
     assert sum(c.convex for c in corners) == 2
     pts = chain.sample(64)[0].reshape(-1, 2)
@@ -91,7 +91,7 @@ def test_without_the_arc_the_roller_would_leave_a_step(tmp_path):
     """The envelope formula alone jumps by 2·R_r·sin(turn/2) at the concave corners (0.79 mm here): what the
     arc replaces."""
     contact = camfab.load(str(_design(tmp_path))).geometry.profiles[0]
-    (c,) = [c for c in roller_corners(contact) if not c.convex and round(math.degrees(c.at)) == 0]
+    (c,) = [c for c in profile_corners(contact) if not c.convex and round(math.degrees(c.at)) == 0]
     raw = contact.evaluate(np.array([contact.period - 1e-9, 0.0])).point
     assert np.hypot(*(raw[1] - raw[0])) == pytest.approx(2 * 8.0 * math.sin(abs(c.turn) / 2), rel=1e-4)
     assert np.hypot(*(raw[1] - raw[0])) > 0.7
@@ -153,4 +153,53 @@ def test_the_cornered_curve_is_continuous_and_its_offset_parallel(tmp_path):
 def test_designs_without_a_velocity_jump_have_no_corner(name):
     cam = camfab.load(str(EXAMPLES / f"{name}.toml"))
     for contact in cam.geometry.profiles:
-        assert roller_corners(contact) == []
+        assert profile_corners(contact) == []
+
+
+def test_force_on_a_flat_face_writes_the_face_stretch(tmp_path):
+    """A flat face's contact point jumps along the face where the velocity jumps: forced, the profile gets the
+    face's straight stretch (where it jumps forward) or a cut-back corner (where it jumps back).  Checked with
+    the face positions themselves: no position of the face cuts into the written part, and every point of it
+    lies on some position of the face (within tol)."""
+    d = tmp_path / "flat.toml"
+    d.write_text(cv_jump("flat").replace("offset_mm = 0.0\n", ""))
+    out = tmp_path / "out"
+    assert main(["export", str(d), "--dxf", "--force", "-o", str(out)]) == 1
+    contact = camfab.load(str(d)).geometry.profiles[0]
+    assert [c.fill for c in sorted(profile_corners(contact), key=lambda c: c.at)] == ["line", "cut", "cut", "line"]
+    pts = _profile_chain(out / "cv_jump.dxf").sample(201)[0].reshape(-1, 2)
+    bp = contact.breakpoints
+    phi = np.concatenate([np.linspace(0.0, contact.period, 20_000), bp, bp - 1e-12]) % contact.period
+    s = contact.evaluate(phi)
+    inside, touch = -np.inf, np.full(pts.shape[0], np.inf)
+    for k in range(0, phi.size, 2000):  # (x − P(φ))·n(φ): > 0 where the face at φ would cut x away
+        h = np.einsum("fpi,fi->fp", pts[None, :, :] - s.point[k:k + 2000, None, :], s.normal[k:k + 2000])
+        inside = max(inside, float(h.max()))
+        touch = np.minimum(touch, np.abs(h).min(axis=0))
+    assert inside <= 0.01 and touch.max() <= 0.01
+
+
+def test_force_on_a_translating_cam_writes_the_roller_profile(tmp_path):
+    """The plate of a translating cam: the same corners on its top edge (travel 100, 150: cut back; 250: an arc
+    of the roller's radius), within tol of the region the roller sweeps; G-code verified."""
+    text = (EXAMPLES / "wedge_translating.toml").read_text().replace('law = "cycloidal"', 'law = "constant_velocity"')
+    text = text.replace("lift = 20.0", "lift = 5.0").replace("lift = -20.0", "lift = -5.0")
+    d = tmp_path / "wedge.toml"
+    d.write_text(text)
+    out = tmp_path / "out"
+    assert main(["export", str(d), "--dxf", "--force", "--tol", "1e-3", "-o", str(out)]) == 1
+    contact = camfab.load(str(d)).geometry.profiles[0]
+    corners = sorted(profile_corners(contact), key=lambda c: c.at)
+    assert [(round(c.at), c.fill) for c in corners] == [(100, "cut"), (150, "cut"), (250, "arc")]
+    chain = _profile_chain(out / "WedgeCam.dxf")
+    bp = contact.breakpoints
+    t = np.clip(np.concatenate([np.linspace(0.0, contact.period, 100_000), bp, bp - 1e-9]), 0.0,
+                np.nextafter(contact.period, 0.0))
+    centres = contact.evaluate(t).pitch
+    assert chain.distance(centres)[0].min() >= 8.0 - 1e-3  # no roller position overlaps the plate
+    pts = chain.sample(65)[0][:, :-1].reshape(-1, 2)
+    top = pts[pts[:, 1] > 20.0 + 1e-6]  # the top edge (the plate's S = 0 line is 20 mm up)
+    assert cKDTree(centres).query(top)[0].max() <= 8.0 + 1e-3  # every point of it touched by the roller
+    nc = tmp_path / "w.nc"
+    assert main(["gcode", str(d), "--force", "-o", str(nc)]) == 1
+    assert main(["verify", str(nc), "--design", str(d)]) == 0
