@@ -33,6 +33,8 @@ __all__ = [
     "MAX_LIFT_MM",
     "MAX_LENGTH_MM",
     "MAX_SIZE_OVER_TOL",
+    "MAX_DEPTH_LEVELS",
+    "MAX_PROGRAM_MOVES",
     "MAX_ITEMS",
     "MAX_LISTED",
     "data_problems",
@@ -65,6 +67,10 @@ MAX_LIFT_MM = 1e5
 MAX_LENGTH_MM = 1e6
 #: a cam's largest radius over its export tolerance (a 1 m cam to 1 nm, a 10 m cam to 10 nm)
 MAX_SIZE_OVER_TOL = 1e9
+#: depth levels of a milling program (plate thickness / step-down), and the moves of the whole program
+#: (levels × passes × contour entities; a real cam's program has a few tens of thousands)
+MAX_DEPTH_LEVELS = 1000
+MAX_PROGRAM_MOVES = 500_000
 #: entries of one table or array (the longest a design has: the knot rows)
 MAX_ITEMS = MAX_KNOTS
 #: problems listed by :func:`data_problems` before it sums up the rest

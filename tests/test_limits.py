@@ -307,3 +307,37 @@ def test_a_long_bad_line_of_a_knot_file_is_quoted_not_echoed(tmp_path):
     with pytest.raises(SpecError) as e:
         read_knots_csv(f)
     assert "line 3: 'zzzz" in str(e.value) and len(str(e.value)) < 600
+
+
+# ---- a milling program's size -------------------------------------------------------------------------------
+def test_a_tiny_step_down_refused_on_reading_and_in_the_job(tmp_path):
+    """``step_down_mm = 1e-9`` asked for 1e10 depth levels: a MemoryError traceback after 2.7 GB."""
+    from camfab.gcode import Job
+
+    text = (EXAMPLES / "ejemplo9rt.toml").read_text().replace("[outputs]", "[machining]\nstep_down_mm = 1e-9\n\n"
+                                                               "[outputs]")
+    f = tmp_path / "sd.toml"
+    f.write_text(text)
+    err = _refused(f, "machining.step_down_mm = 1e-09", "more than 1000 depth levels",
+                   "at least 0.01 mm")
+    assert err.count("\n  - ") == 1
+    with pytest.raises(SpecError) as e:
+        Job(tool_diameter_mm=6, depth_mm=10, step_down_mm=1e-9)
+    assert [p.path for p in e.value.problems] == ["job.step_down_mm"]
+    assert len(Job(tool_diameter_mm=6, depth_mm=10, step_down_mm=0.01).levels) == 1000  # the limit itself
+
+
+def test_a_program_over_the_move_limit_refused_before_it_is_built():
+    from camfab.gcode import Job, Segment, contour_toolpath
+    from camfab.limits import MAX_PROGRAM_MOVES
+
+    n = 1200  # a circle of 1200 arcs, cut in 1000 levels: 1.2 million moves
+    pts = [(20 * math.cos(2 * math.pi * k / n), 20 * math.sin(2 * math.pi * k / n)) for k in range(n + 1)]
+    circle = [Segment(pts[k], pts[k + 1], center=(0, 0), clockwise=False) for k in range(n)]
+    job = Job(tool_diameter_mm=6, depth_mm=10, step_down_mm=0.01, roughing_passes=0)
+    with pytest.raises(SpecError) as e:
+        contour_toolpath(circle, job)
+    (p,) = e.value.problems
+    assert p.path == "job" and f"exceed {MAX_PROGRAM_MOVES:,} moves" in p.rule and "1000 depth levels" in p.rule
+    few = Job(tool_diameter_mm=6, depth_mm=10, step_down_mm=0.1, roughing_passes=0)
+    assert len(contour_toolpath(circle, few).items) > 100 * n

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..errors import Problem, SpecError
-from ..limits import MAX_LENGTH_MM, MAX_LIFT_MM, MAX_SEGMENTS, data_problems
+from ..limits import MAX_DEPTH_LEVELS, MAX_LENGTH_MM, MAX_LIFT_MM, MAX_SEGMENTS, data_problems
 from ..units import DEG, RPM
 from .kinds import CamKind, Direction, FollowerMotion, FollowerType, LiftUnit, Rotation
 from .knots import KnotFile, KnotTable, build_knot_table
@@ -300,6 +300,7 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
                                 cam.kind == CamKind.TRANSLATING)
     out = outputs_section(v, v.table(data, "outputs"))
     machining = machining_section(v, v.table(data, "machining"))
+    _depth_levels(v, mfg, machining)
     checks = v.table(data, "checks")
     v.keys(checks, _CHECK_KEYS, "checks")
     pa = v.number(checks, "pressure_angle_limit_deg", "checks", None, lo=0.0, hi=90.0, lo_open=True, hi_open=True)
@@ -308,6 +309,15 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
     return DesignSpec(name.strip(), cam, fol, motion, table, mfg, out, pressure_angle_limit_deg=pa,
                       description=str(data.get("description", "")), source=source, face_margin_mm=margin,
                       dynamics=dyn, machining=machining)
+
+
+def _depth_levels(v: Validator, mfg: ManufacturingSpec, machining: MachiningSpec) -> None:
+    """The plate cut in at most :data:`~camfab.limits.MAX_DEPTH_LEVELS` step-downs (``docs/decisions.md``,
+    "Input limits")."""
+    depth, step = mfg.thickness_mm, machining.step_down_mm
+    if depth / step > MAX_DEPTH_LEVELS:
+        v.add("machining.step_down_mm", step, f"cuts the {depth:g} mm plate in more than {MAX_DEPTH_LEVELS} depth "
+              "levels (the input limit)", f"give a step-down of at least {depth / MAX_DEPTH_LEVELS:.3g} mm")
 
 
 # ---------------------------------------------------------------------------

@@ -10,6 +10,7 @@ import math
 from dataclasses import dataclass, field
 
 from camfab.errors import Problem, SpecError
+from camfab.limits import MAX_DEPTH_LEVELS
 from camfab.tolerances import MAX_EXPORT_TOL_MM, MIN_EXPORT_TOL_MM
 
 __all__ = ["Rapid", "Feed", "Arc", "Comment", "ToolChange", "Spindle", "Coolant", "CutterComp", "Item", "Job",
@@ -207,14 +208,18 @@ class Job:
                                  f"give a whole number >= {minimum}"))
 
         D = num("tool_diameter_mm")
-        num("depth_mm")
+        depth = num("depth_mm")
         integer("tool_number", 1)
         if isinstance(self.tool_number, int) and self.tool_number > 99:
             P.append(Problem("job.tool_number", self.tool_number, "must be <= 99", "use a tool pocket 1..99"))
         num("spindle_rpm")
         num("feed_mm_min")
         num("plunge_feed_mm_min")
-        num("step_down_mm")
+        step = num("step_down_mm")
+        if depth is not None and step is not None and depth / step > MAX_DEPTH_LEVELS:
+            P.append(Problem("job.step_down_mm", step, f"cuts {depth:g} mm in more than {MAX_DEPTH_LEVELS} depth "
+                             "levels (the input limit)",
+                             f"give a step-down of at least {depth / MAX_DEPTH_LEVELS:.3g} mm"))
         safe = num("safe_z_mm")
         clear = num("clearance_mm")
         if safe is not None and clear is not None and clear >= safe:

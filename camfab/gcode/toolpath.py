@@ -42,6 +42,7 @@ from camfab.gcode.model import (
     ToolChange,
 )
 from camfab.geom2d import TWO_PI
+from camfab.limits import MAX_PROGRAM_MOVES
 
 __all__ = ["contour_toolpath"]
 
@@ -181,6 +182,11 @@ def contour_toolpath(path_entities, job: Job, *, roughing_contours=None,
     for li, z in enumerate(fin_levels):
         passes.append(("FINISH", f"FINISH PASS LEVEL {li + 1} OF {len(fin_levels)}", finish, z))
 
+    moves = sum(len(segs) + 8 for _, _, segs, _ in passes)
+    if moves > MAX_PROGRAM_MOVES:  # docs/decisions.md, "Input limits"
+        raise SpecError(Problem("job", f"{moves} moves", f"the program would exceed {MAX_PROGRAM_MOVES:,} moves "
+                                f"({len(levels)} depth levels × {N + 1} passes × {len(finish)} contour entities)",
+                                "raise step_down_mm, use fewer roughing_passes, or a coarser tolerance"))
     items: list = [ToolChange(job.tool_number, job.tool_diameter_mm), Rapid(None, None, job.safe_z_mm),
                    Spindle(job.spindle_rpm)]
     if job.coolant != "off":
