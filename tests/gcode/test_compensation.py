@@ -412,7 +412,8 @@ def test_reversal_rolls_half_a_turn_round_the_end():
 
 
 def test_side_change_without_g40_is_reported():
-    text = "G17 G21 G40 G54 G90 G94\nG0 X0 Y0 Z-1\nG1 G41 D1 X10 Y0 F100\nG1 X20\nG1 G42 D1 X30\nG1 X40\nG1 G40 X50\nM2\n"
+    text = ("G17 G21 G40 G54 G90 G94\nG0 X0 Y0 Z-1\nG1 G41 D1 X10 Y0 F100\nG1 X20\nG1 G42 D1 X30\nG1 X40\n"
+            "G1 G40 X50\nM2\n")
     path = simulate_compensation(parse(text).moves, 2.0)
     assert [(p.code, p.line) for p in path.problems] == [("COMP_SIDE_CHANGE", 5)]
     assert len(path.runs) == 2
