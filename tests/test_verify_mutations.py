@@ -70,6 +70,38 @@ def _num(pattern_letter, delta):
     return lambda m: f"{pattern_letter}{float(m.group(1)) + delta:.4f}"
 
 
+def _replacing(find, pattern, repl, after=None):
+    """An edit: in the first line matching ``find`` (after the comment ``after``), ``pattern`` -> ``repl``."""
+    return lambda L: _sub(L, _at(L, find, after), pattern, repl)
+
+
+def _deleting(find, after=None):
+    """An edit: delete the first line matching ``find`` (after the comment ``after``)."""
+    def edit(L):
+        del L[_at(L, find, after)]
+    return edit
+
+
+m_finish_depth = _replacing(r"^G1 Z-10\.", r"Z-10\.0000", "Z-5.0000", "FINISH PASS LEVEL 1 OF 1")
+m_rough_depth = _replacing(r"^G1 Z-5\.0000", r"Z-5\.0000", "Z-10.0000")
+m_feed_lower = _replacing(r"F600\.0", r"F600\.0", "F550.0", "FINISH LEAD-IN")
+m_plunge_feed = _replacing(r"^G1 Z-10\.", r"F200\.0", "F2000.0", "FINISH PASS LEVEL 1 OF 1")
+m_m3_to_m4 = _replacing(r"\bM3\b", r"\bM3\b", "M4")
+m_spindle_speed = _replacing(r"\bM3\b", r"S3000", "S30000")
+m_m8_to_m7 = _replacing(r"^M8$", r"M8", "M7")
+m_rapid_plunge = _replacing(r"^G1 Z-10\.", r"^G1 Z-10\.0000 F200\.0", "G0 Z-10.0000", "FINISH PASS LEVEL 1 OF 1")
+m_other_tool = _replacing(r"^T1 M6$", r"^T1", "T2")
+m_no_length_offset = _replacing(r"G43 H1", r"G43 H1 ", "")
+m_inch = _replacing(r"\bG21\b", r"\bG21\b", "G20")
+m_no_g90 = _replacing(r"\bG90\b", r" G90\b", "")
+m_drop_m3 = _deleting(r"\bM3\b")
+m_drop_m8 = _deleting(r"^M8$")
+m_no_retract = _deleting(r"^G0 Z25\.", "ROUGH LEAD-OUT")
+m_no_final_retract = _deleting(r"^G0 Z25\.", "FINISH LEAD-OUT")
+m_no_tool_change = _deleting(r"^T1 M6$")
+m_no_program_end = _deleting(r"^M(2|30)$")
+
+
 # -- the mutations: (name, posts it applies to, edit(lines) -> None, the finding(s) one of which must appear) --
 def m_delete_finish_line(L):
     del L[_at(L, r"^G[0123]\b", "FINISH CONTOUR", 3)]
@@ -85,14 +117,6 @@ def m_truncate_after_roughing(L):
     del L[i:]
 
 
-def m_finish_depth(L):
-    _sub(L, _at(L, r"^G1 Z-10\.", "FINISH PASS LEVEL 1 OF 1"), r"Z-10\.0000", "Z-5.0000")
-
-
-def m_rough_depth(L):
-    _sub(L, _at(L, r"^G1 Z-5\.0000"), r"Z-5\.0000", "Z-10.0000")
-
-
 def m_feed_fast(L):
     i = _at(L, r"^G[123]\b", "FINISH CONTOUR")
     L[i] += " F60000.0"
@@ -103,47 +127,15 @@ def m_feed_zero(L):
     L[i] += " F0"
 
 
-def m_feed_lower(L):
-    _sub(L, _at(L, r"F600\.0", "FINISH LEAD-IN"), r"F600\.0", "F550.0")
-
-
-def m_plunge_feed(L):
-    _sub(L, _at(L, r"^G1 Z-10\.", "FINISH PASS LEVEL 1 OF 1"), r"F200\.0", "F2000.0")
-
-
-def m_drop_m3(L):
-    del L[_at(L, r"\bM3\b")]
-
-
-def m_m3_to_m4(L):
-    _sub(L, _at(L, r"\bM3\b"), r"\bM3\b", "M4")
-
-
-def m_spindle_speed(L):
-    _sub(L, _at(L, r"\bM3\b"), r"S3000", "S30000")
-
-
 def m_spindle_after_plunge(L):
     i = _at(L, r"\bM3\b")
     line = L.pop(i)
     L.insert(_at(L, r"^G1 Z-5\.") + 1, line)
 
 
-def m_drop_m8(L):
-    del L[_at(L, r"^M8$")]
-
-
-def m_m8_to_m7(L):
-    _sub(L, _at(L, r"^M8$"), r"M8", "M7")
-
-
 def m_m9_before_cutting(L):
     i = _at(L, r"^M8$")
     L.insert(i + 1, "M9")
-
-
-def m_rapid_plunge(L):
-    _sub(L, _at(L, r"^G1 Z-10\.", "FINISH PASS LEVEL 1 OF 1"), r"^G1 Z-10\.0000 F200\.0", "G0 Z-10.0000")
 
 
 def m_rapid_in_material(L):
@@ -183,30 +175,10 @@ def m_coordinate_typo(L):
     _sub(L, i, r"X(-?[\d.]+)", _num("X", 0.05))
 
 
-def m_no_retract(L):
-    del L[_at(L, r"^G0 Z25\.", "ROUGH LEAD-OUT")]
-
-
-def m_no_final_retract(L):
-    del L[_at(L, r"^G0 Z25\.", "FINISH LEAD-OUT")]
-
-
 def m_safe_z_low(L):
     for i, t in enumerate(L):
         if re.search(r"^G0 .*Z25\.0000", _code(t)):
             _sub(L, i, r"Z25\.0000", "Z1.0000")
-
-
-def m_no_tool_change(L):
-    del L[_at(L, r"^T1 M6$")]
-
-
-def m_other_tool(L):
-    _sub(L, _at(L, r"^T1 M6$"), r"^T1", "T2")
-
-
-def m_no_length_offset(L):
-    _sub(L, _at(L, r"G43 H1"), r"G43 H1 ", "")
 
 
 def m_plunge_deeper(L):
@@ -214,27 +186,25 @@ def m_plunge_deeper(L):
     L.insert(i + 1, "G1 Z-12.0000")
 
 
-def m_inch(L):
-    _sub(L, _at(L, r"\bG21\b"), r"\bG21\b", "G20")
-
-
-def m_no_g90(L):
-    _sub(L, _at(L, r"\bG90\b"), r" G90\b", "")
-
-
 def m_inject_g91(L):
     i = next(k for k, t in enumerate(L) if t.upper() == "(FINISH CONTOUR)")
     L.insert(i + 1, "G91")
-
-
-def m_no_program_end(L):
-    del L[_at(L, r"^M(2|30)$")]
 
 
 def m_cut_across(L):
     i = _finish_moves(L)[8]
     x, y = _xy(L[i])
     L[i + 1:i + 1] = ["G1 X0.0000 Y0.0000", f"G1 X{x:.4f} Y{y:.4f}"]
+
+
+def m_lift_over_a_stretch(L):
+    # lift the tool after one finishing move, rapid over the next three and plunge again: only coverage sees it
+    f = _finish_moves(L)
+    k = f[6]
+    x, y = _xy(L[f[9]])
+    del L[f[7]:f[10]]
+    L[k + 1:k + 1] = ["G0 Z25.0000", f"G0 X{x:.4f} Y{y:.4f}", "G0 Z2.0000", "G1 Z-10.0000 F200.0"]
+    L[k + 5] += " F600.0"
 
 
 def m_swap_ij(L):
@@ -280,6 +250,7 @@ MUTATIONS = [
     ("G91 injected before the finishing contour", ALL, m_inject_g91, GEOMETRY),
     ("program end deleted", ALL, m_no_program_end, {"PARSE_WARNING"}),
     ("a cut across the part", ALL, m_cut_across, {"GOUGE"}),
+    ("a stretch skipped by lifting the tool", ALL, m_lift_over_a_stretch, {"COVERAGE"}),
     ("I and J swapped", ALL, m_swap_ij, {"PARSE_ERROR", "DEVIATION", "GOUGE"}),
 ]
 CASES = [pytest.param(post, edit, codes, id=f"{post}: {name}")

@@ -11,8 +11,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-import numpy as np
-
 from ..discretize import ParametricCurve, arcs, polyline
 from ..geom2d import ArcChain
 from ..offset.cutter import offset_curve, profile_curve, tool_centre_path
@@ -99,12 +97,6 @@ def verify_cam_program(program: str | bytes, contact, job: Job, *, tol: float, p
     """
     if part is None:
         part = signed_distance(profile_curve(contact), tol=tol, exact_within=job.tool_radius_mm + tol + 0.05)
-    r = job.tool_radius_mm
-    dist = part
-
-    def centre(p: np.ndarray) -> np.ndarray:
-        return dist(p) - r
-
-    return verify_program(program, post=post, default_post=default_post, exact_curve_distance=centre,
-                          part_distance=part, part_curve=part, tool_radius=r, tol=tol, safe_z=job.safe_z_mm,
-                          top_z=0.0, comp_radius=comp_radius, job=job)
+    return verify_program(program, post=post, default_post=default_post, exact_curve_distance=None,
+                          part_distance=part, part_curve=part, tool_radius=job.tool_radius_mm, tol=tol,
+                          safe_z=job.safe_z_mm, top_z=0.0, comp_radius=comp_radius, job=job)

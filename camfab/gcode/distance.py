@@ -28,6 +28,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from camfab.discretize import polyline
+from camfab.discretize.curve import derivatives_at, piece_index, points_at
 from camfab.errors import ApiError, GeometryError
 from camfab.gcode.contour import Segment, as_contour
 from camfab.geom2d import TWO_PI, ArcChain
@@ -390,13 +392,14 @@ class CurveDistance:
     """
 
     def __init__(self, curve, coarse_tol: float = 0.01, exact_within: float = math.inf):
-        from camfab.discretize import polyline
-
         self.curve = curve
         self.exact_within = float(exact_within)
         disc = polyline(curve, tol=coarse_tol)
         self.coarse_tol = float(disc.max_deviation if disc.max_deviation > 0 else coarse_tol)
         self.params = np.asarray(disc.params, dtype=float)
+        # the smooth piece of the curve each coarse segment lies in (its vertices include every breakpoint)
+        piece = piece_index(curve, 0.5 * (self.params[:-1] + self.params[1:]))
+        self.piece_lo, self.piece_hi = curve.breakpoints[piece], curve.breakpoints[piece + 1]
         self.coarse = IndexedContourDistance(disc.arc_chain())
         self._ccw = not self.coarse.clockwise
 
@@ -416,30 +419,30 @@ class CurveDistance:
         reach[i0] = d0 + 2.0 * self.coarse_tol * (1 + 1e-9) + 1e-12
         qi, qj = tree.query(geoms, predicate="dwithin", distance=reach)
         qi, qj = np.concatenate([qi, i0]), np.concatenate([qj, j0])  # the nearest always, whatever the rounding
-        d, t, end = self._refine(p[qi], self.params[qj], self.params[qj + 1])
+        d, t, end = self._refine(p[qi], self.params[qj], self.params[qj + 1], self.piece_lo[qj], self.piece_hi[qj])
         order = np.lexsort((t, d, qi))  # per point: the smallest distance
         qi, d, t, end = qi[order], d[order], t[order], end[order]
         first = np.ones(len(qi), dtype=bool)
         first[1:] = qi[1:] != qi[:-1]
         return d[first], t[first], end[first]
 
-    def _refine(self, p: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Nearest point of the curve on ``[a, b]`` (one smooth piece) to each ``p``: ``(distance, t, at an end)``.
+    def _refine(self, p: np.ndarray, a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Nearest point of the curve on ``[a, b]`` (inside the smooth piece ``[lo, hi]``) to each ``p``:
+        ``(distance, t, at an end)``.
 
         The distance and ``g(t) = (P(t) - p) . P'(t)`` at ``_SUB + 1`` points across the interval; every change
         of sign of ``g`` from - to + between two of them (a local minimum) that could beat the nearest of
         those points (the distance is 1-Lipschitz along the arc) is refined by Illinois regula falsi.  A
         point near a centre of curvature sees a nearly flat distance with several extrema: all are looked at.
         """
-        from camfab.discretize.curve import points_at
-
         curve = self.curve
         n = len(p)
         grid = a[:, None] + (b - a)[:, None] * (np.arange(_SUB + 1) / _SUB)[None, :]  # (n, SUB+1)
         rep = np.repeat(np.arange(n), _SUB + 1)
         tg = grid.reshape(-1)
         q = points_at(curve, tg)
-        g = _slope(curve, p[rep], tg, a[rep], b[rep], q).reshape(n, _SUB + 1)
+        g = _slope(curve, p[rep], tg, lo[rep], hi[rep], q).reshape(n, _SUB + 1)
         q = q.reshape(n, _SUB + 1, 2)
         dg = np.hypot(q[..., 0] - p[:, None, 0], q[..., 1] - p[:, None, 1])
         rows = np.arange(n)
@@ -449,7 +452,7 @@ class CurveDistance:
         lower = np.minimum(dg[:, :-1], dg[:, 1:]) - 0.51 * chord - 1e-12
         pi, si = np.nonzero((g[:, :-1] < 0.0) & (g[:, 1:] > 0.0) & (lower < d[:, None]))
         if len(pi):
-            tk = self._illinois(p[pi], grid[pi, si], grid[pi, si + 1], g[pi, si], g[pi, si + 1], a[pi], b[pi])
+            tk = self._illinois(p[pi], grid[pi, si], grid[pi, si + 1], g[pi, si], g[pi, si + 1], lo[pi], hi[pi])
             dk = np.hypot(*(p[pi] - points_at(curve, tk)).T)
             better = np.full(n, np.inf)
             np.minimum.at(better, pi, dk)
@@ -486,8 +489,6 @@ class CurveDistance:
         """Signed distance of ``points`` (array ``(n, 2)``) in mm; negative inside."""
         import shapely
 
-        from camfab.discretize.curve import derivatives_at, piece_index, points_at
-
         p = np.asarray(points, dtype=float).reshape(-1, 2)
         ok = np.all(np.isfinite(p), axis=1)
         out = np.full(len(p), np.nan)
@@ -518,8 +519,6 @@ class CurveDistance:
 
     def at_position(self, s) -> np.ndarray:
         """Points of the exact curve at arc-length positions ``s`` of the coarse polyline (wrapped)."""
-        from camfab.discretize.curve import points_at
-
         j, u = self.coarse.locate(s)
         return points_at(self.curve, self.params[j] + u * (self.params[j + 1] - self.params[j]))
 
@@ -527,8 +526,6 @@ class CurveDistance:
 def _slope(curve, p: np.ndarray, t: np.ndarray, lo: np.ndarray, hi: np.ndarray, q: np.ndarray | None = None
            ) -> np.ndarray:
     """``(P(t) - p) . P'(t)``: half the derivative of the squared distance along the curve (``q = P(t)`` if known)."""
-    from camfab.discretize.curve import derivatives_at, points_at
-
     if q is None:
         q = points_at(curve, t)
     return np.einsum("ij,ij->i", q - p, derivatives_at(curve, t, lo, hi))

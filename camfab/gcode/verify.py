@@ -154,7 +154,7 @@ def _r(v: float) -> float:
     return float(f"{v:.6g}")
 
 
-def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
+def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray] | None,
            part_distance: Callable[[np.ndarray], np.ndarray], tool_radius: float, tol: float,
            safe_z: float, top_z: float = 0.0, step: float | None = None,
            finish_label: str = "FINISH CONTOUR", curve_points: np.ndarray | None = None,
@@ -168,9 +168,11 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
     moves : Backplot or sequence of Move
         From :func:`camfab.gcode.parse.parse`; a Backplot's warnings become problems and its modal state
         is checked.
-    exact_curve_distance : callable
+    exact_curve_distance : callable or None
         ``f(points (n, 2)) -> (n,)`` signed distance in mm from the exact tool-centre curve (positive
-        outside).
+        outside); None: the tool-centre curve is the set of points ``tool_radius`` from the part, whose
+        distance is ``|part_distance - tool_radius|`` (what ``camfab verify`` uses; the finishing moves then
+        reuse the part distances the gouge check measured).
     part_distance : callable
         ``f(points (n, 2)) -> (n,)`` signed distance in mm from the finished part profile (negative inside
         the material).
@@ -265,9 +267,15 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
         sub = [moves[i] for i in cutting]
         smp = sample(sub, step, K)
         below = smp.points[:, 2] < top_z - _EPS_Z
+        d_base = np.full(len(smp.points), np.nan)
         if below.any():
+            d_base[below] = np.asarray(part_distance(smp.points[below, :2]), dtype=float)
+        # kept per move: the finishing moves' deviation reuses them
+        part_at = dict(zip(cutting, np.split(d_base, np.cumsum(np.bincount(smp.index, minlength=len(sub)))[:-1]),
+                           strict=True))
+        if below.any():
+            pen = r_tool - d_base[below]
             smp = _subset(smp, below)
-            pen = r_tool - np.asarray(part_distance(smp.points[:, :2]), dtype=float)
             extra = _around_peaks(sub, smp, pen)  # each move's deepest sample, resolved 16 times finer
             keep = extra.points[:, 2] < top_z - _EPS_Z
             extra = _subset(extra, keep)
@@ -308,18 +316,27 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray],
     if fin_final:
         sub = [moves[i] for i in fin_final]
 
-        def deviation(pts: np.ndarray, idx: np.ndarray) -> np.ndarray:
-            # simulated compensated moves: the exact tool-centre curve is where the part is tool_radius away
-            comp = np.array([moves[i].comp != "G40" for i in idx], dtype=bool)
+        def deviation(pts: np.ndarray, idx: np.ndarray, known: np.ndarray | None = None) -> np.ndarray:
+            # the exact tool-centre curve is where the part is tool_radius away: |part distance - r| for the
+            # simulated compensated moves, and for all when no exact_curve_distance is given
+            by_part = np.array([moves[i].comp != "G40" or exact_curve_distance is None for i in idx], dtype=bool)
             dev = np.empty(len(pts))
-            if (~comp).any():
-                dev[~comp] = np.abs(np.asarray(exact_curve_distance(pts[~comp, :2]), dtype=float))
-            if comp.any():
-                dev[comp] = np.abs(np.asarray(part_distance(pts[comp, :2]), dtype=float) - r_tool)
+            if (~by_part).any():
+                assert exact_curve_distance is not None
+                dev[~by_part] = np.abs(np.asarray(exact_curve_distance(pts[~by_part, :2]), dtype=float))
+            if by_part.any():
+                d = known[by_part] if known is not None else np.full(int(by_part.sum()), np.nan)
+                todo = np.isnan(d)
+                if todo.any():
+                    d[todo] = np.asarray(part_distance(pts[by_part][todo, :2]), dtype=float)
+                dev[by_part] = np.abs(d - r_tool)
             return dev
 
         smp = sample(sub, step, K)
-        dev = deviation(smp.points, np.asarray(fin_final)[smp.index])
+        known = np.concatenate([part_at.get(i, np.full(int(c), np.nan)) if len(part_at.get(i, ())) == c
+                                else np.full(int(c), np.nan)
+                                for i, c in zip(fin_final, np.bincount(smp.index, minlength=len(sub)), strict=True)])
+        dev = deviation(smp.points, np.asarray(fin_final)[smp.index], known)
         extra = _around_peaks(sub, smp, dev)  # each move's worst sample, resolved 16 times finer
         dev_x = deviation(extra.points, np.asarray(fin_final)[extra.index])
         pts, idx = smp.points, np.asarray(fin_final)[smp.index]  # (coverage: the evenly spaced samples)

@@ -123,3 +123,34 @@ def test_sample_points_lie_on_the_arc():
     assert (s.index == 0).all()
     steps = np.linalg.norm(np.diff(s.points, axis=0), axis=1)
     assert steps.max() <= 0.1 + 1e-12
+
+
+def test_machine_state_is_carried_by_every_move():
+    text = ("G17 G21 G40 G54 G90 G94\nT3 M6\nG0 G43 H3 Z25\nS2500 M4\nM8\nG0 X0 Y0\nG1 Z-1 F100\nM7\n"
+            "G1 X5\nM9\nM3\nG49\nG1 X6\nG43\nG1 X7\nM2\n")
+    m = {mv.line: mv for mv in parse(text).moves}
+    assert (m[7].tool, m[7].length_offset, m[7].spindle_dir, m[7].spindle_rpm, m[7].coolant) == (3, 3, "ccw", 2500,
+                                                                                                    "flood")
+    assert m[9].coolant == "flood+mist"
+    assert (m[13].coolant, m[13].spindle_dir, m[13].length_offset) == ("off", "cw", None)
+    assert m[15].length_offset == 3  # G43 alone takes the loaded tool
+
+
+def test_modal_groups_set_before_the_first_move():
+    bp = parse("G21 G90\nG0 X0 Y0 Z5\nG17 G94\nM2\n")
+    assert bp.modal_before_motion >= {"units", "distance", "motion"}
+    assert not bp.modal_before_motion & {"plane", "feed_mode", "comp", "wcs"}
+    assert parse("G17 G21 G40 G54 G90 G94\nG0 Z5\nM2\n").modal_before_motion >= {
+        "plane", "units", "distance", "feed_mode", "comp", "wcs"}
+
+
+def test_sampling_is_bounded_per_move_and_keeps_where():
+    from camfab.gcode.parse import points_along
+
+    m = _arc("G3 X-10 Y0 I-5 J0 F100")
+    s = sample([m], 0.001, max_per_move=40)
+    assert len(s.points) == 41 and np.allclose(s.param, np.linspace(0, 1, 41))
+    assert np.allclose(points_along(m, s.param), s.points)
+    # a line 1 km long: at most 40 intervals
+    line = parse("G21 G90\nG0 X0 Y0 Z0\nG1 X1000000 F100\nM2\n").moves[-1]
+    assert len(sample([line], 0.05, max_per_move=40).points) == 41

@@ -174,3 +174,37 @@ def test_report_is_json_ready():
     rep = _verify(_text())
     d = json.loads(json.dumps(rep.to_dict()))
     assert d["ok"] is True and d["problems"] == [] and d["gouge_at"] is None
+
+
+def test_bounded_sampling_still_finds_the_worst_deviation():
+    """Each move sampled at most 256 (or 32) times, its worst sample resolved 16 times finer: the reported
+    deviation is the one a 2 um sampling of the whole finishing pass measures."""
+    from camfab import pipeline
+    from camfab.gcode.cam import cam_program, signed_distance
+    from camfab.gcode.parse import sample
+    from camfab.offset import profile_curve
+
+    cam = pipeline.load("ejemplo9rt")
+    contact = cam.geometry.profiles[0]
+    job = pipeline.gcode_job(cam.spec, tol=0.01, overrides={"step_down_mm": 5.0})
+    bp = parse(dumps(cam_program(contact, job, tol=0.01).program, "linuxcnc"))
+    part = signed_distance(profile_curve(contact), tol=0.01)
+    fin = [m for m in bp.moves if (m.label or "").startswith("FINISH CONTOUR")]
+    dense = float(np.abs(part(sample(fin, 0.002).points[:, :2]) - R_TOOL).max())
+    for k, rel in ((256, 1e-5), (32, 1e-3)):
+        rep = verify(bp, exact_curve_distance=None, part_distance=part, tool_radius=R_TOOL, tol=0.01, safe_z=SAFE_Z,
+                     job=job, max_samples_per_move=k)
+        assert rep.ok and rep.max_deviation_mm == pytest.approx(dense, rel=rel)
+
+
+def test_declared_post_reads_every_posts_header():
+    from camfab.gcode.verify import declared_post
+
+    for post, opts in POSTS:
+        assert declared_post(parse(_text(post, opts)).comments) == post
+    assert declared_post(("post: heidenhain",)) is None and declared_post(()) is None
+
+
+def test_without_a_job_the_job_checks_are_left_out_and_said_so():
+    rep = _verify(_text())
+    assert rep.ok and any("no job given" in n for n in rep.notes) and any("coverage" in n for n in rep.notes)
