@@ -3,9 +3,11 @@
 Curve to entities: exact point-to-line / point-to-arc distances of exact curve samples to the chain.
 Entities to curve: every entity sample is projected onto the curve (Newton on a Hermite interpolant of
 the exact samples and derivatives, on both sample intervals touching the nearest curve sample, never
-across a breakpoint) and its distance taken to the exact curve point at the foot, an upper bound.  The
-worst local maxima of each direction are then refined by two nested grids around them.  The exact
-curve is called a fixed, small number of times (batched).
+across a breakpoint) and its distance taken to the exact curve point at the foot, an upper bound; the
+feet of the samples that could hold the maximum are then polished by Gauss-Newton steps on the exact
+curve (a short, sharp piece has only its few samples in the interpolant).  The worst local maxima of
+each direction are then refined by two nested grids around them.  The exact curve is called a fixed,
+small number of times (batched).
 """
 from __future__ import annotations
 
@@ -78,11 +80,6 @@ class _CurveProjector:
         self.x = sur.x
         self.n = sur.x.size - 1
         self.tree = cKDTree(sur.points[:-1] if self.curve.closed else sur.points)
-
-    def __call__(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Distance from each ``x`` ``(N, 2)`` to the curve and the foot parameter."""
-        dist, t, _ = self.project(x)
-        return dist, t
 
     def project(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Distance from each ``x`` ``(N, 2)`` to the curve, the foot parameter and its smooth piece."""
@@ -200,9 +197,9 @@ def _chain_to_curve(chain: Chain, sur: HermiteSurrogate, per_entity: int,
 
         def g_b(uu):
             pts = entity_point(chain.start[ent, None], chain.tangent[ent, None], chain.curvature[ent, None], uu)
-            flat = pts.reshape(-1, 2)
-            dist, t, piece = proj.project(flat)
-            return proj.polish(flat, t, piece, dist)[0].reshape(uu.shape)
+            q = pts.reshape(-1, 2)
+            dist, t, piece = proj.project(q)
+            return proj.polish(q, t, piece, dist)[0].reshape(uu.shape)
 
         best_b = _zoom_max(g_b, u_lo, u_hi)
         if best_b.max() > worst_b:

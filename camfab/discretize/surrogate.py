@@ -132,7 +132,7 @@ def fit_surrogate(curve: ParametricCurve, tol: float, n: int = 4096) -> tuple[He
         err = sur.interval_errors()
         bad = (err > goal) & (np.diff(sur.x) > floor)
         if not bad.any():
-            break
+            return sur, float(err.max())
         ratio = np.where(np.isfinite(err), err / goal, 1e4)
         parts = np.where(bad, np.clip(np.ceil(1.25 * ratio ** 0.25), 2, 16), 1).astype(int)
         room = SURROGATE_MAX_NODES - sur.x.size

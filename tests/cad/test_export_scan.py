@@ -191,7 +191,7 @@ SLOW = {f"{law}_{span}deg_{lift}mm_rr{rr}_rb{rb}": law_design(span, lift, rr, rb
             (("cycloidal", p) for p in itertools.product((0.01, 1.0), (0.001, 0.1), (0.01, 1.0), (50, 200))),
             (("modified_sine", p) for p in ((0.1, 0.01, 0.01, 200), (1.0, 0.1, 1.0, 50))))}
 SLOW.update({f"knots_{span}deg_{lift}mm_gap{gap}": knot_design(span, lift, gap, 0.01, 200)
-             for span, lift, gap in itertools.product((0.01, 1.0), (0.001, 0.1), (1e-12, 1e-9, 1e-6, 1e-3))})
+             for (span, lift), gap in itertools.product(((0.01, 0.001), (1.0, 0.1)), (1e-12, 1e-9, 1e-6, 1e-3))})
 SLOW.update({"knots_1deg_0.1mm_gap1e-12_rr1_rb50": knot_design(1.0, 0.1, 1e-12, 1.0, 50),
              "poly345_0.1deg_0.01mm_rr0.1_rb50": law_design(0.1, 0.01, 0.1, 50, "poly345")})
 
