@@ -22,9 +22,9 @@ Checks (vectorised over the moves' sample points; each move is sampled every ``s
   left);
 * **deviation** - the largest ``|exact_curve_distance|`` over the finishing-pass cutting moves at final
   depth (moves labelled ``FINISH CONTOUR`` by camfab's posts; without such labels, every horizontal
-  cutting move at the deepest Z, which then includes any lead-in arcs); for simulated compensated moves
-  the exact tool-centre curve is the set of points ``tool_radius`` from the part, so their deviation is
-  ``|part_distance - tool_radius|``;
+  cutting move at the deepest Z, which then includes any lead-in arcs); for simulated compensated moves,
+  and for all when ``exact_curve_distance`` is None, the exact tool-centre curve is the set of points
+  ``tool_radius`` from the part, so the deviation is ``|part_distance - tool_radius|``;
 * **gouge** - a cutting move below the stock top whose tool centre comes closer to the finished part
   than ``tool_radius - tol`` (``part_distance < tool_radius - tol``), compensated or not, with the
   program lines involved;
@@ -47,9 +47,14 @@ Checks (vectorised over the moves' sample points; each move is sampled every ``s
   clockwise around the part);
 * **end** - the program ends with the tool below the stock top (``RETRACT_MISSING``);
 * **arcs** - an arc whose start and end radius differ by more than ``tol`` (as programmed);
-* **coverage** (``curve_points``) - the largest distance from points of the exact tool-centre curve to
-  the finishing moves at final depth (exact distances to the lines and arcs, simulated for compensated
-  programs), so a program that skips part of the contour fails too.
+* **coverage** (``part_curve`` or ``curve_points``) - the thickest material the finishing moves at final
+  depth leave on the part (the finishing samples projected onto the part, the part measured where no
+  continuous cut covers it and at 4096 points along it), or the largest distance from the given points of
+  the exact tool-centre curve to those moves (exact distances to the lines and arcs, simulated for
+  compensated programs), so a program that skips part of the contour fails too.
+
+The maximum deviation and penetration of each move are resolved 16 times finer around its worst sample,
+so the bounded sampling still finds them (see ``docs/decisions.md``, "What verify checks").
 
 Every problem names the program line (1-based); moves the simulation inserts (corner arcs, bridges) carry
 the line of the programmed move they lead into.
