@@ -226,18 +226,25 @@ def cmd_gcode(args: argparse.Namespace) -> int:
                   machining=machining, lift_step_deg=args.lift_step)
     pipeline.gcode_job(cam.spec, tol=tol, overrides=machining)  # a bad job is refused before the check
     _refuse_compensation(req.post, pipeline.machining_of(cam.spec, machining).compensation, args.compensation)
-    if _refuse_unacceptable(cam, "gcode", args.force):
-        return EXIT_CHECKS
-    arts = pipeline.EXPORTERS[Output.GCODE](cam, req)
-    lift = pipeline.EXPORTERS[Output.LIFT_TABLE](cam, req)[0] if args.lift_table else None
     out = Path(args.output)
-    for i, a in enumerate(arts):
-        name = out if len(arts) == 1 else out.with_name(f"{out.stem}_cam{i + 1}{out.suffix}")
-        atomic_write(name, a.data)
+    # the folders of the program and the lift table: created and proved writable before computing (else exit 3);
+    # not locked (gcode writes single named files, often beside others' files)
+    with contextlib.ExitStack() as stack:
+        for folder in dict.fromkeys(p.parent for p in (out, *([Path(args.lift_table)] if args.lift_table else []))):
+            stack.enter_context(output_folder(folder, lock=False))
+        if _refuse_unacceptable(cam, "gcode", args.force):
+            return EXIT_CHECKS
+        arts = pipeline.EXPORTERS[Output.GCODE](cam, req)
+        names = [out if len(arts) == 1 else out.with_name(f"{out.stem}_cam{i + 1}{out.suffix}")
+                 for i in range(len(arts))]
+        files: dict[Path, bytes | str] = {n: a.data for n, a in zip(names, arts, strict=True)}
+        if args.lift_table:
+            files[Path(args.lift_table)] = pipeline.EXPORTERS[Output.LIFT_TABLE](cam, req)[0].data
+        write_all(files)  # the programs and the lift table: all or none
+    for name, a in zip(names, arts, strict=True):
         print(f"wrote {name}: {req.post}, {a.entities} contour entities, max deviation {a.deviation_mm:.3g} mm "
               f"(tol {tol:g} mm)")
-    if lift is not None:
-        atomic_write(args.lift_table, lift.data)
+    if args.lift_table:
         print(f"wrote {args.lift_table}")
     return _exit(cam.verdict)  # forced files of an unacceptable design: written, and still exit 1
 
@@ -403,7 +410,8 @@ def cmd_report(args: argparse.Namespace) -> int:
 
     require_report_dependencies()
     cam = _cam(args.file)
-    paths = write_files(render_report(cam.spec, cam.geometry, cam.check(), standalone=args.standalone), args.out)
+    with output_folder(args.out) as folder:  # created, writable and locked before computing (else exit 3)
+        paths = write_files(render_report(cam.spec, cam.geometry, cam.check(), standalone=args.standalone), folder)
     print(f"{plain(cam.name)}: {cam.verdict}")
     print(f"wrote {Path(paths[0])} (+{len(paths) - 1} plot files)", file=sys.stderr)
     return _exit(cam.verdict)
@@ -422,8 +430,9 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
     require_report_dependencies()
     cams = [_cam(f) for f in args.files]
-    items = [(c.spec, c.geometry, c.check()) for c in cams]
-    paths = write_files(render_comparison(items, standalone=args.standalone), args.out)
+    with output_folder(args.out) as folder:  # created, writable and locked before computing (else exit 3)
+        items = [(c.spec, c.geometry, c.check()) for c in cams]
+        paths = write_files(render_comparison(items, standalone=args.standalone), folder)
     for c in cams:
         print(f"{plain(c.name)}: {c.verdict}")
     print(f"wrote {paths[0]} (+{len(paths) - 1} plot files)", file=sys.stderr)

@@ -248,7 +248,7 @@ def clean_stale(folder: str | Path, depth: int = 2) -> list[Path]:
 
 
 @contextlib.contextmanager
-def output_folder(folder: str | Path) -> Iterator[Path]:
+def output_folder(folder: str | Path, *, lock: bool = True) -> Iterator[Path]:
     """Prepare ``folder`` for one camfab command that writes into it, before any computing:
 
     1. create it (and its parents), then prove it writable with a temporary file: an ``OSError`` naming the
@@ -258,7 +258,8 @@ def output_folder(folder: str | Path) -> Iterator[Path]:
     3. remove the leftovers of killed camfab processes (:func:`clean_stale`).
 
     On exit the folders it created are removed again if nothing was written into them.  Without ``fcntl``
-    (Windows) there is no lock.
+    (Windows) there is no lock.  ``lock=False`` (a command that writes single named files, like ``gcode -o
+    OUT.nc``, into a folder it does not own): steps 1 and 3 only, step 3 in ``folder`` itself, not below it.
     """
     folder = Path(folder)
     created = _missing_ancestors(folder)
@@ -267,6 +268,11 @@ def output_folder(folder: str | Path) -> Iterator[Path]:
     except OSError as exc:
         raise named(exc, folder, "cannot create the output folder") from exc
     try:
+        if not lock:
+            _probe(folder)
+            clean_stale(folder, depth=0)
+            yield folder
+            return
         fd = _lock(folder)
         try:
             _probe(folder)

@@ -297,7 +297,8 @@ def test_a_locked_folder_is_refused_with_exit_3_naming_it(tmp_path, capsys):
     with output_folder(out):
         assert (out / LOCK).exists()
         for argv in (["run", "ejemplo9rt", "--outputs", "xlsx"], ["package", str(EXAMPLES / "ejemplo9rt.toml")],
-                     ["export", "ejemplo9rt", "--dxf"]):
+                     ["export", "ejemplo9rt", "--dxf"], ["report", "ejemplo9rt"],
+                     ["compare", "ejemplo9rt", "ejemplo1rt"]):
             assert main([*argv, "-o", str(out)]) == 3
             err = capsys.readouterr().err
             assert "another camfab command is writing into this folder" in err and str(out) in err
@@ -390,7 +391,9 @@ def test_disk_full_on_the_manifest_still_writes_the_index(designs, tmp_path, mon
 
 
 @pytest.mark.parametrize("argv", [["run", "ejemplo9rt"], ["export", "ejemplo9rt", "--dxf"],
-                                  ["package", str(EXAMPLES / "ejemplo9rt.toml")]], ids=lambda a: a[0])
+                                  ["package", str(EXAMPLES / "ejemplo9rt.toml")], ["report", "ejemplo9rt"],
+                                  ["compare", "ejemplo9rt", "ejemplo1rt"], ["gcode", "ejemplo9rt"],
+                                  ["gcode", "ejemplo9rt", "--lift-table", "LIFT"]], ids=lambda a: "-".join(a[::2]))
 def test_a_folder_that_cannot_be_written_fails_before_any_computing(tmp_path, monkeypatch, capsys, argv):
     def no(*a, **k):
         raise AssertionError("computed before the output folder was proved writable")
@@ -398,10 +401,17 @@ def test_a_folder_that_cannot_be_written_fails_before_any_computing(tmp_path, mo
     monkeypatch.setattr(pipeline.Cam, "check", no)
     plain = tmp_path / "plain"
     plain.write_text("a file, not a folder")
-    for target in ("/proc/camfab-x", plain / "sub", plain):
-        assert main([*argv, "-o", str(target)]) == 3
+    for target in (Path("/proc/camfab-x"), plain / "sub", plain):
+        if argv[0] != "gcode":
+            args = [*argv, "-o", str(target)]
+        elif "LIFT" in argv:  # the program's folder is fine, the lift table's is not
+            args = [a if a != "LIFT" else str(target / "lift.csv") for a in argv] + ["-o", str(tmp_path / "p.nc")]
+        else:  # gcode -o names a file: its folder is the one proved writable
+            args = [*argv, "-o", str(target / "p.nc")]
+        assert main(args) == 3
         err = capsys.readouterr().err
         assert str(target) in err and "output folder" in err and "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["plain"]  # nothing written, no folder left
 
 
 # ---------------------------------------------------------------------------

@@ -370,9 +370,10 @@ def render_report(spec, geometry, report, *, standalone: bool = False, frames: i
 
 
 def write_files(files: Mapping[str, bytes], out_dir: str | Path) -> list[Path]:
-    """Write ``{relative path: bytes}`` under ``out_dir`` (atomic writes); returns the paths in order."""
-    from ..io import atomic_write, inside
+    """Write ``{relative path: bytes}`` under ``out_dir`` as one set (:func:`camfab.io.write_all`: every file or
+    none, old files untouched on a failure); returns the paths in order."""
+    from ..io import inside, write_all
 
     out = Path(out_dir)
     targets = [inside(out, rel) for rel in files]  # all proved inside out_dir before any write
-    return [atomic_write(t, data) for t, data in zip(targets, files.values(), strict=True)]
+    return write_all(dict(zip(targets, files.values(), strict=True)))
