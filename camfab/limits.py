@@ -16,6 +16,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from .errors import Problem
+from .textsafe import excerpt
 
 __all__ = [
     "MAX_FILE_BYTES",
@@ -80,7 +81,7 @@ MAX_LISTED = 100
 def preview(value: Any, width: int = 40) -> str:
     """A short stand-in for an over-long or deeply nested value in a message (never its whole text)."""
     if isinstance(value, str):
-        return value if len(value) <= width else f"{value[:width]}… ({len(value)} characters)"
+        return excerpt(value, width) + ("" if len(value) <= width else f" ({len(value)} characters)")
     if isinstance(value, Mapping):
         return f"<a table of {len(value)} keys>"
     if isinstance(value, (list, tuple)):

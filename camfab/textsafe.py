@@ -89,8 +89,9 @@ def _take(pieces: Iterable[str], limit: int) -> str:
 
 
 def excerpt(text: str, limit: int = 80) -> str:
-    """A short one-line quote of ``text`` (a line of an input file, a formula) for a message."""
-    return _take(plain(text), limit)
+    """A short one-line quote of ``text`` (a line of an input file, a formula) for a message; only the first
+    ``limit + 1`` characters are looked at (a 1 GB text costs nothing more than a short one)."""
+    return _take(plain(str(text)[: limit + 1]), limit)
 
 
 def bounded(message: str, *, line_max: int = MESSAGE_LINE_MAX, lines_max: int = MESSAGE_LINES_MAX) -> str:

@@ -22,7 +22,7 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "camfab.errors": ("camfab.textsafe",),  # messages quote values through textsafe.excerpt
     "camfab.units": (),
     "camfab.tolerances": (),
-    "camfab.limits": ("camfab.errors",),
+    "camfab.limits": ("camfab.errors", "camfab.textsafe"),
     "camfab.io": ("camfab.errors",),
     "camfab.textsafe": (),
     "camfab.assets": ("camfab.errors",),
