@@ -6,7 +6,12 @@ dwell-compatible laws; random geometry scaled to pass the checks), then times
 --jobs 1 and --jobs 2, each into a fresh folder.  Reports wall time, peak resident memory (the parent and
 its worker processes) and the speed-up.
 
+``--fsync`` instead times the built-in examples' package (every output but STEP, one process) with fsync on
+(``camfab.io.DURABLE``, the default) and off, alternating, and reports what the durability costs
+(docs/decisions.md, "Faults: staging, locks, durability").
+
 Run:  python3 benchmarks/bench_package.py [--n 100] [--no-step | --step-only]
+      python3 benchmarks/bench_package.py --fsync [--repeat 3]
 """
 from __future__ import annotations
 
@@ -61,12 +66,49 @@ def run(src: Path, out: Path, jobs: int, outputs: str) -> tuple[float, float, st
     return wall, peak, f"rc {rc}, {status}, {files} files"
 
 
+#: one package run in a child with ``camfab.io.DURABLE`` set; prints the wall time of the run
+FSYNC_CHILD = """
+import sys, time, io, contextlib
+import camfab.io as cio
+cio.DURABLE = sys.argv[1] == "on"
+from camfab.cli import main
+t = time.perf_counter()
+with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+    rc = main(["package", sys.argv[2], "-o", sys.argv[3], "--outputs", sys.argv[4], "--force"])
+print(rc, time.perf_counter() - t)
+"""
+
+
+def fsync_cost(repeat: int) -> None:
+    from camfab.formats import EXAMPLES_DIR
+
+    outputs = OUTPUTS
+    print(f"package of the built-in examples ({outputs}), one process, fsync on/off alternating, {repeat} rounds")
+    times: dict[str, list[float]] = {"on": [], "off": []}
+    with tempfile.TemporaryDirectory() as tmp:
+        for r in range(repeat):
+            for mode in ("on", "off"):
+                out = Path(tmp) / f"{mode}{r}"
+                p = subprocess.run([sys.executable, "-c", FSYNC_CHILD, mode, str(EXAMPLES_DIR), str(out),
+                                    outputs], capture_output=True, text=True, check=True)
+                times[mode].append(float(p.stdout.split()[-1]))
+        files = sum(1 for p in (Path(tmp) / "on0").rglob("*") if p.is_file())
+    on, off = sorted(times["on"])[repeat // 2], sorted(times["off"])[repeat // 2]
+    print(f"{files} files; median wall: fsync on {on:.2f} s, off {off:.2f} s; durability costs {on - off:+.2f} s "
+          f"({100 * (on - off) / off:+.1f} %)")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=100)
     ap.add_argument("--no-step", action="store_true", help="only the set without STEP")
     ap.add_argument("--step-only", action="store_true", help="only the set with STEP")
+    ap.add_argument("--fsync", action="store_true", help="the cost of fsync on the built-in examples' package")
+    ap.add_argument("--repeat", type=int, default=3, help="rounds of --fsync")
     a = ap.parse_args()
+    if a.fsync:
+        fsync_cost(a.repeat)
+        return
     rng = random.Random(1)
     with tempfile.TemporaryDirectory() as tmp:
         src = Path(tmp) / "designs"
