@@ -44,7 +44,6 @@ from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
 import numpy as np
-from scipy.optimize import brentq
 
 from ..errors import ApiError, Problem
 from ..numeric import extremum
@@ -351,6 +350,8 @@ def follower_limits(mechanism: _Desmodromic, program, *, bore_mm: float | None =
     i = next((j for j in np.flatnonzero(vals > 0) if g(grid[j]) > 0), None)
     if i is None:
         return math.nan, math.nan
+    from scipy.optimize import brentq  # here, not at module level: scipy.optimize is half of camfab's import time
+
     xt = 1e-12 * max(1.0, abs(grid[-1]))
     a = grid[i - 1] if i else lo0
     lo = brentq(g, a, grid[i], xtol=xt) if g(a) < 0 else a

@@ -6,7 +6,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from ..geom2d import TWO_PI, J, cross, dot, rotate, unit
 from .entities import LINE_SWEEP_RAD, MAX_ARC_SWEEP_RAD, arc_from, entity_distance, entity_point
@@ -65,6 +64,8 @@ class Chain:
         u = self.length[owner] * (j + 0.5) / parts[owner]
         mid = entity_point(self.start[owner], self.tangent[owner], self.curvature[owner], u)
         reach = 0.5 * float((self.length / parts).max())
+        from scipy.spatial import cKDTree  # lazy: scipy.spatial costs ~0.3 s of every command's start
+
         tree = cKDTree(mid)
         dist = np.full(q.shape[0], np.inf)
         which = np.zeros(q.shape[0], dtype=int)

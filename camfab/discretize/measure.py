@@ -14,7 +14,6 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from ..errors import GeometryError
 from ..geom2d import ArcChain, dot
@@ -79,6 +78,8 @@ class _CurveProjector:
         self.curve = sur.curve
         self.x = sur.x
         self.n = sur.x.size - 1
+        from scipy.spatial import cKDTree  # lazy: scipy.spatial costs ~0.3 s of every command's start
+
         self.tree = cKDTree(sur.points[:-1] if self.curve.closed else sur.points)
 
     def project(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
