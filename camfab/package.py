@@ -54,6 +54,7 @@ from .io import atomic_write, hold_sigint, inside, leftover_name, output_folder,
 from .pipeline import Cam, Request, run, shop_file_names
 from .results import Verdict
 from .textsafe import bounded, plain
+from .threads import blas_single_threaded
 from .version import __version__
 
 __all__ = ["discover", "folders", "input_key", "package", "exit_status", "MANIFEST", "INDEX"]
@@ -354,11 +355,13 @@ def _stop(pool: ProcessPoolExecutor, workers: list) -> None:
 
 
 def _worker_init(parent: int) -> None:
-    """A worker process ignores Ctrl-C (its parent stops it) and dies with its parent."""
+    """A worker process ignores Ctrl-C (its parent stops it), dies with its parent, and runs BLAS on one thread
+    (the pool already keeps every core busy: more threads per worker only oversubscribe them)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     if hasattr(signal, "pthread_sigmask"):
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
     _die_with_parent(parent)
+    blas_single_threaded()
 
 
 def _die_with_parent(parent: int) -> None:

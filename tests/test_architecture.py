@@ -16,7 +16,7 @@ PACKAGE = ROOT / "camfab"
 #: what each part of the package may import from camfab (module-name prefixes); a module not listed here
 #: fails the test, so a new package must take its place in the layers
 BASE = ("camfab.version", "camfab.errors", "camfab.units", "camfab.tolerances", "camfab.results", "camfab.numeric",
-        "camfab.geom2d", "camfab.textsafe", "camfab.limits")
+        "camfab.geom2d", "camfab.textsafe", "camfab.limits", "camfab.threads")
 LAYERS: dict[str, tuple[str, ...]] = {
     "camfab.version": (),
     "camfab.errors": ("camfab.textsafe",),  # messages quote values through textsafe.excerpt
@@ -25,6 +25,7 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "camfab.limits": ("camfab.errors", "camfab.textsafe"),
     "camfab.io": ("camfab.errors",),
     "camfab.textsafe": (),
+    "camfab.threads": (),
     "camfab.assets": ("camfab.errors",),
     "camfab.results": ("camfab.errors",),
     "camfab.numeric": ("camfab.errors", "camfab.quadrature"),

@@ -39,6 +39,7 @@ import logging
 
 import numpy as np
 
+from ..threads import one_blas_thread
 from ..tolerances import DEFAULT_EXPORT_TOL_MM
 from .arcspline import fit_spline
 from .chain import Chain, merge_cocircular
@@ -139,6 +140,11 @@ def arcs(curve: ParametricCurve, *, tol: float = DEFAULT_EXPORT_TOL_MM) -> ArcDi
     """
     tol = validate_tol(tol)
     check_closed(curve, tol)
+    with one_blas_thread():  # the same arcs whatever the machine's BLAS threads (and no threads for tiny solves)
+        return _arcs(curve, tol)
+
+
+def _arcs(curve: ParametricCurve, tol: float) -> ArcDiscretisation:
     sur = fit_surrogate(curve, tol)
     spline = fit_spline(curve, sur, tol)
     if spline is None:
