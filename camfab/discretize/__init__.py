@@ -11,7 +11,7 @@ Modules, in dependency order: ``tolerance``, ``curve``, ``surrogate``, ``entitie
 ``results``, ``measure``, ``interpolate``, ``spanmodel``, ``spans``, ``arcspline``, ``fit``.
 """
 from .chain import Chain
-from .curve import CurveError, ParametricCurve, curvature_at
+from .curve import CurveError, ParametricCurve, curvature_at, points_at
 from .fit import arcs, polyline
 from .measure import max_deviation, measure_deviation
 from .results import ArcDiscretisation, Deviation, Discretisation
@@ -29,6 +29,7 @@ __all__ = [
     "curvature_at",
     "max_deviation",
     "measure_deviation",
+    "points_at",
     "polyline",
     "validate_tol",
 ]

@@ -3,9 +3,10 @@
 Sign convention: ``distance > 0`` offsets **outward**, along the profile's unit
 outward normal ``n`` (away from the cam material), so a cutter of radius ``Rc``
 milling the periphery runs on ``P(φ) + Rc·n(φ)``.  The exact offset is the
-reference; shapely's ``buffer`` of the profile (round joins, ``quad_segs`` given
-explicitly) is computed beside it to detect split or self-intersecting offsets
-and to cross-check the exact one.
+reference; shapely's ``buffer`` of a coarse polygon of the profile (round joins,
+``quad_segs`` given explicitly) is computed beside it as the topology guard: it
+detects split or self-intersecting offsets (:func:`shapely_guard`).  The comparison
+of the two to the micrometre is a test, not a run-time cost.
 
 Before offsetting, concave stretches whose radius is below the cutter radius
 are refused with their angle ranges and the largest cutter that fits.
@@ -18,24 +19,36 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..discretize import ArcDiscretisation, ParametricCurve, arcs, measure_deviation, polyline, validate_tol
+from ..discretize import (
+    ArcDiscretisation,
+    ParametricCurve,
+    arcs,
+    measure_deviation,
+    points_at,
+    polyline,
+    validate_tol,
+)
 from ..errors import GeometryError
 from ..tolerances import DEFAULT_EXPORT_TOL_MM
 from .corners import corner_note, cornered_curve, profile_corners
 from .outline import translating_outline
 
 __all__ = ["profile_curve", "pitch_curve", "offset_curve", "concave_limit", "ToolCentrePath",
-           "tool_centre_path", "shapely_offset", "roller_envelope_deviation", "QUAD_SEGS", "JOIN_STYLE"]
+           "tool_centre_path", "shapely_offset", "shapely_guard", "guard_samples", "roller_envelope_deviation",
+           "QUAD_SEGS", "JOIN_STYLE", "GUARD_SAMPLES", "GUARD_MIN_MM"]
 
 log = logging.getLogger(__name__)
 
 #: shapely buffer resolution (segments per quarter circle) and join style, always explicit
 QUAD_SEGS = 64
 JOIN_STYLE = "round"
-#: the shapely cross-check buffers a polyline of the profile (GEOS simplifies its input slightly), so
-#: below this tolerance (mm) it checks
-#: at this resolution (the exact offset itself is still fitted to the requested tolerance)
-SHAPELY_CHECK_MIN_MM = 1e-4
+#: the shapely topology guard buffers a polygon of this many samples of the profile (at least 4 per smooth
+#: piece) and measures how far samples of the exact offset lie from the buffer's boundary; the comparison to
+#: the micrometre belongs in the tests (docs/decisions.md, "The shapely guard of a tool path")
+GUARD_SAMPLES = 2048
+#: the guard refuses an offset whose samples lie further than this (mm) from the buffer's boundary, or than
+#: twice the guard's own resolution (chords of the polygon plus the buffer's round joins), if that is larger
+GUARD_MIN_MM = 1e-3
 
 
 def _user(contact, x) -> float:
@@ -186,16 +199,48 @@ def tool_centre_path(contact, tool_radius: float, *, tol: float = DEFAULT_EXPORT
         raise GeometryError(f"tool radius must be > 0 mm, got {tool_radius!r}")
     _refuse_if_too_big(contact, tool_radius, label)
     exact = offset_curve(contact, tool_radius)
+    dev = shapely_guard(profile_curve(contact), exact, tool_radius, label)
     fit = arcs(exact, tol=tol)
-    check_tol = max(tol, SHAPELY_CHECK_MIN_MM)
-    base = polyline(profile_curve(contact), tol=check_tol / 4)
-    buffered = shapely_offset(base.points[:-1], tool_radius)
-    ring = np.asarray(buffered.exterior.coords)
-    dev = float(measure_deviation(ring, exact).max)
-    if dev > check_tol:
-        raise GeometryError(f"{label}the shapely offset differs from the exact offset by {dev:.3g} mm (> "
-                            f"{check_tol:g} mm); the offset is ill-conditioned at this tool radius")
     return ToolCentrePath(exact, fit, tool_radius, dev, tol)
+
+
+def guard_samples(curve: ParametricCurve, n: int = GUARD_SAMPLES) -> tuple[np.ndarray, float]:
+    """``n`` (or a few more) points of a closed curve, spread over its smooth pieces by parameter length, at
+    least 4 per piece, and the largest gap between a chord's midpoint and the curve's point half-way along it
+    (the polygon's resolution, mm)."""
+    bp = np.asarray(curve.breakpoints, dtype=float)
+    span = np.diff(bp)
+    k = np.maximum(4, np.ceil(n * span / curve.period)).astype(int)
+    owner = np.repeat(np.arange(span.size), k)
+    j = np.arange(owner.size) - np.repeat(np.cumsum(k) - k, k)
+    h = span[owner] / k[owner]
+    t = bp[owner] + h * j
+    pts = points_at(curve, t)
+    mid = points_at(curve, t + 0.5 * h)
+    chord_mid = 0.5 * (pts + np.roll(pts, -1, axis=0))
+    return pts, float(np.hypot(*(mid - chord_mid).T).max())
+
+
+def shapely_guard(profile: ParametricCurve, exact: ParametricCurve, tool_radius: float, label: str = "") -> float:
+    """The topology guard of a tool path: shapely's buffer of a polygon of the profile must be one piece with no
+    hole (:func:`shapely_offset`), and every sample of the exact offset must lie on its boundary within the
+    guard's resolution, else the exact offset folds or crosses itself (a neck, a loop) where the buffer does not.
+    Returns the largest distance found (mm)."""
+    import shapely
+
+    base, res = guard_samples(profile)
+    buffered = shapely_offset(base, tool_radius)
+    q, res_q = guard_samples(exact)
+    ring = np.asarray(buffered.exterior.coords)
+    edges = shapely.STRtree(shapely.linestrings(np.stack([ring[:-1], ring[1:]], axis=1)))
+    dev = float(edges.query_nearest(shapely.points(q), return_distance=True, all_matches=False)[1].max())
+    joins = tool_radius * (1.0 - math.cos(math.pi / (4 * QUAD_SEGS)))  # a round join's chord vs its arc
+    allow = max(GUARD_MIN_MM, 2.0 * (res + res_q + joins))
+    if dev > allow:
+        raise GeometryError(f"{label}the exact tool-centre path lies {dev:.3g} mm off shapely's offset of the "
+                            f"profile (> {allow:.3g} mm): the offset folds or crosses itself at this tool radius "
+                            "(a neck narrower than the cutter, or a loop); use a smaller cutter")
+    return dev
 
 
 def roller_envelope_deviation(contact, *, tol: float = DEFAULT_EXPORT_TOL_MM) -> float:

@@ -156,7 +156,7 @@ def test_tool_path_rounds_the_plate_corners():
     spec = _wedge()
     c = geometry_from_spec(spec).profiles[0]
     path = tool_centre_path(c, 5.0, tol=1e-3)
-    assert path.max_deviation <= 1e-3 and path.shapely_deviation <= 1e-3
+    assert path.max_deviation <= 1e-3 and path.shapely_deviation <= 1e-3  # the coarse guard agrees too
     # four corner arcs of radius 5 about the plate corners: the fit carries them as arcs
     fit = path.arcs
     radii = np.hypot(*(fit.starts - fit.centres).T)[fit.sweeps != 0]
