@@ -396,6 +396,7 @@ def _report_out_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("-o", "--out", required=True, metavar="DIR", help="output directory")
     p.add_argument("--standalone", action="store_true",
                    help="embed the plots in the HTML page (one self-contained file; plots/ is written too)")
+    p.add_argument("--png", action="store_true", help="also write every plot as PNG (the page shows the SVG)")
 
 
 def _report_args(p: argparse.ArgumentParser) -> None:
@@ -411,7 +412,8 @@ def cmd_report(args: argparse.Namespace) -> int:
     require_report_dependencies()
     cam = _cam(args.file)
     with output_folder(args.out) as folder:  # created, writable and locked before computing (else exit 3)
-        paths = write_files(render_report(cam.spec, cam.geometry, cam.check(), standalone=args.standalone), folder)
+        paths = write_files(render_report(cam.spec, cam.geometry, cam.check(), standalone=args.standalone,
+                                                  png=args.png), folder)
     print(f"{plain(cam.name)}: {cam.verdict}")
     print(f"wrote {Path(paths[0])} (+{len(paths) - 1} plot files)", file=sys.stderr)
     return _exit(cam.verdict)
@@ -432,7 +434,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
     cams = [_cam(f) for f in args.files]
     with output_folder(args.out) as folder:  # created, writable and locked before computing (else exit 3)
         items = [(c.spec, c.geometry, c.check()) for c in cams]
-        paths = write_files(render_comparison(items, standalone=args.standalone), folder)
+        paths = write_files(render_comparison(items, standalone=args.standalone, png=args.png), folder)
     for c in cams:
         print(f"{plain(c.name)}: {c.verdict}")
     print(f"wrote {paths[0]} (+{len(paths) - 1} plot files)", file=sys.stderr)

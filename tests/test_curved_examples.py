@@ -188,7 +188,7 @@ def test_report_has_the_face_position_plot_and_draws_the_face_as_an_arc(run):
     html = (out / "report.html").read_text()
     assert "curved-face follower" in html and "roller follower" not in html
     assert 'data-plot="face_position"' in html and "Curved-face contact position" in html
-    assert (out / "plots" / "face_position.png").stat().st_size > 10_000
+    assert (out / "plots" / "face_position.svg").stat().st_size > 10_000
     data = json.loads(re.search(r'<script type="application/json" id="anim-data">(.*?)</script>', html, re.S)[1])
     (f,) = data["followers"]
     n = len(data["frames"]["x"])

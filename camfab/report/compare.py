@@ -2,7 +2,7 @@
 side-by-side table of the key numbers (the CAM-DAS "Pizarra").
 
 :func:`render_comparison` returns ``{relative path: bytes}``: ``compare.html`` and
-``plots/{svaj,curvature,pressure_angle}.{png,svg}``.  Each design keeps its own
+``plots/{svaj,curvature,pressure_angle}.svg`` (and ``.png`` with ``png=True``).  Each design keeps its own
 units (mm or degrees of lift; degrees of cam angle or mm of travel).
 """
 from __future__ import annotations
@@ -221,7 +221,7 @@ def comparison_rows(items) -> list[dict[str, Any]]:
     return [r for r in rows if any(c["text"] != "--" for c in r["cells"])]
 
 
-def render_comparison(items, *, standalone: bool = False) -> dict[str, bytes]:
+def render_comparison(items, *, standalone: bool = False, png: bool = False) -> dict[str, bytes]:
     """The files of a comparison page.
 
     Parameters
@@ -230,11 +230,13 @@ def render_comparison(items, *, standalone: bool = False) -> dict[str, bytes]:
         Two or more designs (one is accepted).
     standalone : bool
         Embed the SVG plots in ``compare.html`` as ``data:`` URIs.
+    png : bool
+        Also write each plot as PNG.
 
     Returns
     -------
     dict[str, bytes]
-        ``{"compare.html": ..., "plots/svaj.png": ..., ...}``.
+        ``{"compare.html": ..., "plots/svaj.svg": ..., ...}`` (and ``"plots/svaj.png"``… with ``png``).
     """
     from .html import common_context, plot_files, template_environment
 
@@ -245,7 +247,7 @@ def render_comparison(items, *, standalone: bool = False) -> dict[str, bytes]:
     figs = {"svaj": compare_svaj_figure(items, labels), "curvature": compare_curvature_figure(items, labels)}
     if any(c.kind == "roller" or c.oscillating for _, g, _ in items for c in g.profiles):
         figs["pressure_angle"] = compare_pressure_angle_figure(items, labels)
-    files, plots = plot_files(figs, standalone=standalone)
+    files, plots = plot_files(figs, standalone=standalone, png=png)
     ctx = common_context(None)
     ctx.update({"labels": labels, "rows": comparison_rows(items), "plots": plots,
                 "sources": [s.source and s.source.rsplit("/", 1)[-1] for s, _, _ in items],

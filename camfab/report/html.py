@@ -1,8 +1,8 @@
 """The HTML report of one design: plots, conclusions, follower dynamics, findings, inputs and an animation.
 
 :func:`render_report` returns the files of a report directory as
-``{relative path: bytes}`` — ``report.html`` plus ``plots/<name>.png`` and
-``plots/<name>.svg`` — and writes nothing (see :func:`write_files`).  The page is
+``{relative path: bytes}`` — ``report.html`` plus ``plots/<name>.svg`` (and, when asked,
+``plots/<name>.png``) — and writes nothing (see :func:`write_files`).  The page is
 rendered from the jinja2 templates in the repository's ``templates/report/``
 (shipped in the wheel, found by :mod:`camfab.assets`); it needs no network: the stylesheet and
 the animation script are inlined, the plots are relative ``<img>`` links (or
@@ -137,24 +137,28 @@ def common_context(source: str | None) -> dict[str, Any]:
             "source": Path(source).name if source else None}
 
 
-def plot_files(figures: Mapping[str, Any], *, standalone: bool = False,
+def plot_files(figures: Mapping[str, Any], *, standalone: bool = False, png: bool = False,
                text: Mapping[str, tuple[str, str]] | None = None) -> tuple[dict[str, bytes], list[dict]]:
-    """Render figures to ``plots/<name>.png|svg`` and describe them for the templates (titles and captions
-    from ``text``, default :data:`PLOT_TEXT`)."""
+    """Render figures to ``plots/<name>.svg`` (and ``.png`` with ``png``) and describe them for the templates
+    (titles and captions from ``text``, default :data:`PLOT_TEXT`).  The page shows the SVG; each format is a
+    full render of the figure, so the PNG is made only when asked (docs/decisions.md, "Report plots")."""
     text = PLOT_TEXT if text is None else text
     from .plots import figure_bytes
 
     files: dict[str, bytes] = {}
     plots = []
     for name, fig in figures.items():
-        png, svg = figure_bytes(fig, "png"), figure_bytes(fig, "svg")
-        files[f"plots/{name}.png"], files[f"plots/{name}.svg"] = png, svg
+        svg = figure_bytes(fig, "svg")
+        files[f"plots/{name}.svg"] = svg
+        if png:
+            files[f"plots/{name}.png"] = figure_bytes(fig, "png")
         w, h = (fig.get_size_inches() * 110).round().astype(int)
         title, caption = text.get(name, (name.replace("_", " ").capitalize(), ""))
         src = ("data:image/svg+xml;base64," + base64.b64encode(svg).decode("ascii")) if standalone \
             else f"plots/{name}.svg"
-        plots.append({"name": name, "title": title, "caption": caption, "src": src, "png": f"plots/{name}.png",
-                      "svg": f"plots/{name}.svg", "width": int(w), "height": int(h)})
+        plots.append({"name": name, "title": title, "caption": caption, "src": src,
+                      "png": f"plots/{name}.png" if png else None, "svg": f"plots/{name}.svg",
+                      "width": int(w), "height": int(h)})
     return files, plots
 
 
@@ -337,7 +341,8 @@ def report_context(spec, geometry, report, plots: list[dict], anim: dict) -> dic
     return ctx
 
 
-def render_report(spec, geometry, report, *, standalone: bool = False, frames: int = 360) -> dict[str, bytes]:
+def render_report(spec, geometry, report, *, standalone: bool = False, frames: int = 360,
+                  png: bool = False) -> dict[str, bytes]:
     """The files of a design's HTML report.
 
     Parameters
@@ -352,16 +357,18 @@ def render_report(spec, geometry, report, *, standalone: bool = False, frames: i
         (the ``plots/`` files are returned either way).
     frames : int
         Animation frames per cycle.
+    png : bool
+        Also write each plot as PNG (``plots/<name>.png``, linked under the plot).
 
     Returns
     -------
     dict[str, bytes]
-        ``{"report.html": ..., "plots/svaj.png": ..., "plots/svaj.svg": ..., ...}``.
+        ``{"report.html": ..., "plots/svaj.svg": ..., ...}`` (and ``"plots/svaj.png"``… with ``png``).
     """
     from .animation import animation_data
     from .plots import report_figures
 
-    files, plots = plot_files(report_figures(spec, geometry, report), standalone=standalone,
+    files, plots = plot_files(report_figures(spec, geometry, report), standalone=standalone, png=png,
                               text=plot_text(geometry))
     anim = animation_data(spec, geometry, report, frames=frames)
     html = template_environment().get_template("report.html.j2").render(

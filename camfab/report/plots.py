@@ -45,7 +45,7 @@ _DYNAMICS_SHADES = (((IssueCode.FOLLOWER_JUMP,), _BAD, "follower jumps (N < 0)")
 _N = 1441
 _RC = {"font.size": 9, "axes.titlesize": 10, "axes.labelsize": 9, "legend.fontsize": 8, "axes.grid": True,
        "grid.alpha": 0.35, "grid.linewidth": 0.6, "svg.hashsalt": "camfab", "svg.fonttype": "path",
-       "axes.formatter.useoffset": False, "axes.formatter.use_mathtext": True, "lines.linewidth": 1.4,
+       "axes.formatter.useoffset": False, "axes.formatter.use_mathtext": False, "lines.linewidth": 1.4,
        "figure.dpi": 100, "savefig.dpi": 110}
 
 

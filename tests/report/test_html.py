@@ -3,7 +3,6 @@ the report's, animation frames consistent with the geometry, offline, determinis
 from __future__ import annotations
 
 import html
-import io
 import json
 import math
 import re
@@ -65,17 +64,28 @@ def test_report_templates_are_found():
 
 
 def test_report_files_and_plots_are_valid(e9_files):
-    from PIL import Image
-
     names = ["svaj", "profile", "curvature", "pressure_angle"]
-    assert sorted(e9_files) == sorted(["report.html"] + [f"plots/{n}.{e}" for n in names for e in ("png", "svg")])
+    assert sorted(e9_files) == sorted(["report.html"] + [f"plots/{n}.svg" for n in names])  # PNG only when asked
     for n in names:
-        im = Image.open(io.BytesIO(e9_files[f"plots/{n}.png"]))
-        assert im.format == "PNG" and im.width > 500 and im.height > 300
         assert ET.fromstring(e9_files[f"plots/{n}.svg"]).tag.endswith("svg")
     page = _parse(e9_files["report.html"])
     assert sorted(i["data-plot"] for i in page.imgs) == sorted(names)
     assert all(i["src"] == f"plots/{i['data-plot']}.svg" for i in page.imgs)
+    assert ".png" not in e9_files["report.html"].decode()  # no link to a file that was not written
+
+
+def test_report_png_on_request(e9, tmp_path, capsys):
+    from PIL import Image
+
+    from camfab.cli import main
+
+    assert main(["report", "ejemplo9rt", "-o", str(tmp_path), "--png"]) == 0
+    names = ["svaj", "profile", "curvature", "pressure_angle"]
+    for n in names:
+        im = Image.open(tmp_path / "plots" / f"{n}.png")
+        assert im.format == "PNG" and im.width > 500 and im.height > 300
+    page = (tmp_path / "report.html").read_text()
+    assert all(f'href="plots/{n}.png"' in page for n in names)
 
 
 def test_flat_face_report_has_the_face_plot(valve_files):
