@@ -1,5 +1,7 @@
 """Benchmark: `camfab package` of N generated cams, without and with STEP, on 1 and 2 processes.
 
+Prints, per run, the stage times summed over the cams (from the manifest's ``timings``): where the time goes.
+
 Generates N valid designs (translating and oscillating rollers, flat faces; 4-8 segments of
 dwell-compatible laws; random geometry scaled to pass the checks), then times
 ``camfab package --outputs dxf,stl,gcode,lift_table,xlsx,report,drawing`` (and the same plus step) with
@@ -63,7 +65,16 @@ def run(src: Path, out: Path, jobs: int, outputs: str) -> tuple[float, float, st
     cams = json.loads((out / "manifest.json").read_text())["cams"]
     files = sum(len(c["files"]) for c in cams)
     status = ",".join(f"{k}:{v}" for k, v in sorted(Counter(c["status"] for c in cams).items()))
-    return wall, peak, f"rc {rc}, {status}, {files} files"
+    return wall, peak, f"rc {rc}, {status}, {files} files\n{_stages(cams)}"
+
+
+def _stages(cams: list[dict]) -> str:
+    """Per-stage seconds summed over the cams (the manifest's ``timings``), largest first, with shares."""
+    total: Counter[str] = Counter()
+    for c in cams:
+        total.update(c.get("timings") or {})
+    whole = sum(total.values()) or 1.0
+    return "    stages: " + ", ".join(f"{k} {v:.1f} s ({100 * v / whole:.0f} %)" for k, v in total.most_common())
 
 
 #: one package run in a child with ``camfab.io.DURABLE`` set; prints the wall time of the run
