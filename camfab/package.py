@@ -32,9 +32,9 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
-import html
 import json
 import logging
+import math
 import multiprocessing
 import os
 import shutil
@@ -46,20 +46,26 @@ from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
+import numpy as np
+
 from .assets import read_template, templates_hash
 from .design.spec import DesignSpec
+from .discretize.curve import points_at
 from .errors import ExportError, MissingDependencyError
 from .formats import load_design
 from .io import atomic_write, hold_sigint, inside, leftover_name, output_folder, safe_stem, swap_dir
 from .pipeline import Cam, Request, run, shop_file_names
-from .results import Verdict
-from .textsafe import bounded, plain
+from .results import Severity, Verdict
+from .textsafe import bounded, excerpt, plain
 from .version import __version__
 
-__all__ = ["discover", "folders", "input_key", "package", "exit_status", "MANIFEST", "INDEX"]
+__all__ = ["discover", "folders", "input_key", "package", "exit_status", "cam_summary", "MANIFEST", "INDEX",
+           "DRAWING_SET"]
 
 MANIFEST = "manifest.json"
 INDEX = "index.html"
+#: the package's drawing set: a contents page, then every cam's sheet (:func:`camfab.cad.pdf.write_drawing_set`)
+DRAWING_SET = "drawings.pdf"
 
 log = logging.getLogger(__name__)
 
@@ -84,7 +90,7 @@ def discover(paths: Iterable[str | Path]) -> list[Path]:
 def folders(stems: Sequence[str]) -> list[str]:
     """Unique folder names for designs whose :func:`~camfab.io.safe_stem` are ``stems``, in order: a stem
     taken (case-insensitively) by an earlier one or by :data:`MANIFEST` / :data:`INDEX` gets ``_2``, ``_3``…"""
-    taken = {MANIFEST.casefold(), INDEX.casefold()}
+    taken = {MANIFEST.casefold(), INDEX.casefold(), DRAWING_SET.casefold()}
     out = []
     for stem in stems:
         name, k = stem, 1
@@ -163,6 +169,7 @@ def _build(args: tuple) -> dict:
                      tolerance_mm=res.tol, withheld=res.withheld, timings=res.timings,
                      folder=str(folder.relative_to(out)),
                      files=[_file_entry(folder / n, Path(out), res.deviations.get(n)) for n in sorted(res.files)])
+        entry.update(cam_summary(cam, res.deviations.values()))
     except (ApiError, InternalError) as exc:  # bugs of camfab: recorded as internal failures
         _internal_error(entry, exc)
     except (CamfabError, OSError, ValueError) as exc:
@@ -179,6 +186,77 @@ def _build(args: tuple) -> dict:
     entry.setdefault("name", Path(path).stem)
     entry["seconds"] = time.perf_counter() - t0
     return entry
+
+
+def cam_summary(cam: Cam, deviations: Iterable[float | None] = ()) -> dict:
+    """What the index shows of a built cam, recorded in its manifest entry: ``drawing_number`` (the design's
+    ``[drawing] number``, when it has one), ``figures`` (largest |pressure angle| and its limit, smallest convex
+    radius of curvature, largest radius ``r_max_mm`` and — a disc cam — largest diameter ``d_max_mm`` named
+    apart, speed, achieved deviation), ``reasons`` (the findings behind the verdict, one per code, errors
+    first) and ``outline`` (the profile thumbnail: SVG path data, y up, mm)."""
+    rep = cam.check()
+    pa, cv = rep.pressure_angle, rep.curvature
+    rmax = rep.max_radius_mm if rep.max_radius_mm is not None else cam.geometry.max_radius
+    devs = [d for d in deviations if d is not None]
+    spec = cam.spec
+    if spec.is_translating_cam:
+        speed = {"value": spec.cam.speed_mm_s, "unit": "mm/s", "given": spec.cam.speed_mm_s is not None}
+    else:
+        speed = {"value": spec.cam.omega_rad_s * 30.0 / math.pi, "unit": "rpm", "given": spec.cam.speed_given}
+    figures = {
+        "pressure_angle_max_deg": None if pa is None else max(abs(pa.max), abs(pa.min)),
+        "pressure_angle_limit_deg": None if pa is None else pa.limit,
+        "min_radius_of_curvature_mm": None if cv is None else cv.min_convex,
+        "r_max_mm": rmax, "d_max_mm": None if spec.is_translating_cam or rmax is None else 2.0 * rmax,
+        "speed": speed, "deviation_mm": max(devs) if devs else None,
+    }
+    order = {Severity.ERROR: 0, Severity.WARNING: 1, Severity.INFO: 2}
+    reasons, seen = [], set()
+    for f in sorted(rep.findings, key=lambda f: order.get(f.severity, 3)):
+        if f.code in seen or f.severity == Severity.INFO:
+            continue
+        seen.add(f.code)
+        reasons.append({"code": str(f.code), "severity": str(f.severity), "message": bounded(f.message)})
+    number = getattr(getattr(spec, "drawing", None), "number", None)
+    return {"drawing_number": plain(str(number)) if number else None, "figures": figures, "reasons": reasons[:6],
+            "outline": _outline(cam)}
+
+
+def _outline(cam: Cam, n: int = 241) -> dict | None:
+    """The cam's outline for a thumbnail: each profile sampled at ``n`` points (a translating cam's plate closed
+    down to its bottom edge), the bore as a circle; coordinates in mm, y up, rounded to 1/400 of the size.
+    None when the profile cannot be sampled."""
+    from .offset import profile_curve
+
+    try:
+        loops = []
+        for c in cam.geometry.profiles:
+            curve = profile_curve(c)
+            pts = points_at(curve, np.linspace(0.0, curve.period, n))
+            if not cam.geometry.closed:
+                pts = np.vstack([pts, [[pts[-1, 0], 0.0], [pts[0, 0], 0.0]]])
+            loops.append(pts)
+    except Exception as exc:  # noqa: BLE001 - a thumbnail is never worth a failed build
+        log.info("%s: no outline thumbnail (%s: %s)", cam.name, type(exc).__name__, exc)
+        return None
+    allp = np.vstack(loops)
+    if not np.all(np.isfinite(allp)):
+        return None
+    lo, hi = allp.min(axis=0), allp.max(axis=0)
+    size = float(max(hi - lo)) or 1.0
+    q = size / 400.0
+    digits = max(0, -math.floor(math.log10(q)))
+
+    def num(v: float) -> str:
+        s = f"{round(v / q) * q:.{digits}f}"
+        return "0" if float(s) == 0 else s
+
+    paths = ["M" + "L".join(f"{num(x)},{num(-y)}" for x, y in p) + "Z" for p in loops]
+    bore = cam.spec.manufacturing.bore_mm / 2 if cam.geometry.closed else 0.0
+    pad = 0.04 * size
+    box = [lo[0] - pad, -hi[1] - pad, hi[0] - lo[0] + 2 * pad, hi[1] - lo[1] + 2 * pad]
+    return {"viewbox": " ".join(num(v) for v in box), "paths": paths, "bore_r": float(bore) if bore > 0 else None,
+            "stroke": num(size / 120.0)}
 
 
 def _keep_other_files(folder: Path, staging: Path, out: Path, recorded: frozenset[str], shop: set[str]) -> None:
@@ -278,6 +356,10 @@ def _package(paths: Iterable[str | Path], out: Path, jobs: int, outputs: Sequenc
                 "cams": [entries[str(p)] for p in designs]}
     _remove_stale(out, old, manifest)
     failed: list[OSError] = []
+    try:
+        manifest["drawing_set"] = _drawing_set(out, manifest, _old_set(out), say)
+    except OSError as exc:  # the manifest and the index are still written
+        failed.append(exc)
     for name, text in ((MANIFEST, lambda: json.dumps(manifest, indent=2) + "\n"),
                        (INDEX, lambda: _index_html(manifest))):
         try:  # the index is still written when the manifest cannot be, and the other way round
@@ -287,6 +369,62 @@ def _package(paths: Iterable[str | Path], out: Path, jobs: int, outputs: Sequenc
     if failed:
         raise failed[0]
     return manifest
+
+
+def _old_set(out: Path) -> dict | None:
+    """The ``drawing_set`` record of the previous manifest (None when there is none)."""
+    try:
+        data = json.loads((out / MANIFEST).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    rec = data.get("drawing_set") if isinstance(data, dict) else None
+    return rec if isinstance(rec, dict) else None
+
+
+def _set_entries(out: Path, manifest: dict) -> list:
+    """Every cam of the package as a :class:`~camfab.cad.pdf.SetEntry`: its sheet (the ``*_drawing.dxf`` it
+    has), or why it has none."""
+    from .cad.pdf import SetEntry
+
+    items = []
+    for e in manifest["cams"]:
+        sheets = [f["path"] for f in e.get("files", []) if f["path"].endswith("_drawing.dxf")]
+        if e.get("status") == "error":
+            reason = " ".join((e.get("error") or "error").split())
+        elif "drawing" in e.get("withheld", []):
+            codes = ", ".join(r["code"] for r in e.get("reasons", []) if r.get("severity") == "error")
+            reason = f"withheld: the verdict is unacceptable ({codes})" if codes else "withheld: unacceptable"
+        else:
+            reason = "no drawing asked for ([outputs] drawing)"
+        items.append(SetEntry(str(e.get("name", "")), e.get("verdict"), e.get("drawing_number"),
+                              out / sheets[0] if sheets else None, "" if sheets else reason))
+    return items
+
+
+def _drawing_set(out: Path, manifest: dict, old: dict | None, say: Callable[[str], None]) -> dict | None:
+    """Write :data:`DRAWING_SET` (a contents page, then every cam's sheet) when any cam has a sheet; returns
+    its manifest record, or None (an earlier set is then removed).  Not rendered again when nothing it shows
+    changed (its key: every cam's name, verdict, drawing number, reason and sheet hash) and the file is
+    still the one recorded."""
+    from .cad.pdf import write_drawing_set
+
+    path = out / DRAWING_SET
+    items = _set_entries(out, manifest)
+    if not any(i.sheet is not None for i in items):
+        if old is not None and path.is_file():
+            path.unlink()
+        return None
+    sha = {f["path"]: f["sha256"] for e in manifest["cams"] for f in e.get("files", [])}
+    key = _sha(json.dumps([__version__, [[i.name, i.verdict, i.number, i.reason,
+                                          sha.get(i.sheet.relative_to(out).as_posix()) if i.sheet else None]
+                                         for i in items]]).encode())
+    if old and old.get("key") == key and path.is_file() and _sha(path.read_bytes()) == old.get("sha256"):
+        say(f"[up to date] {DRAWING_SET}")
+        return old
+    say(f"{DRAWING_SET}: contents and {sum(i.sheet is not None for i in items)} sheet(s)")
+    pages = write_drawing_set(path, items)
+    data = path.read_bytes()
+    return {"path": DRAWING_SET, "key": key, "pages": pages, "sha256": _sha(data), "bytes": len(data)}
 
 
 def _recorded(entry: dict) -> list[str]:
@@ -405,20 +543,81 @@ def exit_status(manifest: dict) -> int:
 
 
 _ERROR_LABEL = {"io": "I/O error", "dependency": "missing dependency", "internal": "internal error"}
+_VERDICTS = (("acceptable", "acceptable"), ("not_for_high_speed", "not for high speed"),
+             ("unacceptable", "unacceptable"), ("error", "failed"))
+#: file groups of the index, in order: (label, test on the file's path relative to the cam folder)
+_KINDS: tuple[tuple[str, Callable[[str], bool]], ...] = (
+    ("drawings", lambda n: n.endswith(("_drawing.pdf", "_drawing.dxf"))),
+    ("CAD", lambda n: n.endswith((".dxf", ".step", ".stl"))),
+    ("G-code", lambda n: n.endswith(".nc")),
+    ("report", lambda n: n in ("report.html", "check.json")),
+    ("plots", lambda n: n.startswith("plots/")),
+    ("tables", lambda n: n.endswith((".xlsx", ".csv"))),
+)
+_GROUP_MAX = 6  # links shown per group (the rest counted)
+
+
+def _num(v: float | None, digits: int = 2) -> str:
+    return "–" if v is None else f"{v:.{digits}f}"
+
+
+def _cells(e: dict) -> list[dict]:
+    """The key-figure cells of a built cam: text, sort value, and whether it breaks its limit."""
+    f = e.get("figures") or {}
+    pa, lim = f.get("pressure_angle_max_deg"), f.get("pressure_angle_limit_deg")
+    sp = f.get("speed") or {}
+    star = "" if sp.get("given") else "*"
+    speed = None if sp.get("value") is None else f"{sp['value']:.4g} {sp.get('unit', '')}{star}"
+    dev, tol = f.get("deviation_mm"), e.get("tolerance_mm")
+    return [
+        {"text": _num(pa, 1) + ("" if lim is None else f" ({lim:g})"), "sort": "" if pa is None else pa,
+         "over": pa is not None and lim is not None and pa > lim},
+        {"text": _num(f.get("min_radius_of_curvature_mm")), "sort": f.get("min_radius_of_curvature_mm") or ""},
+        {"text": _num(f.get("r_max_mm"), 3), "sort": f.get("r_max_mm") or ""},
+        {"text": _num(f.get("d_max_mm"), 3), "sort": f.get("d_max_mm") or ""},
+        {"text": speed or "–", "sort": "" if sp.get("value") is None else sp["value"]},
+        {"text": "–" if dev is None else f"{dev:.2g}", "sort": "" if dev is None else dev,
+         "title": None if tol is None else f"tolerance {tol:g} mm", "over": dev is not None and tol is not None
+         and dev > tol},
+    ]
+
+
+def _groups(e: dict) -> list[dict]:
+    """A cam's files grouped by kind (:data:`_KINDS`): at most :data:`_GROUP_MAX` links each."""
+    folder = e.get("folder") or ""
+    groups: dict[str, list[dict]] = {}
+    for f in e.get("files", []):
+        rel = Path(f["path"]).relative_to(folder).as_posix() if folder else f["path"]
+        kind = next((k for k, test in _KINDS if test(rel)), "other")
+        name = Path(rel).name  # shown without the cam's stem: "drawing.pdf", "dxf", "cam1.step", "lift.csv"
+        label = name[len(folder):].lstrip("_.") if folder and name.startswith(folder) else name
+        groups.setdefault(kind, []).append({"path": Path(f["path"]).as_posix(), "label": label or name})
+    order = [k for k, _ in _KINDS] + ["other"]
+    return [{"kind": k, "files": groups[k][:_GROUP_MAX], "more": max(0, len(groups[k]) - _GROUP_MAX)}
+            for k in order if k in groups]
 
 
 def _index_html(manifest: dict) -> str:
+    """The package's ``index.html`` (``templates/package/index.html.j2``, autoescaped): counts by verdict, the
+    drawing set, one row per cam with its outline, key figures, reasons and files grouped by kind."""
     from jinja2 import Environment, select_autoescape
 
     env = Environment(autoescape=select_autoescape(default=True))
     tpl = env.from_string(read_template("package", "index.html.j2"))
+    rank = {k: i for i, (k, _) in enumerate(_VERDICTS)}
+    counts = dict.fromkeys(rank, 0)
     rows = []
     for e in manifest["cams"]:
-        files = {Path(f["path"]).name: f["path"] for f in e.get("files", [])}
+        verdict = e.get("verdict") if e.get("status") != "error" else "error"
+        counts[verdict if verdict in counts else "error"] += 1
+        reasons = [{"code": r.get("code"), "message": r.get("message", ""),
+                    "short": excerpt(str(r.get("message", "")).split("\n", 1)[0], 140)}
+                   for r in e.get("reasons") or []]
         rows.append({"name": e.get("name"), "source": e.get("source"), "status": e.get("status"),
                      "error_label": _ERROR_LABEL.get(e.get("error_kind", ""), "error"),
-                     "verdict": e.get("verdict"), "error": e.get("error"),
-                     "report": files.get("report.html"), "files": sorted(files.values()),
+                     "verdict": e.get("verdict"), "verdict_rank": rank.get(str(verdict), 9), "error": e.get("error"),
+                     "drawing_number": e.get("drawing_number"), "reasons": reasons,
+                     "cells": _cells(e), "groups": _groups(e), "outline": e.get("outline"),
                      "withheld": e.get("withheld", [])})
-    return tpl.render(rows=rows, version=manifest["camfab_version"], escape=html.escape)
-
+    return tpl.render(rows=rows, version=manifest["camfab_version"], counts=counts, verdicts=_VERDICTS,
+                      drawing_set=manifest.get("drawing_set"))
