@@ -390,7 +390,8 @@ def _set_entries(out: Path, manifest: dict) -> list:
     for e in manifest["cams"]:
         sheets = [f["path"] for f in e.get("files", []) if f["path"].endswith("_drawing.dxf")]
         if e.get("status") == "error":
-            reason = " ".join((e.get("error") or "error").split())
+            error, source = e.get("error") or "error", str(e.get("source", ""))
+            reason = " ".join(error.removeprefix(f"{source}: ").split())  # the contents names the cam already
         elif "drawing" in e.get("withheld", []):
             codes = ", ".join(r["code"] for r in e.get("reasons", []) if r.get("severity") == "error")
             reason = f"withheld: the verdict is unacceptable ({codes})" if codes else "withheld: unacceptable"
@@ -573,8 +574,8 @@ def _cells(e: dict) -> list[dict]:
         {"text": _num(pa, 1) + ("" if lim is None else f" ({lim:g})"), "sort": "" if pa is None else pa,
          "over": pa is not None and lim is not None and pa > lim},
         {"text": _num(f.get("min_radius_of_curvature_mm")), "sort": f.get("min_radius_of_curvature_mm") or ""},
-        {"text": _num(f.get("r_max_mm"), 3), "sort": f.get("r_max_mm") or ""},
-        {"text": _num(f.get("d_max_mm"), 3), "sort": f.get("d_max_mm") or ""},
+        {"text": _num(f.get("r_max_mm")), "sort": f.get("r_max_mm") or ""},
+        {"text": _num(f.get("d_max_mm")), "sort": f.get("d_max_mm") or ""},
         {"text": speed or "–", "sort": "" if sp.get("value") is None else sp["value"]},
         {"text": "–" if dev is None else f"{dev:.2g}", "sort": "" if dev is None else dev,
          "title": None if tol is None else f"tolerance {tol:g} mm", "over": dev is not None and tol is not None

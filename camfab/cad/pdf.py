@@ -285,7 +285,7 @@ def _contents_pages(entries: Sequence[SetEntry], pages: Sequence[int | None], n_
         for i in range(k * _CONTENTS_ROWS, min(len(entries), (k + 1) * _CONTENTS_ROWS)):
             e, page = entries[i], pages[i]
             put(cols[0], y, f"{i + 1}.")
-            put(cols[1], y, excerpt(plain(e.name), 38))
+            put(cols[1], y, excerpt(plain(e.name), 34))
             put(cols[2], y, excerpt(plain(e.number or "—"), 24))
             put(cols[3], y, (e.verdict or "error").replace("_", " "))
             put(cols[4], y, str(page) if page is not None else "—", ha="right")
