@@ -3,8 +3,11 @@
 ``package(paths, out)`` finds the designs (``*.toml`` and ``*.xlsx`` files, folders
 searched recursively), runs each design through :mod:`camfab.pipeline` in its own
 folder ``out/<name>/`` on a process pool, and writes ``out/manifest.json`` (each
-file's sha256 and size, measured deviation, tolerance, verdict, stage timings)
-and ``out/index.html``.
+file's sha256 and size, measured deviation, tolerance, verdict, key figures and the reasons for the verdict
+(:func:`camfab.report.overview.cam_summary`), stage timings), ``out/index.html``
+(:func:`camfab.report.overview.index_html`) and, when any cam has a PDF sheet, ``out/drawings.pdf``: a contents
+page, then every cam's sheet (:func:`camfab.cad.pdf.write_drawing_set`; docs/decisions.md, "The package index and
+the drawing set").
 
 Folders: each design's folder is :func:`~camfab.io.safe_stem` of its name (of its file's stem when it cannot
 be read), made unique in the order the designs are found (:func:`folders`): a stem already taken — by an
@@ -34,7 +37,6 @@ import contextlib
 import hashlib
 import json
 import logging
-import math
 import multiprocessing
 import os
 import shutil
@@ -44,23 +46,21 @@ import threading
 import time
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import ProcessPoolExecutor
+from dataclasses import replace
 from pathlib import Path
 
-import numpy as np
-
-from .assets import read_template, templates_hash
+from .assets import templates_hash
 from .design.spec import DesignSpec
-from .discretize.curve import points_at
 from .errors import ExportError, MissingDependencyError
 from .formats import load_design
 from .io import atomic_write, hold_sigint, inside, leftover_name, output_folder, safe_stem, swap_dir
-from .pipeline import Cam, Request, run, shop_file_names
-from .results import Severity, Verdict
-from .textsafe import bounded, excerpt, plain
+from .pipeline import Cam, Output, Request, run, shop_file_names
+from .report.overview import cam_summary, index_html
+from .results import Verdict
+from .textsafe import bounded, plain
 from .version import __version__
 
-__all__ = ["discover", "folders", "input_key", "package", "exit_status", "cam_summary", "MANIFEST", "INDEX",
-           "DRAWING_SET"]
+__all__ = ["discover", "folders", "input_key", "package", "exit_status", "MANIFEST", "INDEX", "DRAWING_SET"]
 
 MANIFEST = "manifest.json"
 INDEX = "index.html"
@@ -161,6 +161,8 @@ def _build(args: tuple) -> dict:
         outputs = options.get("outputs")
         req = Request.from_design(spec, outputs, force=options.get("force") or None,
                                   post="linuxcnc" if outputs is not None else None)
+        if Output.PDF in req.outputs:  # the drawing set's page is rendered from the sheet: keep it beside the PDF
+            req = replace(req, outputs=req.outputs | {Output.DRAWING})
         cam = Cam(spec)
         res = run(cam, staging, req, lock=False)
         _keep_other_files(folder, staging, Path(out), recorded, shop_file_names(cam))
@@ -169,7 +171,7 @@ def _build(args: tuple) -> dict:
                      tolerance_mm=res.tol, withheld=res.withheld, timings=res.timings,
                      folder=str(folder.relative_to(out)),
                      files=[_file_entry(folder / n, Path(out), res.deviations.get(n)) for n in sorted(res.files)])
-        entry.update(cam_summary(cam, res.deviations.values()))
+        entry.update(cam_summary(spec, cam.geometry, cam.check(), res.deviations.values()))
     except (ApiError, InternalError) as exc:  # bugs of camfab: recorded as internal failures
         _internal_error(entry, exc)
     except (CamfabError, OSError, ValueError) as exc:
@@ -186,77 +188,6 @@ def _build(args: tuple) -> dict:
     entry.setdefault("name", Path(path).stem)
     entry["seconds"] = time.perf_counter() - t0
     return entry
-
-
-def cam_summary(cam: Cam, deviations: Iterable[float | None] = ()) -> dict:
-    """What the index shows of a built cam, recorded in its manifest entry: ``drawing_number`` (the design's
-    ``[drawing] number``, when it has one), ``figures`` (largest |pressure angle| and its limit, smallest convex
-    radius of curvature, largest radius ``r_max_mm`` and — a disc cam — largest diameter ``d_max_mm`` named
-    apart, speed, achieved deviation), ``reasons`` (the findings behind the verdict, one per code, errors
-    first) and ``outline`` (the profile thumbnail: SVG path data, y up, mm)."""
-    rep = cam.check()
-    pa, cv = rep.pressure_angle, rep.curvature
-    rmax = rep.max_radius_mm if rep.max_radius_mm is not None else cam.geometry.max_radius
-    devs = [d for d in deviations if d is not None]
-    spec = cam.spec
-    if spec.is_translating_cam:
-        speed = {"value": spec.cam.speed_mm_s, "unit": "mm/s", "given": spec.cam.speed_mm_s is not None}
-    else:
-        speed = {"value": spec.cam.omega_rad_s * 30.0 / math.pi, "unit": "rpm", "given": spec.cam.speed_given}
-    figures = {
-        "pressure_angle_max_deg": None if pa is None else max(abs(pa.max), abs(pa.min)),
-        "pressure_angle_limit_deg": None if pa is None else pa.limit,
-        "min_radius_of_curvature_mm": None if cv is None else cv.min_convex,
-        "r_max_mm": rmax, "d_max_mm": None if spec.is_translating_cam or rmax is None else 2.0 * rmax,
-        "speed": speed, "deviation_mm": max(devs) if devs else None,
-    }
-    order = {Severity.ERROR: 0, Severity.WARNING: 1, Severity.INFO: 2}
-    reasons, seen = [], set()
-    for f in sorted(rep.findings, key=lambda f: order.get(f.severity, 3)):
-        if f.code in seen or f.severity == Severity.INFO:
-            continue
-        seen.add(f.code)
-        reasons.append({"code": str(f.code), "severity": str(f.severity), "message": bounded(f.message)})
-    number = getattr(getattr(spec, "drawing", None), "number", None)
-    return {"drawing_number": plain(str(number)) if number else None, "figures": figures, "reasons": reasons[:6],
-            "outline": _outline(cam)}
-
-
-def _outline(cam: Cam, n: int = 241) -> dict | None:
-    """The cam's outline for a thumbnail: each profile sampled at ``n`` points (a translating cam's plate closed
-    down to its bottom edge), the bore as a circle; coordinates in mm, y up, rounded to 1/400 of the size.
-    None when the profile cannot be sampled."""
-    from .offset import profile_curve
-
-    try:
-        loops = []
-        for c in cam.geometry.profiles:
-            curve = profile_curve(c)
-            pts = points_at(curve, np.linspace(0.0, curve.period, n))
-            if not cam.geometry.closed:
-                pts = np.vstack([pts, [[pts[-1, 0], 0.0], [pts[0, 0], 0.0]]])
-            loops.append(pts)
-    except Exception as exc:  # noqa: BLE001 - a thumbnail is never worth a failed build
-        log.info("%s: no outline thumbnail (%s: %s)", cam.name, type(exc).__name__, exc)
-        return None
-    allp = np.vstack(loops)
-    if not np.all(np.isfinite(allp)):
-        return None
-    lo, hi = allp.min(axis=0), allp.max(axis=0)
-    size = float(max(hi - lo)) or 1.0
-    q = size / 400.0
-    digits = max(0, -math.floor(math.log10(q)))
-
-    def num(v: float) -> str:
-        s = f"{round(v / q) * q:.{digits}f}"
-        return "0" if float(s) == 0 else s
-
-    paths = ["M" + "L".join(f"{num(x)},{num(-y)}" for x, y in p) + "Z" for p in loops]
-    bore = cam.spec.manufacturing.bore_mm / 2 if cam.geometry.closed else 0.0
-    pad = 0.04 * size
-    box = [lo[0] - pad, -hi[1] - pad, hi[0] - lo[0] + 2 * pad, hi[1] - lo[1] + 2 * pad]
-    return {"viewbox": " ".join(num(v) for v in box), "paths": paths, "bore_r": float(bore) if bore > 0 else None,
-            "stroke": num(size / 120.0)}
 
 
 def _keep_other_files(folder: Path, staging: Path, out: Path, recorded: frozenset[str], shop: set[str]) -> None:
@@ -361,7 +292,7 @@ def _package(paths: Iterable[str | Path], out: Path, jobs: int, outputs: Sequenc
     except OSError as exc:  # the manifest and the index are still written
         failed.append(exc)
     for name, text in ((MANIFEST, lambda: json.dumps(manifest, indent=2) + "\n"),
-                       (INDEX, lambda: _index_html(manifest))):
+                       (INDEX, lambda: index_html(manifest))):
         try:  # the index is still written when the manifest cannot be, and the other way round
             atomic_write(out / name, text())
         except OSError as exc:
@@ -382,13 +313,14 @@ def _old_set(out: Path) -> dict | None:
 
 
 def _set_entries(out: Path, manifest: dict) -> list:
-    """Every cam of the package as a :class:`~camfab.cad.pdf.SetEntry`: its sheet (the ``*_drawing.dxf`` it
-    has), or why it has none."""
+    """Every cam of the package as a :class:`~camfab.cad.pdf.SetEntry`: its sheet (the ``*_drawing.dxf`` of a
+    cam that has its ``*_drawing.pdf``), or why it has none."""
     from .cad.pdf import SetEntry
 
     items = []
     for e in manifest["cams"]:
-        sheets = [f["path"] for f in e.get("files", []) if f["path"].endswith("_drawing.dxf")]
+        paths = [f["path"] for f in e.get("files", [])]
+        sheets = [p for p in paths if p.endswith("_drawing.dxf") and p.removesuffix(".dxf") + ".pdf" in paths]
         if e.get("status") == "error":
             error, source = e.get("error") or "error", str(e.get("source", ""))
             reason = " ".join(error.removeprefix(f"{source}: ").split())  # the contents names the cam already
@@ -396,14 +328,14 @@ def _set_entries(out: Path, manifest: dict) -> list:
             codes = ", ".join(r["code"] for r in e.get("reasons", []) if r.get("severity") == "error")
             reason = f"withheld: the verdict is unacceptable ({codes})" if codes else "withheld: unacceptable"
         else:
-            reason = "no drawing asked for ([outputs] drawing)"
+            reason = "no PDF drawing asked for ([outputs] pdf)"
         items.append(SetEntry(str(e.get("name", "")), e.get("verdict"), e.get("drawing_number"),
                               out / sheets[0] if sheets else None, "" if sheets else reason))
     return items
 
 
 def _drawing_set(out: Path, manifest: dict, old: dict | None, say: Callable[[str], None]) -> dict | None:
-    """Write :data:`DRAWING_SET` (a contents page, then every cam's sheet) when any cam has a sheet; returns
+    """Write :data:`DRAWING_SET` (a contents page, then every cam's sheet) when any cam has a PDF sheet; returns
     its manifest record, or None (an earlier set is then removed).  Not rendered again when nothing it shows
     changed (its key: every cam's name, verdict, drawing number, reason and sheet hash) and the file is
     still the one recorded."""
@@ -541,84 +473,3 @@ def exit_status(manifest: dict) -> int:
     if any(e.get("status") == "error" and e.get("error_kind") in ("io", "dependency") for e in manifest["cams"]):
         return 3
     return 2 if "error" in st else 1 if "unacceptable" in st else 0
-
-
-_ERROR_LABEL = {"io": "I/O error", "dependency": "missing dependency", "internal": "internal error"}
-_VERDICTS = (("acceptable", "acceptable"), ("not_for_high_speed", "not for high speed"),
-             ("unacceptable", "unacceptable"), ("error", "failed"))
-#: file groups of the index, in order: (label, test on the file's path relative to the cam folder)
-_KINDS: tuple[tuple[str, Callable[[str], bool]], ...] = (
-    ("drawings", lambda n: n.endswith(("_drawing.pdf", "_drawing.dxf"))),
-    ("CAD", lambda n: n.endswith((".dxf", ".step", ".stl"))),
-    ("G-code", lambda n: n.endswith(".nc")),
-    ("report", lambda n: n in ("report.html", "check.json")),
-    ("plots", lambda n: n.startswith("plots/")),
-    ("tables", lambda n: n.endswith((".xlsx", ".csv"))),
-)
-_GROUP_MAX = 6  # links shown per group (the rest counted)
-
-
-def _num(v: float | None, digits: int = 2) -> str:
-    return "–" if v is None else f"{v:.{digits}f}"
-
-
-def _cells(e: dict) -> list[dict]:
-    """The key-figure cells of a built cam: text, sort value, and whether it breaks its limit."""
-    f = e.get("figures") or {}
-    pa, lim = f.get("pressure_angle_max_deg"), f.get("pressure_angle_limit_deg")
-    sp = f.get("speed") or {}
-    star = "" if sp.get("given") else "*"
-    speed = None if sp.get("value") is None else f"{sp['value']:.4g} {sp.get('unit', '')}{star}"
-    dev, tol = f.get("deviation_mm"), e.get("tolerance_mm")
-    return [
-        {"text": _num(pa, 1) + ("" if lim is None else f" ({lim:g})"), "sort": "" if pa is None else pa,
-         "over": pa is not None and lim is not None and pa > lim},
-        {"text": _num(f.get("min_radius_of_curvature_mm")), "sort": f.get("min_radius_of_curvature_mm") or ""},
-        {"text": _num(f.get("r_max_mm")), "sort": f.get("r_max_mm") or ""},
-        {"text": _num(f.get("d_max_mm")), "sort": f.get("d_max_mm") or ""},
-        {"text": speed or "–", "sort": "" if sp.get("value") is None else sp["value"]},
-        {"text": "–" if dev is None else f"{dev:.2g}", "sort": "" if dev is None else dev,
-         "title": None if tol is None else f"tolerance {tol:g} mm", "over": dev is not None and tol is not None
-         and dev > tol},
-    ]
-
-
-def _groups(e: dict) -> list[dict]:
-    """A cam's files grouped by kind (:data:`_KINDS`): at most :data:`_GROUP_MAX` links each."""
-    folder = e.get("folder") or ""
-    groups: dict[str, list[dict]] = {}
-    for f in e.get("files", []):
-        rel = Path(f["path"]).relative_to(folder).as_posix() if folder else f["path"]
-        kind = next((k for k, test in _KINDS if test(rel)), "other")
-        name = Path(rel).name  # shown without the cam's stem: "drawing.pdf", "dxf", "cam1.step", "lift.csv"
-        label = name[len(folder):].lstrip("_.") if folder and name.startswith(folder) else name
-        groups.setdefault(kind, []).append({"path": Path(f["path"]).as_posix(), "label": label or name})
-    order = [k for k, _ in _KINDS] + ["other"]
-    return [{"kind": k, "files": groups[k][:_GROUP_MAX], "more": max(0, len(groups[k]) - _GROUP_MAX)}
-            for k in order if k in groups]
-
-
-def _index_html(manifest: dict) -> str:
-    """The package's ``index.html`` (``templates/package/index.html.j2``, autoescaped): counts by verdict, the
-    drawing set, one row per cam with its outline, key figures, reasons and files grouped by kind."""
-    from jinja2 import Environment, select_autoescape
-
-    env = Environment(autoescape=select_autoescape(default=True))
-    tpl = env.from_string(read_template("package", "index.html.j2"))
-    rank = {k: i for i, (k, _) in enumerate(_VERDICTS)}
-    counts = dict.fromkeys(rank, 0)
-    rows = []
-    for e in manifest["cams"]:
-        verdict = e.get("verdict") if e.get("status") != "error" else "error"
-        counts[verdict if verdict in counts else "error"] += 1
-        reasons = [{"code": r.get("code"), "message": r.get("message", ""),
-                    "short": excerpt(str(r.get("message", "")).split("\n", 1)[0], 140)}
-                   for r in e.get("reasons") or []]
-        rows.append({"name": e.get("name"), "source": e.get("source"), "status": e.get("status"),
-                     "error_label": _ERROR_LABEL.get(e.get("error_kind", ""), "error"),
-                     "verdict": e.get("verdict"), "verdict_rank": rank.get(str(verdict), 9), "error": e.get("error"),
-                     "drawing_number": e.get("drawing_number"), "reasons": reasons,
-                     "cells": _cells(e), "groups": _groups(e), "outline": e.get("outline"),
-                     "withheld": e.get("withheld", [])})
-    return tpl.render(rows=rows, version=manifest["camfab_version"], counts=counts, verdicts=_VERDICTS,
-                      drawing_set=manifest.get("drawing_set"))

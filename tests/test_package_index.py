@@ -151,3 +151,32 @@ def test_index_overview(browser, pkg):
     assert sorted(up[:-1]) == sorted(c["figures"]["r_max_mm"] for c in m["cams"] if c.get("figures"))
     assert not errors
     page.close()
+
+
+def test_disk_full_on_the_drawing_set_keeps_the_old_one(pkg, tmp_path, monkeypatch, capsys):
+    """The set is streamed into a temporary file: a full disk leaves the old set whole, no temporary file, and
+    the manifest and index still written (exit 3, naming the set)."""
+    import errno
+
+    import camfab.io as cio
+
+    out, m = pkg
+    copy = tmp_path / "out"
+    shutil.copytree(out, copy)
+    old = (copy / "drawings.pdf").read_bytes()
+    (copy / "manifest.json").write_text(json.dumps({**m, "drawing_set": None}))  # the set must be written again
+    (copy / "index.html").unlink()
+    real = cio.write_bytes
+
+    def write_bytes(fh, raw, path):
+        if path.name == "drawings.pdf":
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        real(fh, raw, path)
+
+    monkeypatch.setattr(cio, "write_bytes", write_bytes)
+    assert main(["package", str(Path(m["cams"][0]["source"]).parent), "-o", str(copy), "--outputs",
+                 "drawing,pdf"]) == 3
+    assert str(copy / "drawings.pdf") in capsys.readouterr().err
+    assert (copy / "drawings.pdf").read_bytes() == old
+    assert (copy / "index.html").is_file() and (copy / "manifest.json").is_file()
+    assert not [p for p in copy.rglob("*") if ".camfab-" in p.name]
