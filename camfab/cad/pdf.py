@@ -33,12 +33,13 @@ from ..io import atomic_stream
 from ..textsafe import excerpt, plain
 
 __all__ = ["sheet_pdf", "sheet_figure", "paper_size", "read_sheet", "SetEntry", "write_drawing_set",
-           "contents_layout", "PT_PER_MM"]
+           "contents_layout", "PT_PER_MM", "CONTENTS_ROWS"]
 
 PT_PER_MM = 72.0 / 25.4
 #: the contents page: A4 portrait (mm)
 CONTENTS_PAPER = (210.0, 297.0)
-_CONTENTS_ROWS = 40  # rows per contents page
+#: cams per contents page (a row of 9 mm: the line, and the reason of a cam without a sheet under it)
+CONTENTS_ROWS = 25
 
 
 def _require() -> None:
@@ -246,7 +247,7 @@ class SetEntry:
 
 def contents_layout(entries: Sequence[SetEntry]) -> tuple[int, list[int | None]]:
     """The number of contents pages and each entry's page in the set (None: no sheet)."""
-    n_contents = max(1, math.ceil(len(entries) / _CONTENTS_ROWS))
+    n_contents = max(1, math.ceil(len(entries) / CONTENTS_ROWS))
     pages: list[int | None] = []
     nxt = n_contents + 1
     for e in entries:
@@ -282,7 +283,7 @@ def _contents_pages(entries: Sequence[SetEntry], pages: Sequence[int | None], n_
         put(cols[4], y, "Page", 9.0, weight="bold", ha="right")
         ax.plot([cols[0], cols[4]], [y - 2.0, y - 2.0], color="black", linewidth=0.5)
         y -= 7.0
-        for i in range(k * _CONTENTS_ROWS, min(len(entries), (k + 1) * _CONTENTS_ROWS)):
+        for i in range(k * CONTENTS_ROWS, min(len(entries), (k + 1) * CONTENTS_ROWS)):
             e, page = entries[i], pages[i]
             put(cols[0], y, f"{i + 1}.")
             put(cols[1], y, excerpt(plain(e.name), 34))
@@ -290,8 +291,8 @@ def _contents_pages(entries: Sequence[SetEntry], pages: Sequence[int | None], n_
             put(cols[3], y, (e.verdict or "error").replace("_", " "))
             put(cols[4], y, str(page) if page is not None else "—", ha="right")
             if page is None and e.reason:
-                put(cols[1], y - 3.2, "no sheet: " + excerpt(plain(e.reason), 110), 6.5, color="#444444")
-            y -= 5.8
+                put(cols[1], y - 3.8, "no sheet: " + excerpt(plain(e.reason), 110), 6.5, color="#444444")
+            y -= 9.0
         yield fig
 
 

@@ -14,7 +14,7 @@ import pytest
 
 from camfab.cad.drawing import drawing_sheet
 from camfab.cad.export import cam_shapes
-from camfab.cad.pdf import PT_PER_MM, SetEntry, contents_layout, sheet_pdf
+from camfab.cad.pdf import CONTENTS_ROWS, PT_PER_MM, SetEntry, contents_layout, sheet_pdf, write_drawing_set
 from camfab.design.assemble import check_design, geometry_from_spec
 from camfab.design.spec import design_from_dict
 from camfab.errors import SpecError
@@ -132,10 +132,30 @@ def test_contents_pages_number_the_sheets():
     entries = [SetEntry(f"c{i}", "acceptable", sheet=Path(f"{i}.dxf") if i % 3 else None, reason="x")
                for i in range(100)]
     n, pages = contents_layout(entries)
-    assert n == 3  # 40 rows a page
+    assert n == -(-100 // CONTENTS_ROWS) >= 2
     with_sheets = [p for p in pages if p is not None]
     assert with_sheets == list(range(n + 1, n + 1 + len(with_sheets)))
     assert [p is None for p in pages] == [i % 3 == 0 for i in range(100)]
+
+
+@needs_poppler
+def test_drawing_set_with_two_contents_pages(e9, tmp_path):
+    text, _, _ = e9
+    dxf = tmp_path / "s.dxf"
+    dxf.write_text(text)
+    n = CONTENTS_ROWS + 5
+    entries = [SetEntry(f"cam{i:02d}", "acceptable", f"D-{i}", dxf if i == n - 2 else None, f"reason {i}")
+               for i in range(n)]
+    out = tmp_path / "set.pdf"
+    assert write_drawing_set(out, entries) == 3
+    assert _info(out)["Pages"].strip() == "3"
+    assert _page_mm(out) == pytest.approx((210.0, 297.0), abs=0.01)  # contents: A4 portrait
+    second = _text(out, "-layout", "-f", "2", "-l", "2")
+    assert f"cam{CONTENTS_ROWS:02d}" in second and f"cam{CONTENTS_ROWS - 1:02d}" not in second
+    line = next(ln for ln in second.splitlines() if f"cam{n - 2:02d}" in ln)
+    assert line.split()[-1] == "3" and f"D-{n - 2}" in line
+    assert "reason 0" in _text(out, "-f", "1", "-l", "1")
+    assert "Ejemplo9RT" in _text(out, "-f", "3", "-l", "3")
 
 
 # ---------------------------------------------------------------------------
