@@ -36,7 +36,8 @@ def cam_summary(spec, geometry, report, deviations: Iterable[float | None] = ())
     if spec.is_translating_cam:
         speed = {"value": spec.cam.speed_mm_s, "unit": "mm/s", "given": spec.cam.speed_mm_s is not None}
     else:
-        speed = {"value": spec.cam.omega_rad_s * 30.0 / math.pi, "unit": "rpm", "given": spec.cam.speed_given}
+        rpm = float(f"{spec.cam.omega_rad_s * 30.0 / math.pi:.10g}")  # 60 rpm, not 59.99999999999999
+        speed = {"value": rpm, "unit": "rpm", "given": spec.cam.speed_given}
     figures = {
         "pressure_angle_max_deg": None if pa is None else max(abs(pa.max), abs(pa.min)),
         "pressure_angle_limit_deg": None if pa is None else pa.limit,
