@@ -142,6 +142,9 @@ def _groups(e: dict) -> list[dict]:
         name = Path(rel).name  # shown without the cam's stem: "drawing.pdf", "dxf", "cam1.step", "lift.csv"
         label = name[len(folder):].lstrip("_.") if folder and name.startswith(folder) else name
         groups.setdefault(kind, []).append({"path": Path(f["path"]).as_posix(), "label": label or name})
+    if "plots" in groups:  # the report's figures: one link to their folder
+        plots = groups["plots"]
+        groups["plots"] = [{"path": plots[0]["path"].rsplit("/", 1)[0] + "/", "label": f"{len(plots)} files"}]
     order = [k for k, _ in _KINDS] + ["other"]
     return [{"kind": k, "files": groups[k][:_GROUP_MAX], "more": max(0, len(groups[k]) - _GROUP_MAX)}
             for k in order if k in groups]
