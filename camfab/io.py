@@ -29,7 +29,7 @@ except ImportError:  # Windows: no lock
 
 __all__ = ["atomic_write", "write_all", "write_bytes", "named", "fsync_dir", "safe_stem", "inside", "STEM_MAX",
            "DURABLE", "LOCK", "TEMP_MARK", "hold_sigint", "leftover_name", "clean_stale", "output_folder",
-           "swap_dir"]
+           "swap_dir", "atomic_stream"]
 
 #: fsync every file written and its folder (docs/decisions.md, "Faults: staging, locks, durability")
 DURABLE = True
@@ -135,6 +135,61 @@ def write_all(files: Mapping[Path, str | bytes], *, durable: bool | None = None)
         for folder in dict.fromkeys(path.parent for _, path in temps):
             fsync_dir(folder)
     return [path for _, path in temps]
+
+
+class _Stream:
+    """A binary file a writer streams into: every write goes through :func:`write_bytes`; ``tell`` counts."""
+
+    def __init__(self, fh: BinaryIO, path: Path):
+        self._fh, self._path, self._at = fh, path, 0
+
+    def write(self, raw: bytes) -> int:
+        write_bytes(self._fh, bytes(raw), self._path)
+        self._at += len(raw)
+        return len(raw)
+
+    def tell(self) -> int:
+        return self._at
+
+    def seek(self, offset: int, whence: int = 0) -> int:
+        """Only where it stands (a stream is written forward)."""
+        if (offset, whence) not in ((self._at, 0), (0, 1)):
+            raise OSError(f"{self._path}: a stream cannot seek")
+        return self._at
+
+    def flush(self) -> None:
+        self._fh.flush()
+
+
+@contextlib.contextmanager
+def atomic_stream(path: str | Path, *, durable: bool | None = None) -> Iterator[_Stream]:
+    """A file to stream a large output into (a writer that needs ``write`` and ``tell``, such as a multi-page
+    PDF): a temporary file beside ``path``, renamed onto it when the block ends without an error and removed
+    otherwise, so ``path`` holds either its old content or the whole new one, as :func:`atomic_write`.
+    An ``OSError`` names ``path``."""
+    path = Path(path)
+    sync = DURABLE if durable is None else durable
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}{TEMP_MARK}tmp-{os.getpid()}-")
+    except OSError as exc:
+        raise named(exc, path) from exc
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            yield _Stream(fh, path)
+            if sync:
+                fh.flush()
+                os.fsync(fh.fileno())
+        os.chmod(tmp, 0o666 & ~_umask())
+        with hold_sigint():
+            os.replace(tmp, path)
+    except BaseException as exc:
+        Path(tmp).unlink(missing_ok=True)
+        if isinstance(exc, OSError) and str(path) not in str(exc):
+            raise named(exc, path) from exc
+        raise
+    if sync:
+        fsync_dir(path.parent)
 
 
 def _write_temp(path: Path, raw: bytes, sync: bool) -> str:

@@ -3,8 +3,11 @@
 ``package(paths, out)`` finds the designs (``*.toml`` and ``*.xlsx`` files, folders
 searched recursively), runs each design through :mod:`camfab.pipeline` in its own
 folder ``out/<name>/`` on a process pool, and writes ``out/manifest.json`` (each
-file's sha256 and size, measured deviation, tolerance, verdict, stage timings)
-and ``out/index.html``.
+file's sha256 and size, measured deviation, tolerance, verdict, key figures and the reasons for the verdict
+(:func:`camfab.report.overview.cam_summary`), stage timings), ``out/index.html``
+(:func:`camfab.report.overview.index_html`) and, when any cam has a PDF sheet, ``out/drawings.pdf``: a contents
+page, then every cam's sheet (:func:`camfab.cad.pdf.write_drawing_set`; docs/decisions.md, "The package index and
+the drawing set").
 
 Folders: each design's folder is :func:`~camfab.io.safe_stem` of its name (of its file's stem when it cannot
 be read), made unique in the order the designs are found (:func:`folders`): a stem already taken — by an
@@ -32,7 +35,6 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
-import html
 import json
 import logging
 import multiprocessing
@@ -44,23 +46,27 @@ import threading
 import time
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import ProcessPoolExecutor
+from dataclasses import replace
 from pathlib import Path
 
-from .assets import read_template, templates_hash
+from .assets import templates_hash
 from .design.spec import DesignSpec
 from .errors import ExportError, MissingDependencyError
 from .formats import load_design
 from .io import atomic_write, hold_sigint, inside, leftover_name, output_folder, safe_stem, swap_dir
-from .pipeline import Cam, Request, run, shop_file_names
+from .pipeline import Cam, Output, Request, run, shop_file_names
+from .report.overview import cam_summary, index_html
 from .results import Verdict
 from .textsafe import bounded, plain
 from .threads import blas_single_threaded
 from .version import __version__
 
-__all__ = ["discover", "folders", "input_key", "package", "exit_status", "MANIFEST", "INDEX"]
+__all__ = ["discover", "folders", "input_key", "package", "exit_status", "MANIFEST", "INDEX", "DRAWING_SET"]
 
 MANIFEST = "manifest.json"
 INDEX = "index.html"
+#: the package's drawing set: a contents page, then every cam's sheet (:func:`camfab.cad.pdf.write_drawing_set`)
+DRAWING_SET = "drawings.pdf"
 
 log = logging.getLogger(__name__)
 
@@ -85,7 +91,7 @@ def discover(paths: Iterable[str | Path]) -> list[Path]:
 def folders(stems: Sequence[str]) -> list[str]:
     """Unique folder names for designs whose :func:`~camfab.io.safe_stem` are ``stems``, in order: a stem
     taken (case-insensitively) by an earlier one or by :data:`MANIFEST` / :data:`INDEX` gets ``_2``, ``_3``…"""
-    taken = {MANIFEST.casefold(), INDEX.casefold()}
+    taken = {MANIFEST.casefold(), INDEX.casefold(), DRAWING_SET.casefold()}
     out = []
     for stem in stems:
         name, k = stem, 1
@@ -156,6 +162,8 @@ def _build(args: tuple) -> dict:
         outputs = options.get("outputs")
         req = Request.from_design(spec, outputs, force=options.get("force") or None,
                                   post="linuxcnc" if outputs is not None else None)
+        if Output.PDF in req.outputs:  # the drawing set's page is rendered from the sheet: keep it beside the PDF
+            req = replace(req, outputs=req.outputs | {Output.DRAWING})
         cam = Cam(spec)
         res = run(cam, staging, req, lock=False)
         _keep_other_files(folder, staging, Path(out), recorded, shop_file_names(cam))
@@ -164,6 +172,7 @@ def _build(args: tuple) -> dict:
                      tolerance_mm=res.tol, withheld=res.withheld, timings=res.timings,
                      folder=str(folder.relative_to(out)),
                      files=[_file_entry(folder / n, Path(out), res.deviations.get(n)) for n in sorted(res.files)])
+        entry.update(cam_summary(spec, cam.geometry, cam.check(), res.deviations.values()))
     except (ApiError, InternalError) as exc:  # bugs of camfab: recorded as internal failures
         _internal_error(entry, exc)
     except (CamfabError, OSError, ValueError) as exc:
@@ -279,8 +288,12 @@ def _package(paths: Iterable[str | Path], out: Path, jobs: int, outputs: Sequenc
                 "cams": [entries[str(p)] for p in designs]}
     _remove_stale(out, old, manifest)
     failed: list[OSError] = []
+    try:
+        manifest["drawing_set"] = _drawing_set(out, manifest, _old_set(out), say)
+    except OSError as exc:  # the manifest and the index are still written
+        failed.append(exc)
     for name, text in ((MANIFEST, lambda: json.dumps(manifest, indent=2) + "\n"),
-                       (INDEX, lambda: _index_html(manifest))):
+                       (INDEX, lambda: index_html(manifest))):
         try:  # the index is still written when the manifest cannot be, and the other way round
             atomic_write(out / name, text())
         except OSError as exc:
@@ -288,6 +301,64 @@ def _package(paths: Iterable[str | Path], out: Path, jobs: int, outputs: Sequenc
     if failed:
         raise failed[0]
     return manifest
+
+
+def _old_set(out: Path) -> dict | None:
+    """The ``drawing_set`` record of the previous manifest (None when there is none)."""
+    try:
+        data = json.loads((out / MANIFEST).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    rec = data.get("drawing_set") if isinstance(data, dict) else None
+    return rec if isinstance(rec, dict) else None
+
+
+def _set_entries(out: Path, manifest: dict) -> list:
+    """Every cam of the package as a :class:`~camfab.cad.pdf.SetEntry`: its sheet (the ``*_drawing.dxf`` of a
+    cam that has its ``*_drawing.pdf``), or why it has none."""
+    from .cad.pdf import SetEntry
+
+    items = []
+    for e in manifest["cams"]:
+        paths = [f["path"] for f in e.get("files", [])]
+        sheets = [p for p in paths if p.endswith("_drawing.dxf") and p.removesuffix(".dxf") + ".pdf" in paths]
+        if e.get("status") == "error":
+            error, source = e.get("error") or "error", str(e.get("source", ""))
+            reason = " ".join(error.removeprefix(f"{source}: ").split())  # the contents names the cam already
+        elif "drawing" in e.get("withheld", []):
+            codes = ", ".join(r["code"] for r in e.get("reasons", []) if r.get("severity") == "error")
+            reason = f"withheld: the verdict is unacceptable ({codes})" if codes else "withheld: unacceptable"
+        else:
+            reason = "no PDF drawing asked for ([outputs] pdf)"
+        items.append(SetEntry(str(e.get("name", "")), e.get("verdict"), e.get("drawing_number"),
+                              out / sheets[0] if sheets else None, "" if sheets else reason))
+    return items
+
+
+def _drawing_set(out: Path, manifest: dict, old: dict | None, say: Callable[[str], None]) -> dict | None:
+    """Write :data:`DRAWING_SET` (a contents page, then every cam's sheet) when any cam has a PDF sheet; returns
+    its manifest record, or None (an earlier set is then removed).  Not rendered again when nothing it shows
+    changed (its key: every cam's name, verdict, drawing number, reason and sheet hash) and the file is
+    still the one recorded."""
+    from .cad.pdf import write_drawing_set
+
+    path = out / DRAWING_SET
+    items = _set_entries(out, manifest)
+    if not any(i.sheet is not None for i in items):
+        if old is not None and path.is_file():
+            path.unlink()
+        return None
+    sha = {f["path"]: f["sha256"] for e in manifest["cams"] for f in e.get("files", [])}
+    key = _sha(json.dumps([__version__, [[i.name, i.verdict, i.number, i.reason,
+                                          sha.get(i.sheet.relative_to(out).as_posix()) if i.sheet else None]
+                                         for i in items]]).encode())
+    if old and old.get("key") == key and path.is_file() and _sha(path.read_bytes()) == old.get("sha256"):
+        say(f"[up to date] {DRAWING_SET}")
+        return old
+    say(f"{DRAWING_SET}: contents and {sum(i.sheet is not None for i in items)} sheet(s)")
+    pages = write_drawing_set(path, items)
+    data = path.read_bytes()
+    return {"path": DRAWING_SET, "key": key, "pages": pages, "sha256": _sha(data), "bytes": len(data)}
 
 
 def _recorded(entry: dict) -> list[str]:
@@ -405,23 +476,3 @@ def exit_status(manifest: dict) -> int:
     if any(e.get("status") == "error" and e.get("error_kind") in ("io", "dependency") for e in manifest["cams"]):
         return 3
     return 2 if "error" in st else 1 if "unacceptable" in st else 0
-
-
-_ERROR_LABEL = {"io": "I/O error", "dependency": "missing dependency", "internal": "internal error"}
-
-
-def _index_html(manifest: dict) -> str:
-    from jinja2 import Environment, select_autoescape
-
-    env = Environment(autoescape=select_autoescape(default=True))
-    tpl = env.from_string(read_template("package", "index.html.j2"))
-    rows = []
-    for e in manifest["cams"]:
-        files = {Path(f["path"]).name: f["path"] for f in e.get("files", [])}
-        rows.append({"name": e.get("name"), "source": e.get("source"), "status": e.get("status"),
-                     "error_label": _ERROR_LABEL.get(e.get("error_kind", ""), "error"),
-                     "verdict": e.get("verdict"), "error": e.get("error"),
-                     "report": files.get("report.html"), "files": sorted(files.values()),
-                     "withheld": e.get("withheld", [])})
-    return tpl.render(rows=rows, version=manifest["camfab_version"], escape=html.escape)
-

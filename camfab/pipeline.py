@@ -51,10 +51,11 @@ class Output(StrEnum):
     XLSX = "xlsx"
     REPORT = "report"
     DRAWING = "drawing"
+    PDF = "pdf"
 
 
 #: artifacts withheld for an unacceptable design unless the job is forced (in the order they are named)
-SHOP_OUTPUTS = (Output.DXF, Output.STEP, Output.STL, Output.GCODE, Output.DRAWING, Output.LIFT_TABLE)
+SHOP_OUTPUTS = (Output.DXF, Output.STEP, Output.STL, Output.GCODE, Output.DRAWING, Output.PDF, Output.LIFT_TABLE)
 
 
 @dataclass(frozen=True)
@@ -93,7 +94,7 @@ class Request:
         """The request a design's ``[outputs]`` table makes (``outputs`` replaces it), with overrides."""
         o = spec.outputs
         if outputs is None:
-            chosen = {Output(k) for k in ("dxf", "step", "stl", "lift_table", "xlsx", "report", "drawing")
+            chosen = {Output(k) for k in ("dxf", "step", "stl", "lift_table", "xlsx", "report", "drawing", "pdf")
                       if getattr(o, k)}
             if o.gcode:
                 chosen.add(Output.GCODE)
@@ -413,12 +414,21 @@ def _drawing(cam: Cam, req: Request) -> list[Artifact]:
                      max(shapes.profile_deviation))]
 
 
+def _pdf(cam: Cam, req: Request) -> list[Artifact]:
+    """Each drawing sheet as a one-page PDF at its paper size (:func:`camfab.cad.pdf.sheet_pdf`)."""
+    from .cad.pdf import sheet_pdf
+
+    return [Artifact(a.filename.removesuffix(".dxf") + ".pdf", sheet_pdf(a.data), "pdf", None, a.deviation_mm)
+            for a in _drawing(cam, req)]
+
+
 #: every artifact's stage, in the order :func:`run` builds them
 EXPORTERS: dict[Output, Stage] = {
     Output.DXF: _dxf,
     Output.STL: _stl,
     Output.STEP: _step,
     Output.DRAWING: _drawing,
+    Output.PDF: _pdf,
     Output.GCODE: _gcode,
     Output.LIFT_TABLE: _lift_table,
     Output.XLSX: _xlsx,
@@ -478,7 +488,8 @@ def shop_file_names(cam: Cam) -> set[str]:
     stem = safe_stem(cam.name)
     n = len(cam.geometry.profiles)
     per_profile = [f"{stem}{_suffix(i, n)}" for i in range(n)]
-    names = {f"{stem}.dxf", f"{stem}_drawing.dxf", f"{stem}_lift.csv", *([f"{stem}_pair.step"] if n > 1 else [])}
+    names = {f"{stem}.dxf", f"{stem}_drawing.dxf", f"{stem}_drawing.pdf", f"{stem}_lift.csv",
+             *([f"{stem}_pair.step"] if n > 1 else [])}
     return names | {f"{s}.{ext}" for s in per_profile for ext in ("stl", "step", "nc")}
 
 

@@ -44,7 +44,7 @@ LAYERS: dict[str, tuple[str, ...]] = {
                                "camfab.formats", "camfab.cad", "camfab.gcode", "camfab.report", "camfab.assets",
                                "camfab.pipeline"),
     "camfab.package": BASE + ("camfab.io", "camfab.design", "camfab.formats", "camfab.pipeline",
-                              "camfab.assets", "camfab.package"),
+                              "camfab.assets", "camfab.package", "camfab.cad", "camfab.report"),
     "camfab.cli": ("camfab",),
     "camfab.__main__": ("camfab.cli",),
     "camfab": ("camfab",),  # the façade re-exports

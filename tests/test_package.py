@@ -110,8 +110,8 @@ def test_run_unacceptable_withholds_shop_files(tmp_path, capsys):
 def test_run_default_example_and_bad_outputs(tmp_path, capsys):
     assert main(["run", "-o", str(tmp_path / "o"), "--outputs", "dxf"]) == 0
     assert (tmp_path / "o" / "Ejemplo9RT.dxf").exists()
-    assert main(["run", "-o", str(tmp_path / "p"), "--outputs", "dxf,pdf"]) == 2
-    assert "'pdf' is not a valid option" in capsys.readouterr().err
+    assert main(["run", "-o", str(tmp_path / "p"), "--outputs", "dxf,svg"]) == 2
+    assert "'svg' is not a valid option" in capsys.readouterr().err
     assert not (tmp_path / "p").exists()
 
 

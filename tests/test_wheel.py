@@ -102,7 +102,7 @@ _API = textwrap.dedent("""
     from camfab import assets
     from camfab.cad.drawing import load_template
     from camfab.formats import EXAMPLES_DIR
-    from camfab.package import _index_html
+    from camfab.report.overview import index_html
 
     cam = camfab.load("ejemplo9rt")
     result = cam.run(Path(sys.argv[1]))
@@ -112,7 +112,7 @@ _API = textwrap.dedent("""
         "templates_hash": assets.templates_hash(), "verdict": str(cam.check().verdict),
         "examples": camfab.examples(), "files": sorted(result.files), "withheld": result.withheld,
         "valve_sources": list(valve.spec.sources), "valve_verdict": str(valve.check().verdict),
-        "title_block": sorted(load_template()), "index": _index_html({"cams": [], "camfab_version": "0"})[:15],
+        "title_block": sorted(load_template()), "index": index_html({"cams": [], "camfab_version": "0"})[:15],
     }))
 """)
 
@@ -151,7 +151,8 @@ def test_the_wheel_installs_and_runs_from_another_folder(tmp_path):
     _sh([camfab, "run", "valve_exhaust_ej1", "-o", "out2"], cwd=elsewhere)  # an example with a knot file
     for out, name in (("out", "Ejemplo9RT"), ("out2", "ValveExhaustEj1")):
         made = {p.relative_to(elsewhere / out).as_posix() for p in (elsewhere / out).rglob("*") if p.is_file()}
-        assert {"report.html", "check.json", f"{name}.dxf", f"{name}_drawing.dxf", "plots/profile.svg"} <= made, \
+        assert {"report.html", "check.json", f"{name}.dxf", f"{name}_drawing.dxf", f"{name}_drawing.pdf",
+                "plots/profile.svg"} <= made, \
             (out, sorted(made))
         assert b"<!DOCTYPE html>" in (elsewhere / out / "report.html").read_bytes()[:100]
 

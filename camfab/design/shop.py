@@ -33,7 +33,7 @@ POSTS = tuple(p.value for p in Post)
 
 _MFG_KEYS = ("thickness_mm", "bore_mm", "keyway", "hub_diameter_mm", "hub_length_mm",
              "tool_diameter_mm", "tolerance_mm", "material")
-_OUTPUT_KEYS = ("dxf", "step", "stl", "gcode", "report", "xlsx", "drawing", "lift_table")
+_OUTPUT_KEYS = ("dxf", "step", "stl", "gcode", "report", "xlsx", "drawing", "lift_table", "pdf")
 
 
 @dataclass(frozen=True, slots=True)
@@ -98,6 +98,8 @@ class OutputsSpec:
     xlsx: bool = False
     drawing: bool = False
     lift_table: bool = False
+    #: the drawing sheet as PDF too (``<stem>_drawing.pdf``); when the file does not say, as ``drawing``
+    pdf: bool = False
 
 
 def manufacturing_section(v: Validator, t: Mapping[str, Any], base_radius_mm: float | None,
@@ -173,4 +175,5 @@ def outputs_section(v: Validator, t: Mapping[str, Any]) -> OutputsSpec:
     defaults = OutputsSpec()
     flags = {k: v.boolean(t, k, "outputs", getattr(defaults, k))
              for k in ("dxf", "step", "stl", "report", "xlsx", "drawing", "lift_table")}
+    flags["pdf"] = v.boolean(t, "pdf", "outputs", flags["drawing"])
     return OutputsSpec(gcode=post, **flags)

@@ -430,6 +430,8 @@ def _output_rows(o: OutputsSpec) -> list[tuple[str, Any]]:
     kv: list[tuple[str, Any]] = [(f"outputs.{name}", getattr(o, name)) for name in ("dxf", "step", "stl")]
     kv.append(("outputs.gcode", o.gcode if o.gcode is not None else False))
     kv += [(f"outputs.{name}", getattr(o, name)) for name in ("report", "xlsx", "drawing", "lift_table")]
+    if o.pdf != o.drawing:  # by default the PDF follows the drawing: written only when it does not
+        kv.append(("outputs.pdf", o.pdf))
     return kv
 
 

@@ -87,7 +87,8 @@ def test_round_trip_toml_example(tmp_path):
                         {"law": "cycloidal", "lift": -8.0, "length_mm": 100.0}]),
     base_design(follower={"type": "knife", "motion": "translating", "base_radius_mm": 40.0, "offset_mm": 3.0},
                 motion=[{"law": "simple_harmonic", "lift": 10.0, "angle_deg": 180.0},
-                        {"law": "simple_harmonic", "lift": -10.0, "angle_deg": 180.0}]),
+                        {"law": "simple_harmonic", "lift": -10.0, "angle_deg": 180.0}],
+                outputs={"drawing": True, "pdf": False}),  # a PDF that does not follow the drawing
     {k: v for k, v in base_design(cam={"kind": "constant_width", "speed_rpm": 60.0},
                                   follower={"type": "flat", "motion": "translating", "base_radius_mm": 30.0,
                                             "width_mm": 80.0, "rise_deg": 150.0}).items() if k != "motion"},
