@@ -146,6 +146,7 @@ def _export_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--stl", action="store_true", help="write the STL mesh")
     p.add_argument("--assembly", action="store_true",
                    help="write the mechanism as a STEP assembly: cam, shaft, follower, frame (needs cadquery)")
+    p.add_argument("--iges", action="store_true", help="write the plate as IGES for older CAM systems (needs cadquery)")
     _assembly_args(p)
     p.add_argument("--tol", type=float, default=None,
                    help="max distance of every entity from the exact profile, mm (default: the design's, 0.001)")
@@ -160,7 +161,7 @@ def _export_args(p: argparse.ArgumentParser) -> None:
 @register("export", "DXF, STEP and STL files within a measured tolerance of the exact profile", _export_args)
 def cmd_export(args: argparse.Namespace) -> int:
     cam = _cam(args.file)
-    kinds = ("dxf", "step", "stl", "assembly")
+    kinds = ("dxf", "step", "stl", "assembly", "iges")
     formats = [f for f in kinds if getattr(args, f)] or [f for f in kinds if getattr(cam.spec.outputs, f)]
     if not formats:
         raise UsageError("nothing to export: give --dxf, --step, --stl or --assembly, or enable them in [outputs]")

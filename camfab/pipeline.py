@@ -54,14 +54,15 @@ class Output(StrEnum):
     REPORT = "report"
     DRAWING = "drawing"
     ASSEMBLY = "assembly"
+    IGES = "iges"
 
 
 #: artifacts withheld for an unacceptable design unless the job is forced (in the order they are named)
 SHOP_OUTPUTS = (Output.DXF, Output.STEP, Output.STL, Output.GCODE, Output.DRAWING, Output.LIFT_TABLE,
-                Output.ASSEMBLY)
+                Output.ASSEMBLY, Output.IGES)
 
 #: outputs a run skips, with a warning, when cadquery is missing (the rest is written)
-CAD_OUTPUTS = (Output.STEP, Output.ASSEMBLY)
+CAD_OUTPUTS = (Output.STEP, Output.ASSEMBLY, Output.IGES)
 
 #: most assembly poses one run writes (``--poses``)
 MAX_POSES = 360
@@ -112,7 +113,7 @@ class Request:
         o = spec.outputs
         if outputs is None:
             chosen = {Output(k) for k in ("dxf", "step", "stl", "lift_table", "xlsx", "report", "drawing",
-                                          "assembly") if getattr(o, k)}
+                                          "assembly", "iges") if getattr(o, k)}
             if o.gcode:
                 chosen.add(Output.GCODE)
         else:
@@ -382,6 +383,19 @@ def _step(cam: Cam, req: Request) -> list[Artifact]:
     return build_artifacts(cam.spec, cam.geometry, ["step"], tol=tol, shapes=cam.shapes(tol))
 
 
+def _iges(cam: Cam, req: Request) -> list[Artifact]:
+    """``<stem>.igs`` (``_cam1``/``_cam2`` for a pair): the plate for older CAM systems."""
+    from .cad import iges
+    from .cad.export import plate_of
+
+    shapes = cam.shapes(req.tol)
+    n = len(shapes.profiles)
+    return [Artifact(f"{safe_stem(cam.name)}{_suffix(i, n)}.igs",
+                     iges.dumps(loop, plate_of(cam.spec), name=f"{cam.name}{_suffix(i, n)}").encode("ascii"),
+                     "iges", loop.n_entities, dev)
+            for i, (loop, dev) in enumerate(zip(shapes.profiles, shapes.profile_deviation, strict=True))]
+
+
 def _assembly(cam: Cam, req: Request) -> list[Artifact]:
     """``<stem>_assembly.step``: the mechanism at ``req.angle``; with ``req.poses`` = N, also N poses at
     equally spaced angles, ``<stem>_assembly_pose<k>.step``."""
@@ -475,6 +489,7 @@ EXPORTERS: dict[Output, Stage] = {
     Output.STL: _stl,
     Output.STEP: _step,
     Output.ASSEMBLY: _assembly,
+    Output.IGES: _iges,
     Output.DRAWING: _drawing,
     Output.GCODE: _gcode,
     Output.LIFT_TABLE: _lift_table,
@@ -545,7 +560,7 @@ def shop_file_names(cam: Cam) -> set[str]:
     per_profile = [f"{stem}{_suffix(i, n)}" for i in range(n)]
     names = {f"{stem}.dxf", f"{stem}_drawing.dxf", f"{stem}_lift.csv", f"{stem}_assembly.step",
              *([f"{stem}_pair.step"] if n > 1 else [])}
-    return names | {f"{s}.{ext}" for s in per_profile for ext in ("stl", "step", "nc")}
+    return names | {f"{s}.{ext}" for s in per_profile for ext in ("stl", "step", "nc", "igs")}
 
 
 def _timed(res: RunResult, stage: str, say: Callable[[str], None], fn: Callable[..., Any], *args: Any) -> Any:

@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 import re
 import tempfile
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -27,18 +27,18 @@ import numpy as np
 from ..design.mechanisms import ConstantDiameterCam, ConstantWidthCam
 from ..errors import Problem, SpecError
 from ..geom2d import ArcChain
-from .plate import PlateSpec
+from .export import plate_of
 from .step import cadquery as _cq
 from .step import plate_solid
-from .stepheader import header_dumps
+from .stepheader import StepMeta, design_meta, header_dumps
 
 __all__ = ["Dimensions", "FollowerPose", "dimensions", "follower_poses", "build", "dumps", "PART_COLOURS"]
 
 #: RGB of each kind of part (the name without its ``_1``/``_2`` suffix)
 PART_COLOURS = {"cam": (0.70, 0.72, 0.75), "shaft": (0.35, 0.35, 0.38), "roller": (0.85, 0.45, 0.10),
                 "pin": (0.90, 0.80, 0.20), "stem": (0.20, 0.40, 0.80), "arm": (0.20, 0.40, 0.80),
-                "face": (0.20, 0.65, 0.35), "pivot": (0.90, 0.80, 0.20), "frame": (0.45, 0.45, 0.45),
-                "slide": (0.45, 0.45, 0.45)}
+                "face": (0.20, 0.65, 0.35), "knife": (0.20, 0.65, 0.35), "pivot": (0.90, 0.80, 0.20),
+                "frame": (0.45, 0.45, 0.45), "slide": (0.45, 0.45, 0.45)}
 
 #: samples per cycle for the follower's extents (face lengths, stroke)
 _SAMPLES = 1441
@@ -195,6 +195,8 @@ def _pose(contact, point, normal, pitch, flip: int, layer: int) -> FollowerPose:
         cl = local(pitch)
         centre, radius, face_b = (float(cl[0, 0]), float(cl[0, 1])), float(contact.roller_radius), 0.0
         d = pl - cl
+        if radius == 0:  # a knife edge: the direction towards the cam is −n
+            d = -np.stack([np.einsum("ij,ij->i", normal, v), np.einsum("ij,ij->i", normal, up)], axis=1)
         gam = np.arctan2(d[1:, 0], -d[1:, 1])  # contact direction from the centre, from −b
         span = (float(gam.min()), float(gam.max()))
     return FollowerPose(kind, oscillating, (float(origin[0, 0]), float(origin[0, 1])),
@@ -256,6 +258,18 @@ def _follower(cq, parts: _Parts, p: FollowerPose, d: Dimensions, z0: float, t: f
             parts.add(f"pin{sfx}", _cyl(cq, ca, cb, d.pin_diameter / 2, *pin_z), at, rot)
         head_b = cb + rr + d.clearance                  # the follower body starts above the roller
         contact_parts: tuple[Any, ...] = ()
+        if p.radius == 0:  # a knife edge: a wedge of half-angle 15° from its edge at the pitch point, pointing
+            # along the middle of the contact normals (straight down the stem of a translating knife)
+            mid = (p.span[0] + p.span[1]) / 2 if p.oscillating else 0.0
+            axis = np.array([math.sin(mid), -math.cos(mid)])
+            height = max(d.stem_diameter, 1.0)
+            back = np.array([ca, cb]) - axis * height
+            side = np.array([-axis[1], axis[0]]) * height * math.tan(math.radians(15.0))
+            knife = (cq.Workplane("XY", origin=(0, 0, zc - w / 2))
+                     .polyline([(ca, cb), tuple(back + side), tuple(back - side)]).close().extrude(w))
+            parts.add(f"knife{sfx}", knife, at, rot)
+            head_b = cb + height
+            contact_parts = (tuple(back),)
     elif p.kind == "curved":
         g0, g1 = p.span
         # a translating face is cut square to its stem (the stem stands on a flat chord); an arm's face
@@ -292,7 +306,7 @@ def _stem(cq, parts, p: FollowerPose, d: Dimensions, at, rot, zc, zin, lo_z, hi_
     """A translating follower: (a fork round the roller,) a yoke and the stem, and the guide block (frame)."""
     ds = d.stem_diameter
     yoke = max(ds, 1.0) * 0.5
-    if p.kind == "roller":
+    if p.kind == "roller" and p.radius > 0:
         hw = max(d.pin_diameter, 0.6 * ds)
         cheek = [_box(cq, -hw, hw, p.centre[1] - hw, head_b + yoke, lo_z, zc - zin),
                  _box(cq, -hw, hw, p.centre[1] - hw, head_b + yoke, zc + zin, hi_z)]
@@ -319,7 +333,9 @@ def _arm(cq, parts, p: FollowerPose, d: Dimensions, at, rot, zc, zin, sfx, conta
     face, the pivot pin and the bracket (frame) below the arm."""
     z1 = zc - zin
     z0 = z1 - d.arm_thickness
-    if p.kind == "roller":
+    if p.kind == "roller" and p.radius == 0:  # a knife on the arm: the arm reaches its back
+        arm = _bar(cq, (0.0, 0.0), tuple(contact_parts[0]), d.arm_width, z0, z1)
+    elif p.kind == "roller":
         arm = _bar(cq, (0.0, 0.0), p.centre, d.arm_width, z0, z1)
         arm = arm.cut(_cyl(cq, *p.centre, d.pin_diameter / 2, z0 - 1, z1 + 1))
     elif p.kind == "curved":
@@ -342,8 +358,7 @@ def build(spec, geometry, outlines: Sequence[ArcChain], x: float, *, dims: Dimen
     """Every part of the mechanism at the cam parameter ``x`` (radians, or mm for a translating cam)."""
     cq = _cq()
     d = dims or dimensions(spec, geometry)
-    m = spec.manufacturing
-    plate = PlateSpec(m.thickness_mm, m.bore_mm, m.keyway, m.hub_diameter_mm, m.hub_length_mm)
+    plate = plate_of(spec)
     t = plate.thickness_mm
     hub = plate.hub_length_mm or 0.0
     poses, cam_move = follower_poses(geometry, x)
@@ -380,9 +395,10 @@ def to_assembly(parts: _Parts, name: str = "mechanism"):
     return assy
 
 
-def dumps(spec, geometry, outlines: Sequence[ArcChain], x: float, *, header: Callable[[str], str] | None = None,
+def dumps(spec, geometry, outlines: Sequence[ArcChain], x: float, *, meta: StepMeta | None = None,
           dims: Dimensions | None = None) -> str:
-    """The assembly STEP (AP214) text at the cam parameter ``x``, reproducible (see :mod:`.stepheader`)."""
+    """The assembly STEP (AP214) text at the cam parameter ``x``, reproducible; header ``meta`` (default: the
+    design's, :func:`.stepheader.design_meta`)."""
     from .step import canonical_reals
 
     assy = to_assembly(build(spec, geometry, outlines, x, dims=dims))
@@ -390,7 +406,7 @@ def dumps(spec, geometry, outlines: Sequence[ArcChain], x: float, *, header: Cal
         path = Path(tmp) / "assembly.step"  # never a path built from the name
         assy.export(str(path), "STEP")
         text = path.read_text(encoding="utf-8", errors="replace")
-    text = (header or (lambda s: header_dumps(s, spec.name)))(text)
+    text = header_dumps(text, spec.name, meta or design_meta(spec))
     return canonical_reals(canonical_order(text))
 
 

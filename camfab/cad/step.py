@@ -13,7 +13,7 @@ from ..errors import MissingDependencyError
 from ..geom2d import ArcChain, bulge_midpoint
 from ..textsafe import step_string
 from .plate import PlateSpec
-from .stepheader import header_dumps
+from .stepheader import StepMeta, header_dumps
 
 __all__ = ["plate_solid", "dumps", "stack_dumps", "canonical_reals", "cadquery"]
 
@@ -54,26 +54,28 @@ def plate_solid(outline: ArcChain, plate: PlateSpec):
     return body
 
 
-def dumps(outline: ArcChain, plate: PlateSpec, *, name: str = "cam") -> str:
-    """STEP (AP214) text of the plate, in millimetres, byte-identical for the same input."""
-    return _export(plate_solid(outline, plate), name)
+def dumps(outline: ArcChain, plate: PlateSpec, *, name: str = "cam", meta: StepMeta | None = None) -> str:
+    """STEP (AP214) text of the plate, in millimetres, byte-identical for the same input (header: ``meta``, by
+    default derived from ``name``, :mod:`.stepheader`)."""
+    return _export(plate_solid(outline, plate), name, meta)
 
 
-def stack_dumps(outlines, plate: PlateSpec, *, gap_mm: float = 2.0, name: str = "cam") -> str:
+def stack_dumps(outlines, plate: PlateSpec, *, gap_mm: float = 2.0, name: str = "cam",
+                meta: StepMeta | None = None) -> str:
     """Several plates on one shaft (a conjugate pair): plate i at z = i·(thickness + hub + gap)."""
     cq = _cq()
     pitch = plate.thickness_mm + (plate.hub_length_mm or 0.0) + gap_mm
     solids = [plate_solid(o, plate).val().translate(cq.Vector(0, 0, i * pitch)) for i, o in enumerate(outlines)]
-    return _export(cq.Workplane("XY").add(cq.Compound.makeCompound(solids)), name)
+    return _export(cq.Workplane("XY").add(cq.Compound.makeCompound(solids)), name, meta)
 
 
-def _export(solid, name: str) -> str:
+def _export(solid, name: str, meta: StepMeta | None = None) -> str:
     cq = _cq()
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "cam.step"  # never a path built from the name
         cq.exporters.export(solid, str(path), "STEP")
         text = path.read_text(encoding="utf-8", errors="replace")
-    text = header_dumps(text, name)  # camfab's header: name, organisation, reproducible timestamp
+    text = header_dumps(text, name, meta)  # camfab's header: name, organisation, reproducible timestamp
     product = step_string(name)  # the full name, as an ISO 10303-21 string (a function: no backslash expansion)
     text = re.sub(r"Open CASCADE STEP translator [0-9.]+ [0-9]+", lambda m: product, text)
     return canonical_reals(text)

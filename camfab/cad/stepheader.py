@@ -22,7 +22,7 @@ from ..errors import InputError
 from ..textsafe import step_string
 from ..version import __version__
 
-__all__ = ["StepMeta", "step_timestamp", "header_dumps"]
+__all__ = ["StepMeta", "step_timestamp", "header_dumps", "design_meta"]
 
 _EPOCH0 = "1970-01-01T00:00:00"
 
@@ -73,6 +73,14 @@ class StepMeta:
         name, author = "" (unknown; never OpenCascade's 'Author'), organisation = "camfab"."""
         return cls(part_number or name, author or "", organisation or "camfab",
                    description or f"{name} (camfab cam)", step_timestamp(timestamp))
+
+
+def design_meta(spec) -> StepMeta:
+    """The header of a design's STEP files: its ``[drawing]`` author, organisation and part number when the
+    design has that table (fields of the same names), else the defaults of :meth:`StepMeta.of`."""
+    d = getattr(spec, "drawing", None)
+    return StepMeta.of(spec.name, author=getattr(d, "author", None), organisation=getattr(d, "organisation", None),
+                       part_number=getattr(d, "part_number", None))
 
 
 _FILE_NAME = re.compile(r"FILE_NAME\(.*?\);", re.S)

@@ -33,7 +33,7 @@ POSTS = tuple(p.value for p in Post)
 
 _MFG_KEYS = ("thickness_mm", "bore_mm", "keyway", "hub_diameter_mm", "hub_length_mm",
              "tool_diameter_mm", "tolerance_mm", "material")
-_OUTPUT_KEYS = ("dxf", "step", "stl", "gcode", "report", "xlsx", "drawing", "lift_table", "assembly")
+_OUTPUT_KEYS = ("dxf", "step", "stl", "gcode", "report", "xlsx", "drawing", "lift_table", "assembly", "iges")
 
 
 @dataclass(frozen=True, slots=True)
@@ -100,6 +100,8 @@ class OutputsSpec:
     lift_table: bool = False
     #: the mechanism as a STEP assembly (``<name>_assembly.step``); when the table does not say, as ``step``
     assembly: bool = True
+    #: the plate as IGES (``<name>.igs``) for older CAM systems
+    iges: bool = False
 
 
 @dataclass(frozen=True, slots=True)
@@ -197,7 +199,7 @@ def outputs_section(v: Validator, t: Mapping[str, Any]) -> OutputsSpec:
         post = None
     defaults = OutputsSpec()
     flags = {k: v.boolean(t, k, "outputs", getattr(defaults, k))
-             for k in ("dxf", "step", "stl", "report", "xlsx", "drawing", "lift_table")}
+             for k in ("dxf", "step", "stl", "report", "xlsx", "drawing", "lift_table", "iges")}
     flags["assembly"] = v.boolean(t, "assembly", "outputs", flags["step"])  # follows step unless given
     return OutputsSpec(gcode=post, **flags)
 

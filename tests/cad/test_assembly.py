@@ -57,7 +57,7 @@ def _contact_pairs(parts):
     pairs = []
     for name in parts:
         kind, _, sfx = name.partition("_")
-        if kind in ("roller", "face"):
+        if kind in ("roller", "face", "knife"):
             cam = "cam" if "cam" in parts else f"cam_{sfx}"
             pairs.append((name, cam))
     return pairs
@@ -92,7 +92,34 @@ CASES = {
     "valve_mushroom": {"cam", "shaft", "face", "stem", "frame"},                           # translating curved
     "finger_follower": {"cam", "shaft", "face", "arm", "pivot", "frame"},                  # oscillating curved
     "press_feed_oscillating": {"cam", "shaft", "roller", "pin", "arm", "pivot", "frame"},  # ccw oscillating
+    "oscillating_flat": {"cam", "shaft", "face", "arm", "pivot", "frame"},                 # no example has one
+    "translating_knife": {"cam", "shaft", "knife", "stem", "frame"},
+    "oscillating_knife": {"cam", "shaft", "knife", "arm", "pivot", "frame"},
 }
+
+_RISE = [{"law": "cycloidal", "lift": 20.0, "angle_deg": 120.0},
+         {"law": "cycloidal", "lift": -20.0, "angle_deg": 120.0},
+         {"law": "dwell", "lift": 0.0, "angle_deg": 120.0}]
+_SWING = [dict(m, lift=m["lift"] / 2) for m in _RISE]
+#: follower types no built-in example has
+DESIGNS = {
+    "oscillating_flat": ({"type": "flat", "motion": "oscillating", "base_radius_mm": 40.0,
+                          "pivot_distance_mm": 80.0, "face_offset_mm": 10.0}, _SWING),
+    "translating_knife": ({"type": "knife", "motion": "translating", "base_radius_mm": 40.0, "offset_mm": 5.0},
+                          _RISE),
+    "oscillating_knife": ({"type": "knife", "motion": "oscillating", "base_radius_mm": 40.0,
+                           "pivot_distance_mm": 80.0, "arm_length_mm": 60.0}, _SWING),
+}
+
+
+def _load(name):
+    if name not in DESIGNS:
+        return camfab.load(name)
+    from camfab.design.spec import design_from_dict
+
+    follower, motion = DESIGNS[name]
+    return camfab.Cam(design_from_dict({"name": name, "cam": {"kind": "disc"}, "follower": follower,
+                                        "motion": motion, "manufacturing": {"bore_mm": 12.0}}))
 
 
 def _size(cam, angle_deg):
@@ -107,7 +134,7 @@ def _size(cam, angle_deg):
 
 
 def _run(name, angles, tmp_path):
-    cam = camfab.load(name)
+    cam = _load(name)
     tol = cam.tolerance()
     width = cam.spec.manufacturing.thickness_mm
     for ang in angles:
@@ -216,3 +243,29 @@ def test_assembly_table_is_validated():
     spec = dataclasses.replace(base, assembly=dataclasses.replace(base.assembly, pin_diameter_mm=10.0))
     with pytest.raises(SpecError, match="assembly.pin_diameter_mm"):
         assembly.dimensions(spec, camfab.Cam(spec).geometry)  # a 10 mm pin in a 10 mm roller
+
+
+def test_iges_reads_back_as_the_plate(tmp_path, monkeypatch):
+    """The IGES of ejemplo1rt read back with OpenCascade: one valid solid of the plate's exact volume (outline
+    area × thickness − bore), and the same bytes on a second write (no time of writing in its header)."""
+    from OCP.IFSelect import IFSelect_RetDone
+    from OCP.IGESControl import IGESControl_Reader
+
+    from camfab.cad import iges
+    from camfab.cad.export import plate_of
+    from camfab.cad.plate import plate_volume
+
+    monkeypatch.delenv("SOURCE_DATE_EPOCH", raising=False)
+    cam = camfab.load("ejemplo1rt")
+    loop = cam.shapes().profiles[0]
+    text = iges.dumps(loop, plate_of(cam.spec), name=cam.name)
+    assert text == iges.dumps(loop, plate_of(cam.spec), name=cam.name)
+    assert "15H19700101.000000" in text and "Ejemplo1RT.igs" in text
+    path = tmp_path / "cam.igs"
+    path.write_text(text, encoding="ascii")
+    reader = IGESControl_Reader()
+    assert reader.ReadFile(str(path)) == IFSelect_RetDone
+    reader.TransferRoots()
+    shape = cq.Shape.cast(reader.OneShape())
+    assert len(shape.Solids()) == 1 and BRepCheck_Analyzer(shape.wrapped).IsValid()
+    assert _volume(shape.wrapped) == pytest.approx(plate_volume(loop, plate_of(cam.spec)), rel=1e-6)
