@@ -160,6 +160,7 @@ def _export_args(p: argparse.ArgumentParser) -> None:
 
 @register("export", "DXF, STEP and STL files within a measured tolerance of the exact profile", _export_args)
 def cmd_export(args: argparse.Namespace) -> int:
+    _check_assembly_args(args)
     cam = _cam(args.file)
     kinds = ("dxf", "step", "stl", "assembly", "iges")
     formats = [f for f in kinds if getattr(args, f)] or [f for f in kinds if getattr(cam.spec.outputs, f)]
@@ -343,6 +344,15 @@ def _assembly_args(p: argparse.ArgumentParser) -> None:
                         "in CAD; default 0)")
 
 
+def _check_assembly_args(args: argparse.Namespace) -> None:
+    """--angle and --poses refused at once when out of range (before any computing)."""
+    if not math.isfinite(args.angle) or abs(args.angle) > 1e6:
+        raise UsageError(f"--angle {args.angle}: must be a finite number of at most 1e6 (degrees; mm of travel "
+                         "for a translating cam)")
+    if not 0 <= args.poses <= pipeline.MAX_POSES:
+        raise UsageError(f"--poses {args.poses}: must be a whole number from 0 to {pipeline.MAX_POSES}")
+
+
 def _run_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("file", nargs="?", default=None,
                    help="design file (TOML or xlsx) or example name; default: the built-in example ejemplo9rt")
@@ -356,6 +366,7 @@ def _run_args(p: argparse.ArgumentParser) -> None:
 
 @register("run", "the main job: every artifact the design's [outputs] asks for", _run_args)
 def cmd_run(args: argparse.Namespace) -> int:
+    _check_assembly_args(args)
     cam = _cam(args.file or "ejemplo9rt")
     outputs = outputs_list(args.outputs)
     _tol(cam, args.tol)

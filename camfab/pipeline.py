@@ -260,6 +260,12 @@ class Cam:
         arts = _step(self, Request(frozenset({Output.STEP}), tol=tol))
         return atomic_write(path, arts[0].data)
 
+    def to_assembly(self, path: str | Path, *, angle: float = 0.0, tol: float | None = None) -> Path:
+        """The mechanism as a STEP assembly at cam ``angle`` (degrees; mm of travel for a translating cam),
+        written to ``path`` (needs cadquery; README, "CAD assemblies")."""
+        arts = _assembly(self, Request(frozenset({Output.ASSEMBLY}), tol=tol, angle=angle))
+        return atomic_write(path, arts[0].data)
+
     def to_gcode(self, post: str | None = None, path: str | Path | None = None, *, tol: float | None = None,
                  **machining: Any) -> str | Path:
         """The contour-milling program of profile 1 (``[machining]`` values may be overridden as keywords):

@@ -265,8 +265,9 @@ def _follower(cq, parts: _Parts, p: FollowerPose, d: Dimensions, z0: float, t: f
             height = max(d.stem_diameter, 1.0)
             back = np.array([ca, cb]) - axis * height
             side = np.array([-axis[1], axis[0]]) * height * math.tan(math.radians(15.0))
-            knife = (cq.Workplane("XY", origin=(0, 0, zc - w / 2))
-                     .polyline([(ca, cb), tuple(back + side), tuple(back - side)]).close().extrude(w))
+            kz0 = zc - zin if p.oscillating else zc - w / 2  # an arm's knife reaches down to the arm's layer
+            knife = (cq.Workplane("XY", origin=(0, 0, kz0))
+                     .polyline([(ca, cb), tuple(back + side), tuple(back - side)]).close().extrude(zc + w / 2 - kz0))
             parts.add(f"knife{sfx}", knife, at, rot)
             head_b = cb + height
             contact_parts = (tuple(back),)

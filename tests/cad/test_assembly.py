@@ -95,6 +95,10 @@ CASES = {
     "oscillating_flat": {"cam", "shaft", "face", "arm", "pivot", "frame"},                 # no example has one
     "translating_knife": {"cam", "shaft", "knife", "stem", "frame"},
     "oscillating_knife": {"cam", "shaft", "knife", "arm", "pivot", "frame"},
+    "conjugate_roller": {"cam_1", "cam_2", "shaft", "roller_1", "roller_2", "pin_1", "pin_2", "stem_1", "stem_2",
+                         "frame_1", "frame_2"},
+    "conjugate_oscillating_roller": {"cam_1", "cam_2", "shaft", "roller_1", "roller_2", "pin_1", "pin_2", "arm_1",
+                                     "arm_2", "pivot_1", "pivot_2", "frame_1", "frame_2"},
 }
 
 _RISE = [{"law": "cycloidal", "lift": 20.0, "angle_deg": 120.0},
@@ -109,6 +113,11 @@ DESIGNS = {
                           _RISE),
     "oscillating_knife": ({"type": "knife", "motion": "oscillating", "base_radius_mm": 40.0,
                            "pivot_distance_mm": 80.0, "arm_length_mm": 60.0}, _SWING),
+    "conjugate_roller": ({"type": "roller", "motion": "translating", "base_radius_mm": 35.0, "roller_radius_mm": 7.0,
+                          "follower_distance_mm": 120.0}, _RISE),
+    "conjugate_oscillating_roller": ({"type": "roller", "motion": "oscillating", "base_radius_mm": 40.0,
+                                      "roller_radius_mm": 10.0, "pivot_distance_mm": 100.0, "arm_length_mm": 90.0,
+                                      "follower_angle_deg": 80.0}, _SWING),
 }
 
 
@@ -118,7 +127,8 @@ def _load(name):
     from camfab.design.spec import design_from_dict
 
     follower, motion = DESIGNS[name]
-    return camfab.Cam(design_from_dict({"name": name, "cam": {"kind": "disc"}, "follower": follower,
+    kind = "conjugate" if name.startswith("conjugate") else "disc"
+    return camfab.Cam(design_from_dict({"name": name, "cam": {"kind": kind}, "follower": follower,
                                         "motion": motion, "manufacturing": {"bore_mm": 12.0}}))
 
 
@@ -269,3 +279,11 @@ def test_iges_reads_back_as_the_plate(tmp_path, monkeypatch):
     shape = cq.Shape.cast(reader.OneShape())
     assert len(shape.Solids()) == 1 and BRepCheck_Analyzer(shape.wrapped).IsValid()
     assert _volume(shape.wrapped) == pytest.approx(plate_volume(loop, plate_of(cam.spec)), rel=1e-6)
+
+
+@pytest.mark.parametrize("args", [["--poses", "-1"], ["--poses", "361"], ["--angle", "nan"], ["--angle", "1e7"]])
+def test_bad_angle_or_poses_is_refused_before_any_work(args, tmp_path):
+    from camfab.cli import main
+
+    assert main(["run", "-o", str(tmp_path / "o"), "--outputs", "dxf", *args]) == 2
+    assert not (tmp_path / "o").exists()
