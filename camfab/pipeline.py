@@ -552,7 +552,8 @@ def _run(cam: Cam, folder: Path, req: Request, res: RunResult, say: Callable[[st
     written = write_all({paths[n]: files[n] for n in names})
     res.files = dict(zip(names, written, strict=True))
     if refused:  # a shop must never find G-code beside an unacceptable verdict
-        res.removed = [name for name in sorted(shop_file_names(cam)) if (folder / name).is_file()]
+        poses = {p.name for p in folder.glob(f"{safe_stem(cam.name)}_assembly_pose*.step")}  # any --poses N
+        res.removed = [name for name in sorted(shop_file_names(cam) | poses) if (folder / name).is_file()]
         for name in res.removed:
             (folder / name).unlink(missing_ok=True)
     return res

@@ -287,3 +287,21 @@ def test_bad_angle_or_poses_is_refused_before_any_work(args, tmp_path):
 
     assert main(["run", "-o", str(tmp_path / "o"), "--outputs", "dxf", *args]) == 2
     assert not (tmp_path / "o").exists()
+
+
+def test_an_unacceptable_rerun_removes_the_assembly_and_its_poses(tmp_path):
+    """The assembly (and any `--poses` files) are shop files: a rerun whose verdict is unacceptable removes
+    those an earlier run left, and keeps another design's."""
+    from camfab.cli import main
+    from camfab.formats import EXAMPLES_DIR
+
+    d = tmp_path / "bad.toml"  # ejemplo9rt on a 12 mm base circle: undercut, unacceptable
+    d.write_text((EXAMPLES_DIR / "ejemplo9rt.toml").read_text().replace("base_radius_mm = 35.0",
+                                                                       "base_radius_mm = 12.0"))
+    out = tmp_path / "out"
+    out.mkdir()
+    left = ["Ejemplo9RT_assembly.step", "Ejemplo9RT_assembly_pose1.step", "Ejemplo9RT_assembly_pose12.step"]
+    for name in [*left, "Other_assembly_pose1.step"]:
+        (out / name).write_text("an earlier run's file")
+    assert main(["run", str(d), "-o", str(out), "--outputs", "assembly"]) == 1
+    assert {p.name for p in out.iterdir() if p.suffix == ".step"} == {"Other_assembly_pose1.step"}
