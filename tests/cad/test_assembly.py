@@ -253,6 +253,12 @@ def test_assembly_table_is_validated():
     spec = dataclasses.replace(base, assembly=dataclasses.replace(base.assembly, pin_diameter_mm=10.0))
     with pytest.raises(SpecError, match="assembly.pin_diameter_mm"):
         assembly.dimensions(spec, camfab.Cam(spec).geometry)  # a 10 mm pin in a 10 mm roller
+    # a value given is the one built: a 6 mm wide roller on a 4 mm pin (defaults: 12 mm = the plate, 4 mm)
+    spec = dataclasses.replace(base, assembly=dataclasses.replace(base.assembly, roller_width_mm=6.0))
+    cam = camfab.Cam(spec)
+    parts = {n: wp.val() for n, wp, _, _ in assembly.build(spec, cam.geometry, cam.shapes().profiles, 0.0).items}
+    assert parts["roller"].BoundingBox().zlen == pytest.approx(6.0)
+    assert parts["pin"].BoundingBox().xlen == pytest.approx(4.0)
 
 
 def test_iges_reads_back_as_the_plate(tmp_path, monkeypatch):
