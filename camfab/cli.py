@@ -144,6 +144,10 @@ def _export_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--dxf", action="store_true", help="write the DXF drawing of the profile")
     p.add_argument("--step", action="store_true", help="write the STEP solid (needs cadquery)")
     p.add_argument("--stl", action="store_true", help="write the STL mesh")
+    p.add_argument("--assembly", action="store_true",
+                   help="write the mechanism as a STEP assembly: cam, shaft, follower, frame (needs cadquery)")
+    p.add_argument("--iges", action="store_true", help="write the plate as IGES for older CAM systems (needs cadquery)")
+    _assembly_args(p)
     p.add_argument("--tol", type=float, default=None,
                    help="max distance of every entity from the exact profile, mm (default: the design's, 0.001)")
     p.add_argument("--dxf-flavour", choices=("lwpolyline", "r12", "spline"), default="lwpolyline",
@@ -156,17 +160,18 @@ def _export_args(p: argparse.ArgumentParser) -> None:
 
 @register("export", "DXF, STEP and STL files within a measured tolerance of the exact profile", _export_args)
 def cmd_export(args: argparse.Namespace) -> int:
+    _check_assembly_args(args)
     cam = _cam(args.file)
-    formats = [f for f in ("dxf", "step", "stl") if getattr(args, f)] or \
-        [f for f in ("dxf", "step", "stl") if getattr(cam.spec.outputs, f)]
+    kinds = ("dxf", "step", "stl", "assembly", "iges")
+    formats = [f for f in kinds if getattr(args, f)] or [f for f in kinds if getattr(cam.spec.outputs, f)]
     if not formats:
-        raise UsageError("nothing to export: give --dxf, --step or --stl, or enable them in [outputs]")
+        raise UsageError("nothing to export: give --dxf, --step, --stl or --assembly, or enable them in [outputs]")
     tol = _tol(cam, args.tol)
     with output_folder(args.output) as folder:  # created, writable and locked before computing (else exit 3)
         if _refuse_unacceptable(cam, "export", args.force):
             return EXIT_CHECKS
         req = Request(frozenset(Output(f) for f in formats), tol=tol, dxf_flavour=args.dxf_flavour,
-                      tool_paths=args.tool_path)
+                      tool_paths=args.tool_path, angle=args.angle, poses=args.poses)
         arts = [a for out in pipeline.EXPORTERS if out in req.outputs for a in pipeline.EXPORTERS[out](cam, req)]
         targets = [inside(folder, a.filename) for a in arts]  # all proved inside -o before any write
         paths = write_all({t: a.data for t, a in zip(targets, arts, strict=True)})  # all files or none
@@ -331,6 +336,23 @@ def outputs_list(text: str | None) -> list[str] | None:
     return wanted
 
 
+def _assembly_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--angle", type=float, default=0.0, metavar="DEG",
+                   help="cam angle of the assembly STEP, degrees (mm of travel for a translating cam; default 0)")
+    p.add_argument("--poses", type=int, default=0, metavar="N",
+                   help="also write N assembly STEPs at equally spaced cam angles from --angle (a motion check "
+                        "in CAD; default 0)")
+
+
+def _check_assembly_args(args: argparse.Namespace) -> None:
+    """--angle and --poses refused at once when out of range (before any computing)."""
+    if not math.isfinite(args.angle) or abs(args.angle) > 1e6:
+        raise UsageError(f"--angle {args.angle}: must be a finite number of at most 1e6 (degrees; mm of travel "
+                         "for a translating cam)")
+    if not 0 <= args.poses <= pipeline.MAX_POSES:
+        raise UsageError(f"--poses {args.poses}: must be a whole number from 0 to {pipeline.MAX_POSES}")
+
+
 def _run_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("file", nargs="?", default=None,
                    help="design file (TOML or xlsx) or example name; default: the built-in example ejemplo9rt")
@@ -339,15 +361,17 @@ def _run_args(p: argparse.ArgumentParser) -> None:
                    ",".join(o.value for o in Output))
     p.add_argument("--tol", type=float, default=None, help="export tolerance, mm (default: the design's)")
     p.add_argument("--force", action="store_true", help="write shop artifacts even for an unacceptable design")
+    _assembly_args(p)
 
 
 @register("run", "the main job: every artifact the design's [outputs] asks for", _run_args)
 def cmd_run(args: argparse.Namespace) -> int:
+    _check_assembly_args(args)
     cam = _cam(args.file or "ejemplo9rt")
     outputs = outputs_list(args.outputs)
     _tol(cam, args.tol)
     req = Request.from_design(cam.spec, outputs, tol=args.tol, force=args.force,
-                              post="linuxcnc" if outputs is not None else None)
+                              post="linuxcnc" if outputs is not None else None, angle=args.angle, poses=args.poses)
     res = pipeline.run(cam, args.output, req, progress=lambda m: print(f"  ... {m}", file=sys.stderr))
     print(f"{plain(cam.name)}: verdict {res.verdict}; tolerance {res.tol:g} mm; {len(res.files)} file(s) in "
           f"{args.output}")
@@ -356,6 +380,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(f"  {name:<36}" + ("" if dev is None else f" max deviation {dev:.3g} mm"))
     if res.withheld:
         print(f"  withheld (verdict unacceptable, use --force): {', '.join(res.withheld)}")
+    if res.skipped:
+        print(f"  skipped (cadquery is missing: pip install cadquery): {', '.join(res.skipped)}")
     if res.removed:
         print(f"  removed (an earlier run's shop files; verdict unacceptable): {', '.join(res.removed)}")
     return _exit(Verdict(res.verdict))

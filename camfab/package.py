@@ -169,7 +169,7 @@ def _build(args: tuple) -> dict:
         _keep_other_files(folder, staging, Path(out), recorded, shop_file_names(cam))
         swap_dir(staging, folder)
         entry.update(status="unacceptable" if res.verdict == Verdict.UNACCEPTABLE else "ok", verdict=str(res.verdict),
-                     tolerance_mm=res.tol, withheld=res.withheld, timings=res.timings,
+                     tolerance_mm=res.tol, withheld=res.withheld, skipped=res.skipped, timings=res.timings,
                      folder=str(folder.relative_to(out)),
                      files=[_file_entry(folder / n, Path(out), res.deviations.get(n)) for n in sorted(res.files)])
         entry.update(cam_summary(spec, cam.geometry, cam.check(), res.deviations.values()))

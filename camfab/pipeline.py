@@ -15,6 +15,8 @@ command-line flags.
 from __future__ import annotations
 
 import json
+import logging
+import math
 import time
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field, replace
@@ -30,7 +32,7 @@ from .design.mechanisms import geometry_from_spec
 from .design.profile import CamGeometry, ProfileSample
 from .design.spec import DesignSpec
 from .discretize import validate_tol
-from .errors import GeometryError, InputError, Problem, SpecError
+from .errors import GeometryError, InputError, MissingDependencyError, Problem, SpecError
 from .formats import EXAMPLES_DIR, load_design, resolve_design_path
 from .io import atomic_write, inside, output_folder, safe_stem, write_all
 from .limits import MAX_SIZE_OVER_TOL
@@ -52,10 +54,21 @@ class Output(StrEnum):
     REPORT = "report"
     DRAWING = "drawing"
     PDF = "pdf"
+    ASSEMBLY = "assembly"
+    IGES = "iges"
 
 
 #: artifacts withheld for an unacceptable design unless the job is forced (in the order they are named)
-SHOP_OUTPUTS = (Output.DXF, Output.STEP, Output.STL, Output.GCODE, Output.DRAWING, Output.PDF, Output.LIFT_TABLE)
+SHOP_OUTPUTS = (Output.DXF, Output.STEP, Output.STL, Output.GCODE, Output.DRAWING, Output.PDF, Output.LIFT_TABLE,
+                Output.ASSEMBLY, Output.IGES)
+
+#: outputs a run skips, with a warning, when cadquery is missing (the rest is written)
+CAD_OUTPUTS = (Output.STEP, Output.ASSEMBLY, Output.IGES)
+
+#: most assembly poses one run writes (``--poses``)
+MAX_POSES = 360
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -77,6 +90,10 @@ class Request:
         Put the tool-centre paths on the DXF's TOOL_PATH layer; None = when G-code is asked for.
     machining : Mapping
         ``[machining]`` values given on the command line (None values are not given).
+    angle : float
+        The cam angle (degrees; mm of travel for a translating cam) of the assembly STEP.
+    poses : int
+        Also write this many assembly poses at equally spaced angles from ``angle`` (0: none).
     """
 
     outputs: frozenset[Output] = frozenset()
@@ -88,14 +105,16 @@ class Request:
     lift_step_deg: float = 1.0
     xlsx_step_deg: float = 1.0
     machining: Mapping[str, Any] = field(default_factory=dict)
+    angle: float = 0.0
+    poses: int = 0
 
     @classmethod
     def from_design(cls, spec: DesignSpec, outputs: Iterable[str] | None = None, **over: Any) -> Request:
         """The request a design's ``[outputs]`` table makes (``outputs`` replaces it), with overrides."""
         o = spec.outputs
         if outputs is None:
-            chosen = {Output(k) for k in ("dxf", "step", "stl", "lift_table", "xlsx", "report", "drawing", "pdf")
-                      if getattr(o, k)}
+            chosen = {Output(k) for k in ("dxf", "step", "stl", "lift_table", "xlsx", "report", "drawing", "pdf",
+                                          "assembly", "iges") if getattr(o, k)}
             if o.gcode:
                 chosen.add(Output.GCODE)
         else:
@@ -107,7 +126,8 @@ class Request:
         """The options that change the output (for incremental builds)."""
         return {"outputs": sorted(self.outputs), "post": self.post, "tol": self.tol, "force": self.force,
                 "dxf_flavour": self.dxf_flavour, "tool_paths": self.tool_paths, "lift_step_deg": self.lift_step_deg,
-                "xlsx_step_deg": self.xlsx_step_deg, "machining": dict(sorted(self.machining.items()))}
+                "xlsx_step_deg": self.xlsx_step_deg, "machining": dict(sorted(self.machining.items())),
+                "angle": self.angle, "poses": self.poses}
 
 
 @dataclass
@@ -123,6 +143,8 @@ class RunResult:
     tol: float = 0.0
     #: shop files an earlier run left in the folder, removed because the verdict is now unacceptable
     removed: list[str] = field(default_factory=list)
+    #: outputs skipped because a library is missing (cadquery: STEP and assembly), with a warning
+    skipped: list[str] = field(default_factory=list)
 
 
 # ---------------------------------------------------------------------------
@@ -237,6 +259,12 @@ class Cam:
     def to_step(self, path: str | Path, *, tol: float | None = None) -> Path:
         """The plate as a STEP solid, written to ``path`` (needs cadquery)."""
         arts = _step(self, Request(frozenset({Output.STEP}), tol=tol))
+        return atomic_write(path, arts[0].data)
+
+    def to_assembly(self, path: str | Path, *, angle: float = 0.0, tol: float | None = None) -> Path:
+        """The mechanism as a STEP assembly at cam ``angle`` (degrees; mm of travel for a translating cam),
+        written to ``path`` (needs cadquery; README, "CAD assemblies")."""
+        arts = _assembly(self, Request(frozenset({Output.ASSEMBLY}), tol=tol, angle=angle))
         return atomic_write(path, arts[0].data)
 
     def to_gcode(self, post: str | None = None, path: str | Path | None = None, *, tol: float | None = None,
@@ -362,6 +390,54 @@ def _step(cam: Cam, req: Request) -> list[Artifact]:
     return build_artifacts(cam.spec, cam.geometry, ["step"], tol=tol, shapes=cam.shapes(tol))
 
 
+def _iges(cam: Cam, req: Request) -> list[Artifact]:
+    """``<stem>.igs`` (``_cam1``/``_cam2`` for a pair): the plate for older CAM systems."""
+    from .cad import iges
+    from .cad.export import plate_of
+
+    shapes = cam.shapes(req.tol)
+    n = len(shapes.profiles)
+    return [Artifact(f"{safe_stem(cam.name)}{_suffix(i, n)}.igs",
+                     iges.dumps(loop, plate_of(cam.spec), name=f"{cam.name}{_suffix(i, n)}").encode("ascii"),
+                     "iges", loop.n_entities, dev)
+            for i, (loop, dev) in enumerate(zip(shapes.profiles, shapes.profile_deviation, strict=True))]
+
+
+def _assembly(cam: Cam, req: Request) -> list[Artifact]:
+    """``<stem>_assembly.step``: the mechanism at ``req.angle``; with ``req.poses`` = N, also N poses at
+    equally spaced angles, ``<stem>_assembly_pose<k>.step``."""
+    from .cad import assembly
+
+    shapes = cam.shapes(req.tol)
+    axis, geometry = cam.geometry.axis, cam.geometry
+    if not math.isfinite(req.angle) or abs(req.angle) > 1e6:
+        raise InputError(f"--angle {req.angle}: must be a finite number of at most 1e6 (degrees; mm of travel "
+                         "for a translating cam)")
+    if not 0 <= req.poses <= MAX_POSES:
+        raise InputError(f"--poses {req.poses}: must be a whole number from 0 to {MAX_POSES}")
+    span = float(axis.to_user(geometry.period))
+    if not geometry.closed and not 0.0 <= req.angle <= span:
+        raise InputError(f"--angle {req.angle:g}: a translating cam's position is its travel in mm, from 0 to "
+                         f"its length {span:g}")
+    stem = safe_stem(cam.name)
+    dims = assembly.dimensions(cam.spec, geometry)
+    outlines = list(shapes.profiles)
+    dev = max(shapes.profile_deviation)
+
+    def one(user: float) -> bytes:
+        x = float(axis.from_user(user % span))
+        return assembly.dumps(cam.spec, geometry, outlines, x, dims=dims).encode("utf-8")
+
+    out = [Artifact(f"{stem}_assembly.step", one(req.angle), "step", None, dev,
+                    f"the mechanism at {req.angle:g}{axis.x_symbol}")]
+    width = len(str(req.poses))
+    for k in range(req.poses):
+        at = req.angle + k * span / req.poses
+        out.append(Artifact(f"{stem}_assembly_pose{k + 1:0{width}d}.step", one(at), "step", None, dev,
+                            f"pose {k + 1} of {req.poses}: {at:g}{axis.x_symbol}"))
+    return out
+
+
 def _gcode(cam: Cam, req: Request) -> list[Artifact]:
     from .gcode import dumps
     from .gcode.cam import cam_program
@@ -427,6 +503,8 @@ EXPORTERS: dict[Output, Stage] = {
     Output.DXF: _dxf,
     Output.STL: _stl,
     Output.STEP: _step,
+    Output.ASSEMBLY: _assembly,
+    Output.IGES: _iges,
     Output.DRAWING: _drawing,
     Output.PDF: _pdf,
     Output.GCODE: _gcode,
@@ -467,7 +545,15 @@ def _run(cam: Cam, folder: Path, req: Request, res: RunResult, say: Callable[[st
     _timed(res, "geometry", say, lambda: cam.geometry)
     files: dict[str, bytes] = {"check.json": (json.dumps(report.to_dict(), indent=2) + "\n").encode()}
     for out in wanted:
-        for art in _timed(res, str(out), say, EXPORTERS[out], cam, req):
+        try:
+            arts = _timed(res, str(out), say, EXPORTERS[out], cam, req)
+        except MissingDependencyError as exc:
+            if out not in CAD_OUTPUTS:
+                raise
+            log.warning("%s: %s skipped: %s; the other files are written", cam.name, out, exc)
+            res.skipped.append(str(out))
+            continue
+        for art in arts:
             files[art.filename] = art.data
             if art.kind != "report":
                 res.deviations[art.filename] = art.deviation_mm
@@ -476,7 +562,8 @@ def _run(cam: Cam, folder: Path, req: Request, res: RunResult, say: Callable[[st
     written = write_all({paths[n]: files[n] for n in names})
     res.files = dict(zip(names, written, strict=True))
     if refused:  # a shop must never find G-code beside an unacceptable verdict
-        res.removed = [name for name in sorted(shop_file_names(cam)) if (folder / name).is_file()]
+        poses = {p.name for p in folder.glob(f"{safe_stem(cam.name)}_assembly_pose*.step")}  # any --poses N
+        res.removed = [name for name in sorted(shop_file_names(cam) | poses) if (folder / name).is_file()]
         for name in res.removed:
             (folder / name).unlink(missing_ok=True)
     return res
@@ -489,8 +576,8 @@ def shop_file_names(cam: Cam) -> set[str]:
     n = len(cam.geometry.profiles)
     per_profile = [f"{stem}{_suffix(i, n)}" for i in range(n)]
     names = {f"{stem}.dxf", f"{stem}_drawing.dxf", f"{stem}_drawing.pdf", f"{stem}_lift.csv",
-             *([f"{stem}_pair.step"] if n > 1 else [])}
-    return names | {f"{s}.{ext}" for s in per_profile for ext in ("stl", "step", "nc")}
+             f"{stem}_assembly.step", *([f"{stem}_pair.step"] if n > 1 else [])}
+    return names | {f"{s}.{ext}" for s in per_profile for ext in ("stl", "step", "nc", "igs")}
 
 
 def _timed(res: RunResult, stage: str, say: Callable[[str], None], fn: Callable[..., Any], *args: Any) -> Any:

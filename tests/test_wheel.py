@@ -146,14 +146,13 @@ def test_the_wheel_installs_and_runs_from_another_folder(tmp_path):
     elsewhere = tmp_path / "elsewhere"  # not the checkout
     elsewhere.mkdir()
     camfab = bindir / ("camfab.exe" if os.name == "nt" else "camfab")
-    # the designs' own [outputs] (no STEP in either: cadquery is slow and not where templates or examples matter)
+    # the designs' own [outputs]: the built-in example writes its STEP and the assembly STEP (cadquery is a dependency)
     _sh([camfab, "run", "-o", "out"], cwd=elsewhere)  # the built-in example
     _sh([camfab, "run", "valve_exhaust_ej1", "-o", "out2"], cwd=elsewhere)  # an example with a knot file
     for out, name in (("out", "Ejemplo9RT"), ("out2", "ValveExhaustEj1")):
         made = {p.relative_to(elsewhere / out).as_posix() for p in (elsewhere / out).rglob("*") if p.is_file()}
         assert {"report.html", "check.json", f"{name}.dxf", f"{name}_drawing.dxf", f"{name}_drawing.pdf",
-                "plots/profile.svg"} <= made, \
-            (out, sorted(made))
+                "plots/profile.svg", f"{name}.step", f"{name}_assembly.step"} <= made, (out, sorted(made))
         assert b"<!DOCTYPE html>" in (elsewhere / out / "report.html").read_bytes()[:100]
 
     api = json.loads(_sh([python, "-c", _API, "api_out"], cwd=elsewhere).stdout)

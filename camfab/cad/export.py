@@ -25,8 +25,9 @@ from ..offset.cutter import pitch_curve, profile_curve, tool_centre_path
 from . import dxf as dxf_mod
 from . import step, stl
 from .plate import PlateSpec, bore_loop
+from .stepheader import design_meta
 
-__all__ = ["Artifact", "CamShapes", "cam_shapes", "build_artifacts", "write_artifacts", "FORMATS"]
+__all__ = ["Artifact", "CamShapes", "cam_shapes", "build_artifacts", "write_artifacts", "FORMATS", "plate_of"]
 
 FORMATS = ("dxf", "step", "stl")
 
@@ -107,9 +108,13 @@ def _pitch_loop(profile: ArcChain, roller_radius: float, pitch, tol: float) -> A
     return arcs(pitch, tol=tol)
 
 
-def _plate(spec) -> PlateSpec:
+def plate_of(spec) -> PlateSpec:
+    """The plate a design's ``[manufacturing]`` describes."""
     m = spec.manufacturing
     return PlateSpec(m.thickness_mm, m.bore_mm, m.keyway, m.hub_diameter_mm, m.hub_length_mm)
+
+
+_plate = plate_of
 
 
 def _suffix(i: int, n: int) -> str:
@@ -155,12 +160,12 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
     if "step" in formats:
         for i, (loop, dev) in enumerate(zip(shapes.profiles, shapes.profile_deviation, strict=True)):
             say(f"STEP{_suffix(i, n)}")
-            text = step.dumps(loop, plate, name=f"{spec.name}{_suffix(i, n)}")
+            text = step.dumps(loop, plate, name=f"{spec.name}{_suffix(i, n)}", meta=design_meta(spec))
             out.append(Artifact(f"{safe_stem(spec.name)}{_suffix(i, n)}.step", text.encode("utf-8"), "step",
                                 loop.n_entities, dev))
         if n > 1:
             say("STEP pair on the shaft")
-            text = step.stack_dumps(shapes.profiles, plate, name=f"{spec.name}_pair")
+            text = step.stack_dumps(shapes.profiles, plate, name=f"{spec.name}_pair", meta=design_meta(spec))
             out.append(Artifact(f"{safe_stem(spec.name)}_pair.step", text.encode("utf-8"), "step",
                                 sum(lp.n_entities for lp in shapes.profiles), max(shapes.profile_deviation),
                                 "both cams positioned along the shaft"))

@@ -13,16 +13,23 @@ from ..errors import MissingDependencyError
 from ..geom2d import ArcChain, bulge_midpoint
 from ..textsafe import step_string
 from .plate import PlateSpec
+from .stepheader import StepMeta, header_dumps
 
-__all__ = ["plate_solid", "dumps", "stack_dumps"]
+__all__ = ["plate_solid", "dumps", "stack_dumps", "canonical_reals", "cadquery"]
 
 
-def _cq():
+def cadquery():
+    """The cadquery module (MissingDependencyError when it is not installed: it is a dependency of camfab,
+    but an install may lack it)."""
     try:
         import cadquery as cq
     except ImportError as exc:
-        raise MissingDependencyError("STEP export needs the 'step' extra: pip install camfab[step]") from exc
+        raise MissingDependencyError("STEP export needs cadquery, a dependency of camfab that this install lacks: "
+                                     "pip install cadquery (or reinstall camfab)") from exc
     return cq
+
+
+_cq = cadquery
 
 
 def _wire(cq, loop: ArcChain, z: float = 0.0):
@@ -47,28 +54,35 @@ def plate_solid(outline: ArcChain, plate: PlateSpec):
     return body
 
 
-def dumps(outline: ArcChain, plate: PlateSpec, *, name: str = "cam") -> str:
-    """STEP (AP214) text of the plate, in millimetres, byte-identical for the same input."""
-    return _export(plate_solid(outline, plate), name)
+def dumps(outline: ArcChain, plate: PlateSpec, *, name: str = "cam", meta: StepMeta | None = None) -> str:
+    """STEP (AP214) text of the plate, in millimetres, byte-identical for the same input (header: ``meta``, by
+    default derived from ``name``, :mod:`.stepheader`)."""
+    return _export(plate_solid(outline, plate), name, meta)
 
 
-def stack_dumps(outlines, plate: PlateSpec, *, gap_mm: float = 2.0, name: str = "cam") -> str:
+def stack_dumps(outlines, plate: PlateSpec, *, gap_mm: float = 2.0, name: str = "cam",
+                meta: StepMeta | None = None) -> str:
     """Several plates on one shaft (a conjugate pair): plate i at z = i·(thickness + hub + gap)."""
     cq = _cq()
     pitch = plate.thickness_mm + (plate.hub_length_mm or 0.0) + gap_mm
     solids = [plate_solid(o, plate).val().translate(cq.Vector(0, 0, i * pitch)) for i, o in enumerate(outlines)]
-    return _export(cq.Workplane("XY").add(cq.Compound.makeCompound(solids)), name)
+    return _export(cq.Workplane("XY").add(cq.Compound.makeCompound(solids)), name, meta)
 
 
-def _export(solid, name: str) -> str:
+def _export(solid, name: str, meta: StepMeta | None = None) -> str:
     cq = _cq()
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "cam.step"  # never a path built from the name
         cq.exporters.export(solid, str(path), "STEP")
         text = path.read_text(encoding="utf-8", errors="replace")
-    text = re.sub(r"(FILE_NAME\('[^']*',)'[^']*'", r"\1'1970-01-01T00:00:00'", text, count=1)
+    text = header_dumps(text, name, meta)  # camfab's header: name, organisation, reproducible timestamp
     product = step_string(name)  # the full name, as an ISO 10303-21 string (a function: no backslash expansion)
     text = re.sub(r"Open CASCADE STEP translator [0-9.]+ [0-9]+", lambda m: product, text)
+    return canonical_reals(text)
+
+
+def canonical_reals(text: str) -> str:
+    """``text`` with every real of its DATA section rounded to 12 significant digits (see below)."""
     head, sep, data = text.partition("DATA;")
     return head + sep + _REAL.sub(_canonical_real, data)
 

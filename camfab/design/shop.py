@@ -17,8 +17,8 @@ from typing import Any
 from ..tolerances import DEFAULT_EXPORT_TOL_MM, MAX_EXPORT_TOL_MM, MIN_EXPORT_TOL_MM
 from .validator import Validator
 
-__all__ = ["POSTS", "Post", "ManufacturingSpec", "MachiningSpec", "OutputsSpec", "manufacturing_section",
-           "machining_section", "outputs_section"]
+__all__ = ["POSTS", "Post", "ManufacturingSpec", "MachiningSpec", "OutputsSpec", "AssemblySpec", "ASSEMBLY_KEYS",
+           "manufacturing_section", "machining_section", "outputs_section", "assembly_section"]
 
 
 class Post(StrEnum):
@@ -33,7 +33,8 @@ POSTS = tuple(p.value for p in Post)
 
 _MFG_KEYS = ("thickness_mm", "bore_mm", "keyway", "hub_diameter_mm", "hub_length_mm",
              "tool_diameter_mm", "tolerance_mm", "material")
-_OUTPUT_KEYS = ("dxf", "step", "stl", "gcode", "report", "xlsx", "drawing", "lift_table", "pdf")
+_OUTPUT_KEYS = ("dxf", "step", "stl", "gcode", "report", "xlsx", "drawing", "lift_table", "pdf", "assembly",
+                "iges")
 
 
 @dataclass(frozen=True, slots=True)
@@ -91,7 +92,7 @@ class OutputsSpec:
     """``[outputs]``: what ``camfab run`` produces for this design."""
 
     dxf: bool = True
-    step: bool = False
+    step: bool = True
     stl: bool = False
     gcode: str | None = None
     report: bool = True
@@ -100,6 +101,33 @@ class OutputsSpec:
     lift_table: bool = False
     #: the drawing sheet as PDF too (``<stem>_drawing.pdf``); when the file does not say, as ``drawing``
     pdf: bool = False
+    #: the mechanism as a STEP assembly (``<name>_assembly.step``); when the table does not say, as ``step``
+    assembly: bool = True
+    #: the plate as IGES (``<name>.igs``) for older CAM systems
+    iges: bool = False
+
+
+@dataclass(frozen=True, slots=True)
+class AssemblySpec:
+    """``[assembly]``: follower dimensions the design does not give, for the assembly STEP (mm).
+
+    None = derived from the design (``camfab.cad.assembly.dimensions``, ``docs/decisions.md``, "Assembly
+    STEP"): roller width = plate thickness, pin = 0.4 × roller diameter, stem = 0.8 × roller diameter …
+    """
+
+    roller_width_mm: float | None = None
+    pin_diameter_mm: float | None = None
+    stem_diameter_mm: float | None = None
+    arm_width_mm: float | None = None
+    arm_thickness_mm: float | None = None
+    face_thickness_mm: float | None = None
+    pivot_diameter_mm: float | None = None
+    clearance_mm: float | None = None
+
+
+#: [assembly] keys, each a positive length with its upper bound (mm)
+ASSEMBLY_KEYS = {"roller_width_mm": 1e4, "pin_diameter_mm": 1e4, "stem_diameter_mm": 1e4, "arm_width_mm": 1e4,
+                 "arm_thickness_mm": 1e4, "face_thickness_mm": 1e4, "pivot_diameter_mm": 1e4, "clearance_mm": 1e3}
 
 
 def manufacturing_section(v: Validator, t: Mapping[str, Any], base_radius_mm: float | None,
@@ -174,6 +202,14 @@ def outputs_section(v: Validator, t: Mapping[str, Any]) -> OutputsSpec:
         post = None
     defaults = OutputsSpec()
     flags = {k: v.boolean(t, k, "outputs", getattr(defaults, k))
-             for k in ("dxf", "step", "stl", "report", "xlsx", "drawing", "lift_table")}
+             for k in ("dxf", "step", "stl", "report", "xlsx", "drawing", "lift_table", "iges")}
     flags["pdf"] = v.boolean(t, "pdf", "outputs", flags["drawing"])
+    flags["assembly"] = v.boolean(t, "assembly", "outputs", flags["step"])  # follows step unless given
     return OutputsSpec(gcode=post, **flags)
+
+
+def assembly_section(v: Validator, t: Mapping[str, Any]) -> AssemblySpec:
+    """``[assembly]``: positive lengths within their bounds (mm); what is not given is derived later."""
+    v.keys(t, tuple(ASSEMBLY_KEYS), "assembly")
+    return AssemblySpec(**{k: v.number(t, k, "assembly", None, lo=0.0, lo_open=True, hi=hi)
+                           for k, hi in ASSEMBLY_KEYS.items()})

@@ -27,9 +27,11 @@ from .mechanisms import MECHANISMS, mechanism_class, mechanism_from_spec
 from .program import TWO_PI, MotionProgram, SegmentInput, build_program
 from .shop import (
     POSTS,
+    AssemblySpec,
     MachiningSpec,
     ManufacturingSpec,
     OutputsSpec,
+    assembly_section,
     machining_section,
     manufacturing_section,
     outputs_section,
@@ -43,6 +45,7 @@ __all__ = [
     "ManufacturingSpec",
     "MachiningSpec",
     "OutputsSpec",
+    "AssemblySpec",
     "DynamicsSpec",
     "DesignSpec",
     "design_from_dict",
@@ -52,7 +55,7 @@ __all__ = [
 
 
 _TOP_KEYS = ("name", "description", "cam", "follower", "motion", "motion_table", "manufacturing", "machining",
-             "outputs", "checks", "dynamics")
+             "outputs", "checks", "dynamics", "assembly")
 _CAM_KEYS = ("kind", "rotation", "direction", "speed_rpm", "omega_rad_s", "speed_mm_s")
 _FOLLOWER_FLOATS = ("base_radius_mm", "roller_radius_mm", "offset_mm", "pivot_distance_mm",
                     "arm_length_mm", "face_offset_mm", "follower_distance_mm",
@@ -177,6 +180,7 @@ class DesignSpec:
     face_margin_mm: float = 0.0
     dynamics: DynamicsSpec | None = None
     machining: MachiningSpec = field(default_factory=MachiningSpec)
+    assembly: AssemblySpec = field(default_factory=AssemblySpec)
 
     @property
     def is_translating_cam(self) -> bool:
@@ -300,6 +304,7 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
                                 cam.kind == CamKind.TRANSLATING)
     out = outputs_section(v, v.table(data, "outputs"))
     machining = machining_section(v, v.table(data, "machining"))
+    assembly = assembly_section(v, v.table(data, "assembly"))
     _depth_levels(v, mfg, machining)
     checks = v.table(data, "checks")
     v.keys(checks, _CHECK_KEYS, "checks")
@@ -308,7 +313,7 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
     dyn = _dynamics(v, data, cam, fol)
     return DesignSpec(name.strip(), cam, fol, motion, table, mfg, out, pressure_angle_limit_deg=pa,
                       description=str(data.get("description", "")), source=source, face_margin_mm=margin,
-                      dynamics=dyn, machining=machining)
+                      dynamics=dyn, machining=machining, assembly=assembly)
 
 
 def _depth_levels(v: Validator, mfg: ManufacturingSpec, machining: MachiningSpec) -> None:
