@@ -5,12 +5,14 @@ load per tooth ``fz`` (mm, by tool-diameter band) for each work material and too
 and the usual number of flutes per work material.  Then
 
 * ``n = 1000 * vc / (pi * D)`` rpm, rounded to a whole rpm; above the machine's ``max_spindle_rpm`` the
-  maximum is used and the feed follows it at the same chip load (and the program header says so);
+  maximum is used and the feed follows it at the same chip load (and the program header says so:
+  ``spindle LIMITED: ...``);
 * ``feed = fz * z * n`` mm/min;
 * ``plunge = plunge_fraction * feed``: the feed of every move that descends.
 
 Every value the design gives (``spindle_rpm``, ``feed_mm_min``, ``plunge_feed_mm_min``, ``tool_flutes``)
-wins over the table.  :attr:`CuttingData.notes` are the header lines that say where each number came from.
+wins over the table.  :attr:`CuttingData.notes` are the header lines that say where each number came from, each
+at most 60 characters (what a Fanuc comment keeps).
 
 Examples
 --------
@@ -114,7 +116,7 @@ def cutting_data(*, tool_diameter_mm: float, material: str = "", tool_material: 
                                 "lower spindle_rpm or raise max_spindle_rpm"), source)
     if spindle_rpm is not None and feed_mm_min is not None and plunge_feed_mm_min is not None:
         return CuttingData(float(spindle_rpm), float(feed_mm_min), float(plunge_feed_mm_min), flutes,
-                           ("cutting data: spindle speed, feed and plunge feed given in the design, machining table",))
+                           ("cutting data: rpm, feed and plunge feed given",))
     if tool_material not in TOOL_MATERIALS:
         raise SpecError(Problem("machining.tool_material", tool_material, "is not a valid option",
                                 "must be one of: " + ", ".join(TOOL_MATERIALS)), source)
@@ -138,33 +140,33 @@ def cutting_data(*, tool_diameter_mm: float, material: str = "", tool_material: 
     z = int(flutes) if flutes is not None else int(row["flutes"])
     band_lo = lo if band == 0 else edges[band - 1]
     if not text:
-        notes.append(f"material: not given in the design, manufacturing.material, so {name} is assumed")
-    notes.append(f"cutting data from the camfab table: {name}, {row['description']}")
-    notes.append(f"cutting data: {tool_material} end mill, {z} flutes{'' if flutes is None else ' as given'}, "
-                 f"vc {vc:g} m/min, fz {fz:g} mm for D over {band_lo:g} to {edges[band]:g} mm")
+        notes.append(f"material: not given in the design, {name} assumed")
+    notes.append(f"cutting data: camfab table, {name}")
+    notes.append(f"material: {row['description']}")
+    notes.append(f"tool: {tool_material}, {z} flutes{' as given' if flutes is not None else ''}")
+    notes.append(f"table: vc {vc:g} m/min, fz {fz:g} mm for D {band_lo:g}-{edges[band]:g} mm")
     n_table = 1000.0 * vc / (math.pi * D)
     if spindle_rpm is not None:
         n = float(spindle_rpm)
-        notes.append(f"spindle: {n:g} rpm given in the design, table {n_table:.0f} rpm")
+        notes.append(f"spindle: {n:g} rpm given, table {n_table:.0f} rpm")
     elif max_spindle_rpm is not None and round(n_table) > max_spindle_rpm:
         n = float(math.floor(max_spindle_rpm))
-        notes.append(f"spindle: the table speed {n_table:.0f} rpm exceeds the machine's max_spindle_rpm "
-                     f"{max_spindle_rpm:g}: {n:g} rpm used, feed recomputed at the same chip load, "
-                     f"cutting speed {math.pi * D * n / 1000.0:.0f} m/min")
+        notes.append(f"spindle LIMITED: table {n_table:.0f} rpm over machine max {max_spindle_rpm:g}")
+        notes.append(f"spindle: {n:g} rpm, feed at the same fz, vc {math.pi * D * n / 1000.0:.0f} m/min")
     else:
         n = float(round(n_table))
         notes.append(f"spindle: n = 1000 vc / pi D = {n:g} rpm")
     if feed_mm_min is not None:
         feed = float(feed_mm_min)
-        notes.append(f"feed: {feed:g} mm/min given in the design")
+        notes.append(f"feed: {feed:g} mm/min given")
     else:
         feed = fz * z * n
-        notes.append(f"feed: fz x z x n = {fz:g} x {z} x {n:g} = {feed:.1f} mm/min")
+        notes.append(f"feed = fz x z x n = {fz:g} x {z} x {n:g} = {feed:.1f} mm/min")
     frac = float(data["plunge_fraction"])
     if plunge_feed_mm_min is not None:
         plunge = float(plunge_feed_mm_min)
-        notes.append(f"plunge feed: {plunge:g} mm/min given in the design")
+        notes.append(f"plunge feed: {plunge:g} mm/min given")
     else:
         plunge = frac * feed
-        notes.append(f"plunge feed, every descending move: {frac:g} x feed = {plunge:.1f} mm/min")
+        notes.append(f"plunge/helix feed = {frac:g} x feed = {plunge:.1f} mm/min")
     return CuttingData(n, feed, plunge, z, tuple(notes))

@@ -67,9 +67,9 @@ def _points(segs) -> np.ndarray:
                            else np.array([s.start, s.end]) for s in segs])
 
 
-def stock_outline(segs, job: Job, part_offset: float) -> tuple[dict, str]:
+def stock_outline(segs, job: Job, part_offset: float) -> tuple[dict, list[str]]:
     """The blank around the part: ``{"shape": "round", "radius": R}`` centred on the axis, or ``{"shape":
-    "plate", "box": (xmin, ymin, xmax, ymax)}``, and its header line.
+    "plate", "box": (xmin, ymin, xmax, ymax)}``, and its header lines.
 
     ``segs`` is the contour the program follows, ``part_offset`` its distance from the part (the tool radius
     for a tool-centre path, 0 for a compensated part contour).  A derived blank is the part plus
@@ -91,20 +91,18 @@ def stock_outline(segs, job: Job, part_offset: float) -> tuple[dict, str]:
                 raise SpecError(Problem("machining.stock_diameter_mm", D, f"is smaller than the part "
                                         f"(largest diameter {2 * r_part:.3f} mm)",
                                         f"give at least {math.ceil(2 * r_part):g} mm, or leave it out"))
-            how = "stock_diameter_mm"
+            how = "stock: diameter given in the design"
         else:
             D = float(math.ceil(2 * (r_part + a) - 1e-9))
-            how = f"largest part diameter {2 * r_part:.3f} mm + 2 x {a:g} mm allowance, rounded up"
-        return {"shape": "round", "radius": 0.5 * D}, f"stock: round blank D{D:g} x {t:g} mm centred on the cam " \
-            f"axis X0 Y0, {how}"
+            how = f"stock: part D{2 * r_part:.3f} + 2 x {a:g} mm, rounded up"
+        return {"shape": "round", "radius": 0.5 * D}, [f"stock: round blank D{D:g} x {t:g} mm on the axis X0 Y0", how]
     lo = pts.min(axis=0) + part_offset
     hi = pts.max(axis=0) - part_offset
     c = 0.5 * (lo + hi)
     size = np.ceil(hi - lo + 2 * a - 1e-9)
     box = (float(c[0] - size[0] / 2), float(c[1] - size[1] / 2), float(c[0] + size[0] / 2), float(c[1] + size[1] / 2))
-    return {"shape": "plate", "box": box}, (f"stock: plate blank {size[0]:g} x {size[1]:g} x {t:g} mm, X{box[0]:.3f} "
-                                            f"to X{box[2]:.3f}, Y{box[1]:.3f} to Y{box[3]:.3f}, part + {a:g} mm "
-                                            "allowance all round, rounded up")
+    return {"shape": "plate", "box": box}, [f"stock: plate blank {size[0]:g} x {size[1]:g} x {t:g} mm, part + {a:g} mm",
+                                            f"stock: X{box[0]:.3f} to X{box[2]:.3f}, Y{box[1]:.3f} to Y{box[3]:.3f}"]
 
 
 def _exit_distance(stock: dict, q: np.ndarray, n: np.ndarray, margin: float) -> float:
@@ -172,11 +170,11 @@ def _bore_items(job: Job) -> tuple[list[Item], list[str]]:
     items.append(Comment("BORE RETRACT"))
     items += [Feed(R, 0.0, job.clearance_mm, job.plunge_feed_mm_min), Rapid(R, 0.0, job.safe_z_mm)]
     angle = math.degrees(math.atan2(p, TWO_PI * R))
-    notes = [f"bore: D{job.bore_mm:g} milled first by a {'counter-' if ccw else ''}clockwise helix of radius "
-             f"{R:.4f} mm, pitch {p:.4f} mm ({angle:.2f} deg), {turns} turns, then a finishing circle at full depth"]
+    notes = [f"bore: D{job.bore_mm:g} first, {'ccw' if ccw else 'cw'} helix radius {R:.4f} mm",
+             f"bore: pitch {p:.4f} mm, {angle:.2f} deg, {turns} turns, finish circle"]
     core = job.bore_mm - 2 * job.tool_diameter_mm
     if core > 0:
-        notes.append(f"bore: the helix leaves a free core D{core:.3f} mm that drops out at breakthrough")
+        notes.append(f"bore: leaves a free core D{core:.3f} mm, falls at breakthrough")
     return items, notes
 
 
@@ -327,12 +325,11 @@ def contour_toolpath(path_entities, job: Job, *, roughing_contours=None,
     if job.coolant != "off":
         items.append(Coolant(job.coolant))
     part_offset = 0.0 if compensation else r_tool
-    stock, stock_line = stock_outline(finish, job, part_offset)
-    notes = [*job.notes, stock_line,
-             f"depth: plate {job.depth_mm - job.breakthrough_mm:g} mm + breakthrough {job.breakthrough_mm:g} mm = "
-             f"final depth {job.depth_mm:g} mm below the stock top",
-             f"entry: every pass plunges outside the stock, tool {ENTRY_CLEARANCE_MM:g} mm clear of the blank, "
-             "and feeds in horizontally to its lead-in"]
+    stock, stock_lines = stock_outline(finish, job, part_offset)
+    notes = [*job.notes, *stock_lines,
+             f"depth: plate {job.depth_mm - job.breakthrough_mm:g} + breakthrough {job.breakthrough_mm:g} = "
+             f"{job.depth_mm:g} mm",
+             "entry: plunge outside the stock, feed in horizontally"]
     items += bore_items
     notes += bore_notes
     z_clear = job.clearance_mm
