@@ -316,7 +316,8 @@ def _depth_levels(v: Validator, mfg: ManufacturingSpec, machining: MachiningSpec
     "Input limits")."""
     depth, step = mfg.thickness_mm + machining.breakthrough_mm, machining.step_down_mm
     if depth / step > MAX_DEPTH_LEVELS:
-        v.add("machining.step_down_mm", step, f"cuts the {depth:g} mm plate in more than {MAX_DEPTH_LEVELS} depth "
+        v.add("machining.step_down_mm", step, f"cuts the {depth:g} mm depth (plate and breakthrough) in more than "
+              f"{MAX_DEPTH_LEVELS} depth "
               "levels (the input limit)", f"give a step-down of at least {depth / MAX_DEPTH_LEVELS:.3g} mm")
 
 

@@ -165,6 +165,13 @@ def test_verify_checks_the_bore_against_its_wall(tmp_path):
     lines.insert(i + 1, "G1 X3.0500")
     rep = verify_cam_program("\n".join(lines) + "\n", contact, job, tol=TOL)
     assert {"GOUGE"} <= {str(c) for c in rep.codes()}
+    # the helix is a descending move: it must carry the plunge feed, not the cutting feed
+    lines = text.splitlines()
+    i = next(k for k, t in enumerate(lines) if t.startswith("G3") and " Z" in t)
+    lines[i] += f" F{job.feed_mm_min:.1f}"
+    lines[i + 1] += f" F{job.plunge_feed_mm_min:.1f}"
+    rep = verify_cam_program("\n".join(lines) + "\n", contact, job, tol=TOL)
+    assert {str(c) for c in rep.codes()} == {"FEED_OUT_OF_RANGE"} and rep.problems[0].line == i + 1
     # the same program checked as if the job had no bore: the bore moves cut the part
     plain = pipeline.gcode_job(cam.spec, tol=TOL)
     assert "GOUGE" in {str(c) for c in verify_cam_program(text, contact, plain, tol=TOL).codes()}
