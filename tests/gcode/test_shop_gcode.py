@@ -132,6 +132,14 @@ def test_no_plunge_into_the_blank(tmp_path, post):
     for mv in vertical:
         assert blank.distance(shapely.Point(mv.end[:2])) >= 3.0 + ENTRY_CLEARANCE_MM - 1e-3
     assert all(mv.label.startswith("BORE HELIX") for mv in plunges if mv not in vertical)
+    # every pass feeds in along one line (the roughing levels cut the slot the finishing pass at full depth follows)
+    entries = [mv for mv in moves if mv.kind == "line" and (mv.label or "").endswith("LEAD-IN")
+               and abs(mv.end[2] - mv.start[2]) < 1e-9]
+    assert len(entries) == len(vertical)
+    a = np.array(entries[-1].start[:2])
+    d = (np.array(entries[-1].end[:2]) - a) / math.dist(entries[-1].end[:2], a)
+    off = [abs(d[0] * (p[1] - a[1]) - d[1] * (p[0] - a[0])) for mv in entries for p in (mv.start, mv.end)]
+    assert max(off) < 0.01
 
 
 def test_the_bore_is_milled_by_a_helix_and_a_finishing_circle(tmp_path):
