@@ -2,10 +2,10 @@
 and ``[outputs]`` (what ``camfab run`` writes) — their values and their validation.
 
 Every reader collects its problems in a :class:`~camfab.design.validator.Validator` (field path, value,
-rule, fix); nothing here raises.  The defaults of ``[machining]`` are the values ``camfab gcode`` used
-before the table existed, so a design without it cuts the same program as before; command-line flags
-override it (``camfab.pipeline.gcode_job``), so ``gcode``, ``run`` and ``package`` cut the same program
-for the same inputs.
+rule, fix); nothing here raises.  ``[machining]`` leaves spindle speed and feeds unset by default: the
+G-code takes them from the cutting-data table (``camfab.gcode.cutting``); command-line flags override it
+(``camfab.pipeline.gcode_job``), so ``gcode``, ``run`` and ``package`` cut the same program for the same
+inputs.
 """
 from __future__ import annotations
 
