@@ -216,7 +216,7 @@ def bore_findings(moves, bore: list[int], job: Job, tol: float, step: float, sam
         out.append(Finding.at_line(IssueCode.GOUGE, f"the bore moves take the tool {over[w]:.4f} mm beyond the wall of "
                                    f"the D{job.bore_mm:g} bore: lines {line_list(lines)}", lines[0]))
     z_final = -job.depth_mm
-    fin = (smp.points[:, 2] <= z_final + EPS_Z) & np.array(
+    fin = (smp.points[:, 2] <= z_final + tol) & np.array(
         [(moves[bore[int(k)]].label or "").upper().startswith(BORE_LABEL + " FINISH") for k in smp.index])
     if not fin.any():
         out.append(Finding.at_line(IssueCode.FINISH_DEPTH, f"no finishing circle of the bore at the final depth "

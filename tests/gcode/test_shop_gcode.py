@@ -218,3 +218,14 @@ def test_linuxcnc_reads_the_helix_and_the_entry(tmp_path):
     helix = re.findall(r"ARC_FEED\(([^)]*)\)", out)
     zs = [float(a.split(",")[5]) for a in helix]
     assert min(zs) == pytest.approx(-10.5, abs=1e-4) and len(set(np.round(zs, 4))) > 10
+
+
+def test_a_conventional_inch_program_with_its_bore_verifies(tmp_path, capsys):
+    """Conventional milling runs the bore clockwise; in inch the depths read back within the rounding."""
+    p = design(tmp_path, machining="mill_bore = true\ndirection = \"conventional\"\nunits = \"inch\"")
+    text = program(p)
+    helix = [m for m in parse(text).moves if m.kind == "arc" and m.label.startswith("BORE")]
+    assert helix and all(m.clockwise for m in helix)
+    assert min(m.end[2] for m in helix) == pytest.approx(-10.5, abs=2.54e-4)  # 5 decimals of an inch
+    capsys.readouterr()
+    assert main(["verify", str(p.with_suffix(".nc")), "--design", str(p), "--tol", str(TOL)]) == 0
