@@ -185,12 +185,53 @@ def cmd_export(args: argparse.Namespace) -> int:
 
 
 # ---------------------------------------------------------------------------
-#: ``camfab gcode`` flags that override ``[machining]`` (flag dest → [machining] key)
-_MACHINING_FLAGS = {"tool_number": "tool_number", "rpm": "spindle_rpm", "feed": "feed_mm_min",
-                    "plunge_feed": "plunge_feed_mm_min", "step_down": "step_down_mm",
-                    "roughing_passes": "roughing_passes", "allowance": "roughing_allowance_mm",
-                    "direction": "direction", "coolant": "coolant", "units": "units", "safe_z": "safe_z_mm",
-                    "compensation": "compensation", "lines_only": "lines_only", "tool_diameter": "tool_diameter_mm"}
+#: the job flags of ``camfab gcode`` and ``camfab verify`` (flag dest → [machining] key, or [manufacturing]
+#: tool_diameter_mm / material), added to both parsers by :func:`_job_flags`
+_JOB_FLAGS = {"tool_diameter": "tool_diameter_mm", "material": "material", "tool_material": "tool_material",
+              "flutes": "tool_flutes", "max_rpm": "max_spindle_rpm", "tool_number": "tool_number",
+              "rpm": "spindle_rpm", "feed": "feed_mm_min", "plunge_feed": "plunge_feed_mm_min",
+              "step_down": "step_down_mm", "breakthrough": "breakthrough_mm", "roughing_passes": "roughing_passes",
+              "allowance": "roughing_allowance_mm", "direction": "direction", "coolant": "coolant", "units": "units",
+              "safe_z": "safe_z_mm", "stock_diameter": "stock_diameter_mm", "mill_bore": "mill_bore",
+              "compensation": "compensation", "lines_only": "lines_only"}
+#: what verify may not be told: how the program is written, not what it must do
+_GCODE_ONLY = ("units", "compensation", "lines_only")
+
+
+def _job_flags(g: argparse._ArgumentGroup, *, verify: bool = False) -> None:
+    """The job flags (each overrides the design's value, its default in brackets) of ``gcode`` and ``verify``."""
+    g.add_argument("--tool-diameter", type=float, metavar="MM",
+                   help="end mill diameter ([manufacturing] tool_diameter_mm)")
+    g.add_argument("--material", help="work material of the cutting-data table ([manufacturing] material)")
+    g.add_argument("--tool-material", choices=("carbide", "hss"), help="[carbide]")
+    g.add_argument("--flutes", type=int, help="flutes of the end mill [the table's for the material]")
+    g.add_argument("--max-rpm", type=float, help="the machine's highest spindle speed [10000]")
+    g.add_argument("--tool-number", type=int, help="T word and H/D register [1]")
+    g.add_argument("--rpm", type=float, help="spindle speed [from the cutting-data table]")
+    g.add_argument("--feed", type=float, help="cutting feed, mm/min [from the cutting-data table]")
+    g.add_argument("--plunge-feed", type=float, help="feed of descending moves, mm/min [half the feed]")
+    g.add_argument("--step-down", type=float, help="largest depth per level, mm [3]")
+    g.add_argument("--breakthrough", type=float, help="depth below the plate, mm [0.5]")
+    g.add_argument("--roughing-passes", type=int, help="roughing passes per level [1]")
+    g.add_argument("--allowance", type=float, help="radial finishing allowance, mm [0.2]")
+    g.add_argument("--direction", choices=("climb", "conventional"), help="[climb]")
+    g.add_argument("--coolant", choices=("flood", "mist", "off"), help="[flood]")
+    g.add_argument("--safe-z", type=float, help="safe height for rapids, mm [25]")
+    g.add_argument("--stock-diameter", type=float, help="round blank diameter, mm [part + 2 x 2 mm]")
+    g.add_argument("--mill-bore", action="store_const", const=True,
+                   help="mill the bore by helical interpolation ([machining] mill_bore)")
+    if verify:
+        return
+    g.add_argument("--units", choices=("mm", "inch"), help="[mm]")
+    g.add_argument("--compensation", choices=("G41", "G42"),
+                   help="emit the part contour with cutter compensation instead of tool-centre coordinates")
+    g.add_argument("--lines-only", action="store_const", const=True,
+                   help="write the finishing contour as G1 lines (no G2/G3)")
+
+
+def _job_overrides(args: argparse.Namespace) -> dict[str, Any]:
+    """The job flags given on the command line, by design key (None: not given)."""
+    return {key: getattr(args, flag, None) for flag, key in _JOB_FLAGS.items()}
 
 
 def _gcode_args(p: argparse.ArgumentParser) -> None:
@@ -198,24 +239,8 @@ def _gcode_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--post", choices=("linuxcnc", "fanuc", "grbl"), default=None,
                    help="controller dialect (default: [outputs] gcode, else linuxcnc)")
     p.add_argument("--tol", type=float, default=None, help="tool-path tolerance, mm (default: the design's)")
-    g = p.add_argument_group("machining", "override the design's [machining] table (its defaults in brackets)")
-    g.add_argument("--tool-diameter", type=float, metavar="MM",
-                   help="end mill diameter ([manufacturing] tool_diameter_mm)")
-    g.add_argument("--tool-number", type=int, help="T word and H/D register [1]")
-    g.add_argument("--rpm", type=float, help="spindle speed [3000]")
-    g.add_argument("--feed", type=float, help="cutting feed, mm/min [600]")
-    g.add_argument("--plunge-feed", type=float, help="plunge feed, mm/min [200]")
-    g.add_argument("--step-down", type=float, help="largest depth per level, mm [3]")
-    g.add_argument("--roughing-passes", type=int, help="roughing passes per level [1]")
-    g.add_argument("--allowance", type=float, help="radial finishing allowance, mm [0.2]")
-    g.add_argument("--direction", choices=("climb", "conventional"), help="[climb]")
-    g.add_argument("--coolant", choices=("flood", "mist", "off"), help="[flood]")
-    g.add_argument("--units", choices=("mm", "inch"), help="[mm]")
-    g.add_argument("--safe-z", type=float, help="safe height for rapids, mm [25]")
-    g.add_argument("--compensation", choices=("G41", "G42"),
-                   help="emit the part contour with cutter compensation instead of tool-centre coordinates")
-    g.add_argument("--lines-only", action="store_const", const=True,
-                   help="write the finishing contour as G1 lines (no G2/G3)")
+    _job_flags(p.add_argument_group("machining", "override the design's [machining] table (its defaults in "
+                                               "brackets)"))
     p.add_argument("--lift-table", metavar="CSV", help="also write the polar lift table for cam grinders")
     p.add_argument("--lift-step", type=float, default=1.0, help="lift-table step in degrees (divides 360)")
     p.add_argument("--force", action="store_true", help="write even if the design's verdict is unacceptable")
@@ -226,7 +251,7 @@ def _gcode_args(p: argparse.ArgumentParser) -> None:
 def cmd_gcode(args: argparse.Namespace) -> int:
     cam = _cam(args.file)
     tol = _tol(cam, args.tol)
-    machining = {key: getattr(args, flag) for flag, key in _MACHINING_FLAGS.items()}
+    machining = _job_overrides(args)
     req = Request(frozenset({Output.GCODE}), args.post or cam.spec.outputs.gcode or "linuxcnc", tol=tol,
                   machining=machining, lift_step_deg=args.lift_step)
     pipeline.gcode_job(cam.spec, tol=tol, overrides=machining)  # a bad job is refused before the check
@@ -268,32 +293,16 @@ def _refuse_compensation(post: str, compensation: str | None, flag: str | None) 
 def _verify_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("program", help="G-code file to verify")
     p.add_argument("--design", required=True, help="the design the program should cut")
-    p.add_argument("--tool-diameter", type=float, default=None, metavar="MM",
-                   help="end mill diameter (default: [manufacturing] tool_diameter_mm)")
     p.add_argument("--tol", type=float, default=None, help="tolerance, mm (default: the design's)")
-    p.add_argument("--safe-z", type=float, default=None, help="safe height, mm (default: [machining] safe_z_mm)")
     p.add_argument("--profile", type=int, default=1, help="which profile of a conjugate pair (1 or 2)")
     p.add_argument("--comp-radius", type=float, default=None, metavar="MM",
                    help="radius in the controller's D register for G41/G42 programs (default: the tool radius)")
     p.add_argument("--post", choices=("linuxcnc", "fanuc", "grbl"), default=None,
                    help="controller the program is for (default: the one its header names, else [outputs] gcode, "
                         "else linuxcnc): whether T.. M6 and G43 H.. are expected")
-    g = p.add_argument_group("job", "what the program must do, when the gcode command was given other values than "
-                                    "the design's [machining]")
-    g.add_argument("--tool-number", type=int, help="T word and H register [1]")
-    g.add_argument("--rpm", type=float, help="spindle speed [3000]")
-    g.add_argument("--feed", type=float, help="cutting feed, mm/min [600]")
-    g.add_argument("--plunge-feed", type=float, help="plunge feed, mm/min [200]")
-    g.add_argument("--step-down", type=float, help="largest depth per level, mm [3]")
-    g.add_argument("--direction", choices=("climb", "conventional"), help="[climb]")
-    g.add_argument("--coolant", choices=("flood", "mist", "off"), help="[flood]")
+    _job_flags(p.add_argument_group("job", "what the program must do, when the gcode command was given other "
+                                           "values than the design's"), verify=True)
     p.add_argument("--json", action="store_true")
-
-
-#: ``camfab verify`` flags that override the design's job (flag dest → Job field)
-_VERIFY_JOB_FLAGS = {"tool_diameter": "tool_diameter_mm", "safe_z": "safe_z_mm", "tool_number": "tool_number",
-                     "rpm": "spindle_rpm", "feed": "feed_mm_min", "plunge_feed": "plunge_feed_mm_min",
-                     "step_down": "step_down_mm", "direction": "direction", "coolant": "coolant"}
 
 
 @register("verify", "back-plot a G-code program and check it against the exact design and its job", _verify_args)
@@ -307,8 +316,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
     profiles = cam.geometry.profiles
     if not 1 <= args.profile <= len(profiles):
         raise UsageError(f"--profile {args.profile}: the design has {len(profiles)} profile(s)")
-    job = pipeline.gcode_job(cam.spec, tol=tol, overrides={key: getattr(args, flag)
-                                                            for flag, key in _VERIFY_JOB_FLAGS.items()})
+    job = pipeline.gcode_job(cam.spec, tol=tol, overrides=_job_overrides(args))
     data = Path(args.program).read_bytes()  # a missing file is an I/O error (3); an unreadable one a finding
     rep = verify_cam_program(data, profiles[args.profile - 1], job, tol=tol, post=args.post,
                              default_post=cam.spec.outputs.gcode or "linuxcnc", comp_radius=args.comp_radius)

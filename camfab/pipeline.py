@@ -329,36 +329,39 @@ def examples() -> list[str]:
 # ---------------------------------------------------------------------------
 # the G-code job: [machining], overridden by the command line
 def gcode_job(spec: DesignSpec, *, tol: float, overrides: Mapping[str, Any] | None = None) -> Any:
-    """The :class:`camfab.gcode.Job` of a design: ``[manufacturing]`` tool and thickness and ``[machining]``,
-    each value replaced by ``overrides[key]`` when given (not None); ``tool_diameter_mm`` may be
-    overridden too.
+    """The :class:`camfab.gcode.Job` of a design: ``[manufacturing]`` tool, thickness, material and bore and
+    ``[machining]``, each value replaced by ``overrides[key]`` when given (not None); ``tool_diameter_mm``
+    and ``material`` may be overridden too.  Cutting data the design does not give come from the cutting-data table
+    (:func:`camfab.gcode.model.job_from_machining`).
 
     Raises
     ------
     SpecError
         No tool diameter, or a job value out of range.
     """
-    from .gcode import Job
+    from .gcode.model import job_from_machining
 
     over = {k: v for k, v in (overrides or {}).items() if v is not None}
-    m = replace(spec.machining, **{k: v for k, v in over.items() if k != "tool_diameter_mm"})
+    m = replace(spec.machining, **{k: v for k, v in over.items() if k not in _MFG_OVERRIDES})
     tool = over.get("tool_diameter_mm", spec.manufacturing.tool_diameter_mm)
     if not tool:
         raise SpecError(Problem("manufacturing.tool_diameter_mm", None, "G-code needs a tool",
                                 "add tool_diameter_mm to [manufacturing] (or give --tool-diameter)"), spec.source)
-    return Job(tool_diameter_mm=tool, depth_mm=spec.manufacturing.thickness_mm, tool_number=m.tool_number,
-               spindle_rpm=m.spindle_rpm, feed_mm_min=m.feed_mm_min, plunge_feed_mm_min=m.plunge_feed_mm_min,
-               step_down_mm=m.step_down_mm, safe_z_mm=m.safe_z_mm, clearance_mm=m.clearance_mm,
-               roughing_allowance_mm=m.roughing_allowance_mm,
-               roughing_passes=0 if m.compensation else m.roughing_passes,
-               roughing_stepover_mm=m.roughing_stepover_mm, direction=m.direction, coolant=m.coolant,
-               units=m.units, tolerance_mm=tol, design_name=spec.name, lead_radius_mm=m.lead_radius_mm)
+    mfg = spec.manufacturing
+    return job_from_machining(m, tool_diameter_mm=tool, thickness_mm=mfg.thickness_mm,
+                              material=over.get("material", mfg.material),
+                              bore_mm=mfg.bore_mm, stock_shape="plate" if spec.is_translating_cam else "round",
+                              tolerance_mm=tol, design_name=spec.name, source=spec.source)
 
 
 def machining_of(spec: DesignSpec, overrides: Mapping[str, Any] | None = None) -> Any:
     """``[machining]`` with the given overrides applied (None values ignored)."""
-    over = {k: v for k, v in (overrides or {}).items() if v is not None and k != "tool_diameter_mm"}
+    over = {k: v for k, v in (overrides or {}).items() if v is not None and k not in _MFG_OVERRIDES}
     return replace(spec.machining, **over)
+
+
+#: the overrides of gcode_job that are [manufacturing] values, not [machining] ones
+_MFG_OVERRIDES = ("tool_diameter_mm", "material")
 
 
 # ---------------------------------------------------------------------------

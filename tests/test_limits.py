@@ -319,7 +319,7 @@ def test_a_tiny_step_down_refused_on_reading_and_in_the_job(tmp_path):
     f = tmp_path / "sd.toml"
     f.write_text(text)
     err = _refused(f, "machining.step_down_mm = 1e-09", "more than 1000 depth levels",
-                   "at least 0.01 mm")
+                   "at least 0.0105 mm")  # 10 mm plate + 0.5 mm breakthrough
     assert err.count("\n  - ") == 1
     with pytest.raises(SpecError) as e:
         Job(tool_diameter_mm=6, depth_mm=10, step_down_mm=1e-9)

@@ -23,6 +23,7 @@ roughing_passes = 2
 roughing_allowance_mm = 0.3
 coolant = "mist"
 safe_z_mm = 30.0
+breakthrough_mm = 0.0
 """
 
 

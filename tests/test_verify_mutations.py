@@ -28,7 +28,11 @@ GEOMETRY = {"DEVIATION", "GOUGE", "COVERAGE", "PARSE_ERROR", "ARC_RADIUS_MISMATC
 @pytest.fixture(scope="module")
 def case():
     cam = pipeline.load("ejemplo9rt")
-    job = pipeline.gcode_job(cam.spec, tol=TOL, overrides={"step_down_mm": 5.0})
+    # the edits below name the numbers of this job (S3000, F600, F200, Z-5, Z-10): fixed here, not taken from the
+    # cutting-data table, and no breakthrough, so the final depth is the 10 mm plate
+    job = pipeline.gcode_job(cam.spec, tol=TOL, overrides={"step_down_mm": 5.0, "spindle_rpm": 3000.0,
+                                                           "feed_mm_min": 600.0, "plunge_feed_mm_min": 200.0,
+                                                           "breakthrough_mm": 0.0})
     contact = cam.geometry.profiles[0]
     prog = cam_program(contact, job, tol=TOL)
     lines_only = cam_program(contact, job, tol=TOL, arcs_allowed=False)

@@ -2,10 +2,10 @@
 and ``[outputs]`` (what ``camfab run`` writes) — their values and their validation.
 
 Every reader collects its problems in a :class:`~camfab.design.validator.Validator` (field path, value,
-rule, fix); nothing here raises.  The defaults of ``[machining]`` are the values ``camfab gcode`` used
-before the table existed, so a design without it cuts the same program as before; command-line flags
-override it (``camfab.pipeline.gcode_job``), so ``gcode``, ``run`` and ``package`` cut the same program
-for the same inputs.
+rule, fix); nothing here raises.  ``[machining]`` leaves spindle speed and feeds unset by default: the
+G-code takes them from the cutting-data table (``camfab.gcode.cutting``); command-line flags override it
+(``camfab.pipeline.gcode_job``), so ``gcode``, ``run`` and ``package`` cut the same program for the same
+inputs.
 """
 from __future__ import annotations
 
@@ -58,12 +58,28 @@ class MachiningSpec:
     ``compensation`` = ``"G41"`` / ``"G42"`` writes the part contour with the controller's cutter
     compensation instead of tool-centre coordinates (no roughing passes then); ``lines_only`` writes the
     finishing contour as G1 lines.
+
+    ``spindle_rpm``, ``feed_mm_min`` and ``plunge_feed_mm_min`` not given (None) come from the cutting-data
+    table (``camfab/gcode/cutting_data.toml``) for ``[manufacturing] material``, the tool diameter,
+    ``tool_material`` and ``tool_flutes``, within the machine's ``max_spindle_rpm``.  The final depth is the
+    plate thickness plus ``breakthrough_mm``; the stock is a blank ``stock_allowance_mm`` larger than the
+    part all round (or a round blank of ``stock_diameter_mm``); ``mill_bore`` mills the bore by a helix of
+    at most ``helix_pitch_mm`` per turn and ``ramp_angle_deg`` steep, then a finishing circle.
     """
 
     tool_number: int = 1
-    spindle_rpm: float = 3000.0
-    feed_mm_min: float = 600.0
-    plunge_feed_mm_min: float = 200.0
+    spindle_rpm: float | None = None
+    feed_mm_min: float | None = None
+    plunge_feed_mm_min: float | None = None
+    tool_material: str = "carbide"
+    tool_flutes: int | None = None
+    max_spindle_rpm: float = 10000.0
+    breakthrough_mm: float = 0.5
+    stock_diameter_mm: float | None = None
+    stock_allowance_mm: float = 2.0
+    mill_bore: bool = False
+    helix_pitch_mm: float = 1.0
+    ramp_angle_deg: float = 3.0
     step_down_mm: float = 3.0
     safe_z_mm: float = 25.0
     clearance_mm: float = 2.0
@@ -81,10 +97,14 @@ class MachiningSpec:
 #: [machining] keys: positive numbers (with their upper bounds), then the choices
 _MACHINING_NUMBERS = {"spindle_rpm": 1e6, "feed_mm_min": 1e6, "plunge_feed_mm_min": 1e6, "step_down_mm": 1e3,
                       "safe_z_mm": 1e4, "clearance_mm": 1e3, "roughing_allowance_mm": 1e2,
-                      "roughing_stepover_mm": 1e3, "lead_radius_mm": 1e3}
+                      "roughing_stepover_mm": 1e3, "lead_radius_mm": 1e3, "max_spindle_rpm": 1e6,
+                      "stock_diameter_mm": 1e4, "helix_pitch_mm": 1e2, "ramp_angle_deg": 45.0}
+#: [machining] lengths that may be 0 (with their upper bounds)
+_MACHINING_ZERO_OK = {"breakthrough_mm": 1e2, "stock_allowance_mm": 1e3}
 _MACHINING_CHOICES = {"direction": ("climb", "conventional"), "coolant": ("flood", "mist", "off"),
-                      "units": ("mm", "inch"), "compensation": ("G41", "G42")}
-_MACHINING_KEYS = (*_MACHINING_NUMBERS, *_MACHINING_CHOICES, "tool_number", "roughing_passes", "lines_only")
+                      "units": ("mm", "inch"), "compensation": ("G41", "G42"), "tool_material": ("carbide", "hss")}
+_MACHINING_KEYS = (*_MACHINING_NUMBERS, *_MACHINING_ZERO_OK, *_MACHINING_CHOICES, "tool_number", "roughing_passes",
+                   "lines_only", "tool_flutes", "mill_bore")
 
 
 @dataclass(frozen=True, slots=True)
@@ -167,6 +187,8 @@ def machining_section(v: Validator, t: Mapping[str, Any]) -> MachiningSpec:
     values: dict[str, Any] = {}
     for key, hi in _MACHINING_NUMBERS.items():
         values[key] = v.number(t, key, "machining", getattr(d, key), lo=0.0, lo_open=True, hi=hi)
+    for key, hi in _MACHINING_ZERO_OK.items():
+        values[key] = v.number(t, key, "machining", getattr(d, key), lo=0.0, hi=hi)
     for key, options in _MACHINING_CHOICES.items():
         val = t.get(key, getattr(d, key))
         if val is not None and val not in options:
@@ -176,10 +198,12 @@ def machining_section(v: Validator, t: Mapping[str, Any]) -> MachiningSpec:
     values["tool_number"] = _whole(v, t, "tool_number", d.tool_number, 1, 99999)
     values["roughing_passes"] = _whole(v, t, "roughing_passes", d.roughing_passes, 0, 100)
     values["lines_only"] = v.boolean(t, "lines_only", "machining", d.lines_only)
+    values["mill_bore"] = v.boolean(t, "mill_bore", "machining", d.mill_bore)
+    values["tool_flutes"] = None if "tool_flutes" not in t else _whole(v, t, "tool_flutes", None, 1, 12)
     return MachiningSpec(**values)
 
 
-def _whole(v: Validator, t: Mapping[str, Any], key: str, default: int, lo: int, hi: int) -> int:
+def _whole(v: Validator, t: Mapping[str, Any], key: str, default: Any, lo: int, hi: int) -> Any:
     val = t.get(key, default)
     if isinstance(val, bool) or not isinstance(val, int) or not lo <= val <= hi:
         v.add(f"machining.{key}", val, f"must be a whole number in [{lo}, {hi}]", f"give {key} as an integer")

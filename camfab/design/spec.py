@@ -319,9 +319,10 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
 def _depth_levels(v: Validator, mfg: ManufacturingSpec, machining: MachiningSpec) -> None:
     """The plate cut in at most :data:`~camfab.limits.MAX_DEPTH_LEVELS` step-downs (``docs/decisions.md``,
     "Input limits")."""
-    depth, step = mfg.thickness_mm, machining.step_down_mm
+    depth, step = mfg.thickness_mm + machining.breakthrough_mm, machining.step_down_mm
     if depth / step > MAX_DEPTH_LEVELS:
-        v.add("machining.step_down_mm", step, f"cuts the {depth:g} mm plate in more than {MAX_DEPTH_LEVELS} depth "
+        v.add("machining.step_down_mm", step, f"cuts the {depth:g} mm depth (plate and breakthrough) in more than "
+              f"{MAX_DEPTH_LEVELS} depth "
               "levels (the input limit)", f"give a step-down of at least {depth / MAX_DEPTH_LEVELS:.3g} mm")
 
 

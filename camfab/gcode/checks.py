@@ -15,7 +15,8 @@ from camfab.gcode.parse import Backplot, Move
 from camfab.gcode.posts.base import Post
 from camfab.results import Finding, IssueCode
 
-__all__ = ["EPS_Z", "FEED_ATOL", "FEED_RTOL", "depth_findings", "direction_findings", "feed_findings", "line_list",
+__all__ = ["BORE_LABEL", "EPS_Z", "FEED_ATOL", "FEED_RTOL", "bore_findings", "bore_moves", "depth_findings",
+           "descends", "direction_findings", "feed_findings", "line_list",
            "machine_state_findings", "modal_state", "retract_findings", "xy_travel"]
 
 #: heights closer than this (mm) are the same level
@@ -47,9 +48,15 @@ def xy_travel(m: Move) -> bool:
     return math.hypot(e[0] - s[0], e[1] - s[1]) > EPS_Z
 
 
+def descends(m: Move) -> bool:
+    """The move ends lower than it starts (a plunge, ramp or helix)."""
+    return math.isfinite(m.start[2]) and m.end[2] < m.start[2] - EPS_Z
+
+
 def feed_findings(moves, cutting, job: Job | None) -> list[Finding]:
     """FEED_MISSING for every cutting move without a feed (or F0); with a job FEED_OUT_OF_RANGE for every
-    feed other than the job's (plunge feed for Z-only moves, cutting feed for the others)."""
+    feed other than the job's (plunge feed for Z-only moves and every descending move - helices and ramps -,
+    cutting feed for the others)."""
     out = []
     none = [moves[i].line for i in cutting if moves[i].feed is None or moves[i].feed <= 0]
     if none:
@@ -62,11 +69,12 @@ def feed_findings(moves, cutting, job: Job | None) -> list[Finding]:
         m = moves[i]
         if m.feed is None or m.feed <= 0:
             continue
-        kind, want = ("cutting", job.feed_mm_min) if xy_travel(m) else ("plunge", job.plunge_feed_mm_min)
+        plunge = not xy_travel(m) or descends(m)
+        kind, want = ("plunge", job.plunge_feed_mm_min) if plunge else ("cutting", job.feed_mm_min)
         if abs(m.feed - want) > FEED_ATOL + FEED_RTOL * want:
             wrong.setdefault((kind, want, round(m.feed, 6)), []).append(m.line)
     for (kind, want, got), lines in sorted(wrong.items(), key=lambda kv: kv[1][0]):
-        what = "Z-only (plunge)" if kind == "plunge" else "cutting"
+        what = "Z-only or descending (plunge)" if kind == "plunge" else "cutting"
         out.append(Finding.at_line(IssueCode.FEED_OUT_OF_RANGE, f"{len(lines)} {what} move(s) at F{got:g} mm/min; "
                                    f"the job's {kind} feed is {want:g} mm/min: lines {line_list(lines)}", lines[0]))
     return out
@@ -129,13 +137,13 @@ def depth_findings(moves, cutting, fin_final, zf: float, job: Job, top_z: float,
         how = "does not reach" if zf > z_final else "goes below"
         out.append(Finding.at_line(
             IssueCode.FINISH_DEPTH, f"the finishing pass runs at Z{zf:.4f}: it {how} the final depth Z{z_final:.4f} "
-            f"(the plate is {job.depth_mm:g} mm thick)", moves[fin_final[0]].line))
+            f"(the plate and its breakthrough: {job.depth_mm:g} mm)", moves[fin_final[0]].line))
     deep = sorted({moves[i].line for i in cutting if min(moves[i].start[2], moves[i].end[2]) < z_final - tol})
     if deep:
         zmin = min(min(moves[i].start[2], moves[i].end[2]) for i in cutting)
         out.append(Finding.at_line(
-            IssueCode.TOO_DEEP, f"cutting down to Z{zmin:.4f}, below the bottom of the plate Z{z_final:.4f} (into the "
-            f"fixture): lines {line_list(deep)}", deep[0]))
+            IssueCode.TOO_DEEP, f"cutting down to Z{zmin:.4f}, below the final depth Z{z_final:.4f} (plate and "
+            f"breakthrough; deeper is the fixture): lines {line_list(deep)}", deep[0]))
     floor = top_z
     steep = []
     for i in cutting:
@@ -178,6 +186,47 @@ def direction_findings(pts: np.ndarray, job: Job, line: int) -> list[Finding]:
     return [Finding.at_line(IssueCode.DIRECTION, f"the finishing pass runs {'counter-' if want_cw else ''}clockwise "
                             f"around the part: {'conventional' if want_cw else 'climb'} milling with M3, but the job "
                             f"asks {job.direction}", line)]
+
+
+#: the label (comment prefix) of the bore moves camfab writes
+BORE_LABEL = "BORE"
+
+
+def bore_moves(moves, cutting, job: Job | None) -> list[int]:
+    """The cutting moves of the bore (labelled ``BORE ...``) when the job mills one, else none: they are checked
+    against the bore (:func:`bore_findings`), not the cam contour."""
+    if job is None or not job.mill_bore or job.bore_mm <= 0:
+        return []
+    return [i for i in cutting if (moves[i].label or "").upper().startswith(BORE_LABEL)]
+
+
+def bore_findings(moves, bore: list[int], job: Job, tol: float, step: float, sample) -> list[Finding]:
+    """GOUGE when a bore move takes the tool beyond the bore's wall (Ø ``job.bore_mm`` on the axis), DEVIATION
+    when the bore's finishing circle at full depth does not run at ``(bore - D) / 2`` from the axis."""
+    if not bore:
+        return []
+    out = []
+    smp = sample([moves[i] for i in bore], step, 256)
+    rho = np.hypot(smp.points[:, 0], smp.points[:, 1])
+    R = 0.5 * (job.bore_mm - job.tool_diameter_mm)
+    over = rho - R
+    if (over > tol).any():
+        w = int(np.argmax(over))
+        lines = sorted({moves[bore[int(k)]].line for k in smp.index[over > tol]})
+        out.append(Finding.at_line(IssueCode.GOUGE, f"the bore moves take the tool {over[w]:.4f} mm beyond the wall of "
+                                   f"the D{job.bore_mm:g} bore: lines {line_list(lines)}", lines[0]))
+    z_final = -job.depth_mm
+    fin = (smp.points[:, 2] <= z_final + tol) & np.array(
+        [(moves[bore[int(k)]].label or "").upper().startswith(BORE_LABEL + " FINISH") for k in smp.index])
+    if not fin.any():
+        out.append(Finding.at_line(IssueCode.FINISH_DEPTH, f"no finishing circle of the bore at the final depth "
+                                   f"Z{z_final:.4f}", moves[bore[0]].line))
+    elif float(np.max(np.abs(rho[fin] - R))) > tol or float(np.ptp(np.arctan2(smp.points[fin, 1],
+                                                                                smp.points[fin, 0]))) < 6.0:
+        dev = float(np.max(np.abs(rho[fin] - R)))
+        out.append(Finding.at_line(IssueCode.DEVIATION, f"the bore's finishing circle deviates {dev:.4f} mm from "
+                                   f"radius {R:.4f} mm or does not go round", moves[bore[0]].line))
+    return out
 
 
 def line_list(lines: Sequence[int], limit: int = 8) -> str:

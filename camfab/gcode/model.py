@@ -9,12 +9,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from camfab.design.shop import MachiningSpec
 from camfab.errors import Problem, SpecError
+from camfab.gcode.cutting import cutting_data
 from camfab.limits import MAX_DEPTH_LEVELS
 from camfab.tolerances import MAX_EXPORT_TOL_MM, MIN_EXPORT_TOL_MM
 
 __all__ = ["Rapid", "Feed", "Arc", "Comment", "ToolChange", "Spindle", "Coolant", "CutterComp", "Item", "Job",
-           "Program"]
+           "Program", "job_from_machining"]
 
 
 @dataclass(frozen=True)
@@ -110,6 +112,9 @@ class CutterComp:
 Item = Rapid | Feed | Arc | Comment | ToolChange | Spindle | Coolant | CutterComp
 
 _DIRECTIONS = ("climb", "conventional")
+_STOCKS = ("round", "plate")
+#: the defaults of a job are those of the design's [machining] table (one place)
+_M = MachiningSpec()
 _COOLANTS = ("flood", "mist", "off")
 _UNITS = ("mm", "inch")
 
@@ -123,13 +128,15 @@ class Job:
     tool_diameter_mm : float
         Flat end mill diameter.
     depth_mm : float
-        Plate thickness: the final cutting depth below the stock top (``Z = -depth_mm``).
+        The final cutting depth below the stock top (``Z = -depth_mm``): the plate thickness plus the
+        breakthrough.
     tool_number : int
         T word and length-offset register H (and D register for G41/G42).
     spindle_rpm : float
-        Spindle speed (M3, clockwise).
+        Spindle speed (M3, clockwise).  Designs get it from the cutting-data table
+        (:func:`job_from_machining`); 3000 is only the default of a job built by hand.
     feed_mm_min, plunge_feed_mm_min : float
-        Cutting feed and the vertical plunge feed.
+        Cutting feed, and the feed of every descending move (plunges, helices).
     step_down_mm : float
         Largest depth per level; levels are equal, ``ceil(depth / step_down)`` of them.
     safe_z_mm : float
@@ -158,28 +165,54 @@ class Job:
     finish_full_depth : bool
         With roughing passes, cut the finishing pass at full depth in one level (default) instead of in
         step-downs.
+    breakthrough_mm : float
+        How much of ``depth_mm`` lies below the plate (stated in the header).
+    stock_shape : {"round", "plate"}
+        The blank: a round blank centred on the cam axis (rotating cams) or a rectangular plate.
+    stock_diameter_mm : float or None
+        Diameter of the round blank; default the part's largest diameter plus twice the allowance,
+        rounded up to a whole mm.
+    stock_allowance_mm : float
+        Stock left around the part by the derived blank (each side).
+    bore_mm : float
+        Bore diameter, centred on the cam axis (0: none).
+    mill_bore : bool
+        Mill the bore by helical interpolation (before the contour) and a finishing circle at full depth.
+    helix_pitch_mm, ramp_angle_deg : float
+        The bore helix descends at most this much per turn, and at most this steeply.
+    notes : tuple of str
+        Header lines stating where the cutting data came from.
     """
 
     tool_diameter_mm: float
     depth_mm: float
-    tool_number: int = 1
+    tool_number: int = _M.tool_number
     spindle_rpm: float = 3000.0
     feed_mm_min: float = 600.0
     plunge_feed_mm_min: float = 200.0
-    step_down_mm: float = 3.0
-    safe_z_mm: float = 25.0
-    clearance_mm: float = 2.0
-    roughing_allowance_mm: float = 0.2
-    roughing_passes: int = 1
-    roughing_stepover_mm: float | None = None
-    direction: str = "climb"
-    coolant: str = "flood"
-    units: str = "mm"
+    step_down_mm: float = _M.step_down_mm
+    safe_z_mm: float = _M.safe_z_mm
+    clearance_mm: float = _M.clearance_mm
+    roughing_allowance_mm: float = _M.roughing_allowance_mm
+    roughing_passes: int = _M.roughing_passes
+    roughing_stepover_mm: float | None = _M.roughing_stepover_mm
+    direction: str = _M.direction
+    coolant: str = _M.coolant
+    units: str = _M.units
     tolerance_mm: float = 0.001
     design_name: str = "cam"
     achieved_deviation_mm: float | None = None
-    lead_radius_mm: float | None = None
+    lead_radius_mm: float | None = _M.lead_radius_mm
     finish_full_depth: bool = True
+    breakthrough_mm: float = 0.0
+    stock_shape: str = "round"
+    stock_diameter_mm: float | None = _M.stock_diameter_mm
+    stock_allowance_mm: float = _M.stock_allowance_mm
+    bore_mm: float = 0.0
+    mill_bore: bool = _M.mill_bore
+    helix_pitch_mm: float = _M.helix_pitch_mm
+    ramp_angle_deg: float = _M.ramp_angle_deg
+    notes: tuple[str, ...] = ()
 
     def __post_init__(self):
         problems = self._problems()
@@ -259,6 +292,26 @@ class Job:
         num("lead_radius_mm", allow_none=True)
         if not isinstance(self.finish_full_depth, bool):
             P.append(Problem("job.finish_full_depth", self.finish_full_depth, "must be true or false", ""))
+        brk = num("breakthrough_mm", positive=False)
+        if brk is not None and depth is not None and not 0.0 <= brk < depth:
+            P.append(Problem("job.breakthrough_mm", brk, "must be >= 0 and less than the depth", ""))
+        if self.stock_shape not in _STOCKS:
+            P.append(Problem("job.stock_shape", self.stock_shape, f"must be one of {', '.join(_STOCKS)}", ""))
+        num("stock_diameter_mm", allow_none=True)
+        sa = num("stock_allowance_mm", positive=False)
+        if sa is not None and sa < 0:
+            P.append(Problem("job.stock_allowance_mm", sa, "must be >= 0", "give 0 or more"))
+        bore = num("bore_mm", positive=False)
+        if bore is not None and bore < 0:
+            P.append(Problem("job.bore_mm", bore, "must be >= 0", ""))
+        num("helix_pitch_mm")
+        ang = num("ramp_angle_deg")
+        if ang is not None and ang > 45.0:
+            P.append(Problem("job.ramp_angle_deg", ang, "must be at most 45 degrees", ""))
+        if not isinstance(self.mill_bore, bool):
+            P.append(Problem("job.mill_bore", self.mill_bore, "must be true or false", ""))
+        elif self.mill_bore and bore is not None and D is not None:
+            P += bore_problems(bore, D, "job")
         return P
 
     @property
@@ -285,6 +338,51 @@ class Job:
         return tuple(-self.depth_mm * k / n for k in range(1, n + 1))
 
 
+def bore_problems(bore_mm: float, tool_diameter_mm: float, where: str = "machining") -> list[Problem]:
+    """Why a bore of ``bore_mm`` cannot be milled with the tool (empty when it can)."""
+    if bore_mm <= 0:
+        return [Problem(f"{where}.mill_bore", True, "there is no bore to mill (manufacturing.bore_mm = 0)",
+                        "set manufacturing.bore_mm or mill_bore = false")]
+    if tool_diameter_mm >= bore_mm:
+        return [Problem(f"{where}.mill_bore", True, f"the tool (manufacturing.tool_diameter_mm = "
+                        f"{tool_diameter_mm:g} mm) does not fit the bore (manufacturing.bore_mm = {bore_mm:g} mm): "
+                        "helical bore milling needs a tool smaller than the bore",
+                        "use a smaller tool, or mill_bore = false and bore the hole another way")]
+    return []
+
+
+def job_from_machining(m: MachiningSpec, *, tool_diameter_mm: float, thickness_mm: float, material: str = "",
+                       bore_mm: float = 0.0, stock_shape: str = "round", tolerance_mm: float = 0.001,
+                       design_name: str = "cam", source: str | None = None) -> Job:
+    """The :class:`Job` of a design's ``[machining]`` table ``m`` and its ``[manufacturing]`` values: the
+    cutting data from :func:`camfab.gcode.cutting.cutting_data` where ``m`` does not give them, the final
+    depth ``thickness_mm + m.breakthrough_mm``.
+
+    Raises
+    ------
+    SpecError
+        A material or tool the cutting-data table does not know, a bore the tool does not fit, a job value
+        out of range (field named).
+    """
+    cd = cutting_data(tool_diameter_mm=tool_diameter_mm, material=material, tool_material=m.tool_material,
+                      flutes=m.tool_flutes, spindle_rpm=m.spindle_rpm, feed_mm_min=m.feed_mm_min,
+                      plunge_feed_mm_min=m.plunge_feed_mm_min, max_spindle_rpm=m.max_spindle_rpm, source=source)
+    if m.mill_bore:
+        bad = bore_problems(bore_mm, tool_diameter_mm)
+        if bad:
+            raise SpecError(bad, source)
+    return Job(tool_diameter_mm=tool_diameter_mm, depth_mm=thickness_mm + m.breakthrough_mm,
+               tool_number=m.tool_number, spindle_rpm=cd.spindle_rpm, feed_mm_min=cd.feed_mm_min,
+               plunge_feed_mm_min=cd.plunge_feed_mm_min, step_down_mm=m.step_down_mm, safe_z_mm=m.safe_z_mm,
+               clearance_mm=m.clearance_mm, roughing_allowance_mm=m.roughing_allowance_mm,
+               roughing_passes=0 if m.compensation else m.roughing_passes,
+               roughing_stepover_mm=m.roughing_stepover_mm, direction=m.direction, coolant=m.coolant,
+               units=m.units, tolerance_mm=tolerance_mm, design_name=design_name, lead_radius_mm=m.lead_radius_mm,
+               breakthrough_mm=m.breakthrough_mm, stock_shape=stock_shape, stock_diameter_mm=m.stock_diameter_mm,
+               stock_allowance_mm=m.stock_allowance_mm, bore_mm=bore_mm, mill_bore=m.mill_bore,
+               helix_pitch_mm=m.helix_pitch_mm, ramp_angle_deg=m.ramp_angle_deg, notes=cd.notes)
+
+
 @dataclass(frozen=True)
 class Program:
     """A complete milling program in the common model, ready for a post-processor.
@@ -300,6 +398,8 @@ class Program:
         The finishing contour as traversed (tool-centre path, or the part profile when compensated).
     roughing : tuple of tuple of Segment
         The roughing contours, outermost first.
+    notes : tuple of str
+        Header lines: the job's cutting-data notes, the stock, the depth, the entry and the bore.
     """
 
     job: Job
@@ -307,3 +407,4 @@ class Program:
     compensation: str | None = None
     contour: tuple = ()
     roughing: tuple = field(default=())
+    notes: tuple = ()

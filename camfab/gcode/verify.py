@@ -31,8 +31,11 @@ Checks (vectorised over the moves' sample points; each move is sampled every ``s
 * **rapids** - a rapid with horizontal travel below ``safe_z - tol`` (or before Z is known), a rapid that
   descends below the stock top, or a rapid below the stock top whose tool overlaps the part;
 * **feed** - every cutting move: none set or F0 (``FEED_MISSING``); with a ``job``, a feed other than the
-  job's (``FEED_OUT_OF_RANGE``: a Z-only move at the plunge feed, every other cutting move at the cutting
-  feed, within the rounding of the written F word);
+  job's (``FEED_OUT_OF_RANGE``: a Z-only or descending move - plunge, ramp, helix - at the plunge feed,
+  every other cutting move at the cutting feed, within the rounding of the written F word);
+* **bore** (with a ``job`` that mills the bore) - the moves labelled ``BORE ...`` stay inside the bore's
+  wall (``GOUGE``) and its finishing circle runs round at full depth at ``(bore - D) / 2`` (``DEVIATION``,
+  ``FINISH_DEPTH``); they are then left out of the contour's gouge, deviation and coverage checks;
 * **spindle** - cutting below the top with the spindle off (``SPINDLE_OFF``) or turning counter-clockwise
   (``M4``, ``SPINDLE_DIRECTION``: camfab's end mills cut with M3); with a ``job``, at another speed
   (``SPINDLE_SPEED``);
@@ -41,7 +44,8 @@ Checks (vectorised over the moves' sample points; each move is sampled every ``s
 * **tool** (with a ``job``) - the job's tool loaded by ``T.. M6`` (where the post has a tool changer) and
   its length offset ``G43 H..`` active (where the post writes one) while cutting (``TOOL``,
   ``TOOL_LENGTH_OFFSET``);
-* **depth** (with a ``job``) - the finishing pass at the final depth ``Z = -depth_mm`` (``FINISH_DEPTH``),
+* **depth** (with a ``job``) - the finishing pass at the final depth ``Z = -depth_mm`` (plate and
+  breakthrough, ``FINISH_DEPTH``),
   nothing cut below it (``TOO_DEEP``), no cut deeper than one step-down below what was cut before
   (``STEP_DOWN``), and the finishing pass in the job's milling direction (``DIRECTION``: climb is
   clockwise around the part);
@@ -70,6 +74,8 @@ import numpy as np
 
 from camfab.gcode.checks import (
     EPS_Z,
+    bore_findings,
+    bore_moves,
     depth_findings,
     direction_findings,
     feed_findings,
@@ -266,6 +272,13 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray] | 
         moves = list(comp_path.moves)
         cutting = [i for i, m in enumerate(moves) if m.is_cutting]
 
+    # -- the bore (when the job mills one): checked against its wall, then left out of the contour checks ------
+    bore = bore_moves(moves, cutting, job)
+    all_cutting = cutting
+    if bore and job is not None:
+        problems.extend(bore_findings(moves, bore, job, tol, step, sample))
+        cutting = [i for i in cutting if i not in set(bore)]
+
     # -- gouge ---------------------------------------------------------------------------------------
     gouge_at = None
     if cutting:
@@ -382,7 +395,7 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray] | 
     if curve_points is None and part_curve is None:
         notes.append("no exact curve given: coverage of the whole contour not checked")
     if job is not None:
-        problems.extend(depth_findings(moves, cutting, fin_final, zf, job, top_z, tol))
+        problems.extend(depth_findings(moves, all_cutting, fin_final, zf, job, top_z, tol))
 
     # -- rapids --------------------------------------------------------------------------------------
     rapids = [i for i, m in enumerate(moves) if m.kind == "rapid"]

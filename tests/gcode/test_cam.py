@@ -148,7 +148,9 @@ def test_cli_verify_json_and_failure_exit(tmp_path, capsys):
 
 def test_cli_gcode_refuses_big_tool_and_unacceptable(tmp_path, capsys):
     out = tmp_path / "c.nc"
-    assert main(["gcode", "ejemplo9rt", "--tool-diameter", "100", "-o", str(out)]) == 2
+    # (the cutting data given: a 100 mm tool is beyond the cutting-data table, refused by that first otherwise)
+    assert main(["gcode", "ejemplo9rt", "--tool-diameter", "100", "--rpm", "300", "--feed", "200", "--plunge-feed",
+                 "100", "-o", str(out)]) == 2
     assert "largest cutter" in capsys.readouterr().err and not out.exists()
     d = tmp_path / "bad.toml"
     d.write_text((EXAMPLES / "ejemplo9rt.toml").read_text().replace("base_radius_mm = 35.0", "base_radius_mm = 12.0"))

@@ -342,8 +342,9 @@ def test_concave_arc_larger_than_the_tool_is_offset_exactly():
 
 def test_entry_move_shorter_than_the_tool_radius_is_reported():
     text = comp_text(stadium(HALF, RP))
-    assert "G0 X-6.0000 Y27.0000" in text and "G1 G41 D1 Y21.0000" in text
-    bad = text.replace("G0 X-6.0000 Y27.0000", "G0 X-6.0000 Y23.0000")  # 2 mm entry, 3 mm tool radius
+    # the pass plunges outside the stock and feeds in to Y27, then turns compensation on over 6 mm
+    assert "G1 Y27.0000 F600.0\nG1 G41 D1 Y21.0000\n" in text
+    bad = text.replace("G1 Y27.0000 F600.0", "G1 Y23.0000 F600.0")  # 2 mm entry, 3 mm tool radius
     rep = check(bad, stadium(HALF, RP))
     entry = line_of(bad, r"G41 D1", after="FINISH LEAD-IN")
     assert [p.line for p in rep.problems if p.code == "COMP_ENTRY"] == [entry]
@@ -354,7 +355,7 @@ def test_entry_move_shorter_than_the_tool_radius_is_reported():
 def test_entry_by_an_arc_is_reported():
     text = comp_text(stadium(HALF, RP))
     # the straight entry runs without compensation, which is turned on for the lead-in arc
-    bad = text.replace("G1 G41 D1 Y21.0000 F600.0", "G1 Y21.0000 F600.0\nG41 D1")
+    bad = text.replace("G1 G41 D1 Y21.0000\n", "G1 Y21.0000\nG41 D1\n")
     rep = check(bad, stadium(HALF, RP))
     arc_line = line_of(bad, r"^G3 X0\.0000 Y15", after="FINISH LEAD-IN")
     probs = [p for p in rep.problems if p.code == "COMP_ENTRY"]

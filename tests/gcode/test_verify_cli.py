@@ -57,8 +57,8 @@ def _halfway(text):
 def _finish_at(z):
     def edit(text):
         L = _lines(text)
-        k = max(n for n, t in enumerate(L) if t.startswith("G1 Z-10.0000"))  # the finishing plunge
-        L[k] = L[k].replace("Z-10.0000", z)
+        k = max(n for n, t in enumerate(L) if t.startswith("G1 Z-10.5000"))  # the finishing plunge (with breakthrough)
+        L[k] = L[k].replace("Z-10.5000", z)
         return "\n".join(L) + "\n"
     return edit
 
@@ -77,7 +77,7 @@ ISSUE_CASES = {
     "finishing pass at Z-5 of Z-10": (_finish_at("Z-5.0000"), "FINISH_DEPTH"),
     "F0 on the finishing pass": (_finish_feed("F0"), "FEED_MISSING"),
     "F60000 on the finishing pass": (_finish_feed("F60000"), "FEED_OUT_OF_RANGE"),
-    "M4 instead of M3": (lambda t: t.replace("S3000 M3", "S3000 M4"), "SPINDLE_DIRECTION"),
+    "M4 instead of M3": (lambda t: re.sub(r"(S\d+) M3", r"\1 M4", t), "SPINDLE_DIRECTION"),
     "coolant removed": (lambda t: t.replace("M8\n", ""), "COOLANT"),
     "coolant off before cutting": (lambda t: t.replace("M8\n", "M8\nM9\n"), "COOLANT"),
 }

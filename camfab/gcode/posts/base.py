@@ -72,7 +72,7 @@ def header_lines(program: Program, post_name: str, arc_note: str = "") -> list[s
         f"cutter compensation: {comp}",
         f"roughing passes: {job.roughing_passes}, allowance {L(job.roughing_allowance_mm)} {u}",
     ]
-    return lines
+    return lines + list(program.notes)  # cutting data, stock, depth, entry, bore (camfab.gcode.toolpath)
 
 
 def _fmt(v: float, d: int) -> str:
