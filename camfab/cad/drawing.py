@@ -49,6 +49,7 @@ import math
 
 import numpy as np
 
+from ..design.drawing import keyway_depth_tolerance
 from ..design.kinds import ContactKind, FollowerType
 from ..results import Severity, Verdict
 from .dxf import write_deterministic
@@ -74,13 +75,41 @@ __all__ = ["PAPERS", "LAYERS", "SheetLayout", "load_template", "sheet_layout", "
 
 
 def title_fields(spec, report, layout: SheetLayout) -> dict[str, str]:
-    """The values written into the title block, keyed by template field."""
+    """The values written into the title block, keyed by template field (the texts of ``[drawing]``, made
+    safe by :func:`~camfab.cad.sheet.title_block`)."""
     from ..version import __version__
 
-    return {"name": spec.name, "material": spec.manufacturing.material or "to be specified",
-            "scale": layout.scale_label, "units": "mm", "tolerance": f"±{spec.manufacturing.tolerance_mm:g} mm",
-            "verdict": report.verdict.value, "date": "", "drawn_by": f"camfab {__version__}", "paper": layout.paper,
-            "sheet": "1 / 1", "checked": ""}
+    d = spec.drawing
+    return {"name": spec.name, "material": _material(spec), "scale": layout.scale_label, "units": "mm",
+            "verdict": report.verdict.value, "date": d.date, "drawn_by": d.drawn_by or f"camfab {__version__}",
+            "checked": d.checked_by, "paper": layout.paper, "sheet": "1 / 1", "number": d.number,
+            "revision": d.revision, "organisation": d.organisation, "part_number": d.part_number,
+            "general_tolerance": f"ISO 2768-{d.general_tolerance}"}
+
+
+def _material(spec) -> str:
+    return spec.drawing.material or spec.manufacturing.material or "to be specified"
+
+
+def dim_value(v: float) -> str:
+    """A dimension's value as written: at most 2 decimals, trailing zeros dropped (``45``, ``13.8``)."""
+    t = f"{v:.2f}".rstrip("0").rstrip(".")
+    return "0" if t in ("-0", "") else t
+
+
+def _tolerance_notes(spec, shapes) -> list[str]:
+    """The manufacturing notes of ``[drawing]``: general tolerance, profile tolerance, surface finish, and the
+    CAD approximation tolerance of the drawn arcs (a property of the file, not a shop tolerance)."""
+    d, m = spec.drawing, spec.manufacturing
+    dev = max(shapes.profile_deviation) if shapes.profile_deviation else 0.0
+    return [
+        f"General tolerances ISO 2768-{d.general_tolerance} unless stated.",
+        f"Cam profile: every point within ±{d.profile_tolerance_mm:g} mm of the true profile "
+        "(lift table, RADIUS column).",
+        f"Surface finish of the profile Ra {d.surface_finish_ra_um:g} µm; elsewhere as machined.",
+        f"Drawing accuracy: the drawn arcs lie within {dev:.2g} mm of the exact profile "
+        f"(CAD approximation tolerance {m.tolerance_mm:g} mm, not a manufacturing tolerance).",
+    ]
 
 
 def _verdict_note(report) -> str:
@@ -97,12 +126,14 @@ def notes_text(spec, geometry, report, shapes, layout: SheetLayout) -> list[str]
     """The numbered notes (one string per note)."""
     m, f = spec.manufacturing, spec.follower
     sense = "CLOCKWISE" if spec.cam.rotation == "cw" else "COUNTER-CLOCKWISE"
+    d = spec.drawing
     bore = "no bore"
     if m.bore_mm > 0:
-        bore = f"bore Ø{m.bore_mm:g} mm"
+        bore = f"bore Ø{m.bore_mm:g} {d.bore_fit}"
         if m.keyway:
             b, t2 = keyway_size(m.bore_mm)
-            bore += f" with keyway DIN 6885-1 b = {b:g} mm, t2 = {t2:g} mm (d + t2 = {m.bore_mm + t2:g} mm) on +Y"
+            bore += (f" with hub keyway DIN 6885-1 on +Y: width {b:g} {d.keyway_width_fit}, "
+                     f"d + t2 = {m.bore_mm + t2:g} +{keyway_depth_tolerance(m.bore_mm):g}/0 mm")
     c = geometry.profiles[0]
     fol = f"{f.motion} {FollowerType(f.type).title} follower"
     if c.curved_face:
@@ -123,21 +154,24 @@ def notes_text(spec, geometry, report, shapes, layout: SheetLayout) -> list[str]
         radius_word = "distance of the face's centre of curvature"
     else:
         radius_word = "roller-centre distance (pitch radius)"
-    dev = max(shapes.profile_deviation) if shapes.profile_deviation else 0.0
     verdict = _verdict_note(report)
     centre = ([f"Face-centre circle (chain line) R{f.base_radius_mm + c.roller_radius:g} mm = base radius + face "
                "radius: the face's centre of curvature lies on it while the follower rests on the base circle."]
               if c.curved_face else [])
+    rmax = geometry.max_radius
+    plates = (f"{len(geometry.profiles)} cams, CAM 1 drives the first follower, CAM 2 the second; each"
+              if len(shapes.profiles) > 1 else "")
     return [
-        f"Material: {m.material or 'to be specified'}.",
-        f"Plate thickness {m.thickness_mm:g} mm; {bore}.",
-        f"Profile tolerance ±{m.tolerance_mm:g} mm; drawn arcs lie within {dev:.2g} mm of the exact profile.",
+        f"Material: {_material(spec)}.",
+        f"{plates or 'Plate'} thickness {m.thickness_mm:g} mm (side view); {bore}.",
+        *_tolerance_notes(spec, shapes),
         f"All dimensions in mm (true size); scale {layout.scale_label}.",
         f"The cam rotates {sense} as drawn.",
         "Zero-angle reference: at cam angle 0° the follower axis is +Y (up on this sheet, marked 0°); "
         "the lift table gives the follower lift after the cam has turned by the angle in its sense of rotation.",
         f"Follower: {fol}.",
-        f"Base radius R_b = {f.base_radius_mm:g} mm; largest radius DMAX = {geometry.max_radius:.3f} mm.",
+        f"Base radius R_b = {f.base_radius_mm:g} mm; largest radius R max = {rmax:.3f} mm; "
+        f"blank diameter at least Ø max = 2 × R max = {2 * rmax:.3f} mm.",
         *centre,
         f"Lift table: lift in {'degrees of arm rotation' if f.motion == 'oscillating' else 'mm'}; "
         f"RADIUS = {radius_word} from the cam centre (mm).",
@@ -145,47 +179,69 @@ def notes_text(spec, geometry, report, shapes, layout: SheetLayout) -> list[str]
     ]
 
 
+def _dim(msp, kind: str, text: str, s: float, **kw):
+    """A rendered DIMENSION with its value as explicit text (no ``<>``: LibreCAD ignores the per-entity
+    ``dimlfac`` and would show the paper length); ``dimlfac = 1/scale`` is still set so that a CAD program
+    that re-measures it gets the true size."""
+    add = {"linear": msp.add_linear_dim, "diameter": msp.add_diameter_dim, "radius": msp.add_radius_dim}[kind]
+    d = add(dimstyle="CAMFAB", override={"dimlfac": 1.0 / s}, dxfattribs={"layer": "DIMENSIONS"}, text=text, **kw)
+    d.render()
+    return d
+
+
 def _dimensions(msp, spec, geometry, layout: SheetLayout) -> None:
     s, (cx, cy) = layout.scale, layout.centre
-    over = {"dimlfac": 1.0 / s}
-    attrs = {"layer": "DIMENSIONS"}
     rb, rmax = spec.follower.base_radius_mm, geometry.max_radius
     # base-circle diameter along 210°/30°, text outside the cam at lower left
-    d = msp.add_diameter_dim((cx, cy), radius=rb * s, angle=210.0, dimstyle="CAMFAB", override=dict(over),
-                             dxfattribs=attrs)
-    d.render()
+    _dim(msp, "diameter", f"%%c{dim_value(2 * rb)}", s, center=(cx, cy), radius=rb * s, angle=210.0)
     ext = geometry.radius_extremes()
     p = geometry.evaluate(np.array([ext.at_max])).point[0]
     u = p / np.hypot(*p)
     loc = np.array([cx, cy]) + u * (rmax * s + 8.0)
-    d = msp.add_radius_dim((cx, cy), radius=float(np.hypot(*p)) * s, location=tuple(loc),
-                           dimstyle="CAMFAB", override=dict(over), dxfattribs=attrs)
-    d.render()
-    m = spec.manufacturing
+    _dim(msp, "radius", f"R{dim_value(rmax)}", s, center=(cx, cy), radius=float(np.hypot(*p)) * s,
+         location=tuple(loc))
+    m, d = spec.manufacturing, spec.drawing
     if m.bore_mm > 0:
         r = m.bore_mm / 2
-        d = msp.add_diameter_dim((cx, cy), radius=r * s, angle=315.0,
-                                 location=(cx + (r * s + 6) * math.cos(math.radians(315)),
-                                           cy + (r * s + 6) * math.sin(math.radians(315))),
-                                 dimstyle="CAMFAB", override=dict(over), dxfattribs=attrs)
-        d.render()
+        _dim(msp, "diameter", f"%%c{dim_value(m.bore_mm)} {d.bore_fit}", s, center=(cx, cy), radius=r * s,
+             angle=315.0, location=(cx + (r * s + 6) * math.cos(math.radians(315)),
+                                    cy + (r * s + 6) * math.sin(math.radians(315))))
         if m.keyway:
             b, t2 = keyway_size(m.bore_mm)
             top = cy + (r + t2) * s
-            d = msp.add_linear_dim(base=(cx, top + 5.0), p1=(cx - b / 2 * s, top), p2=(cx + b / 2 * s, top),
-                                   dimstyle="CAMFAB", override=dict(over), dxfattribs=attrs)
-            d.render()
+            _dim(msp, "linear", f"{dim_value(b)} {d.keyway_width_fit}", s, base=(cx, top + 5.0),
+                 p1=(cx - b / 2 * s, top), p2=(cx + b / 2 * s, top))
             xd = cx - (r * s + 5.0)
-            d = msp.add_linear_dim(base=(xd, cy), p1=(cx, cy - r * s), p2=(cx - b / 2 * s, top), angle=90.0,
-                                   dimstyle="CAMFAB", override=dict(over), dxfattribs=attrs)
-            d.render()
+            _dim(msp, "linear", f"{dim_value(m.bore_mm + t2)} +{keyway_depth_tolerance(m.bore_mm):g}/0", s,
+                 base=(xd, cy), p1=(cx, cy - r * s), p2=(cx - b / 2 * s, top), angle=90.0)
+
+
+def _cam_labels(msp, spec, geometry, shapes, layout: SheetLayout) -> None:
+    """Which line is which cam: a legend in the view's top-left corner on conjugate sheets (two plates,
+    CAM 2 dashed on its own layer) and on constant-width / constant-diameter sheets (one cam, two
+    followers)."""
+    x0, _, _, y1 = layout.view
+    kind = str(spec.cam.kind)
+    if len(shapes.profiles) > 1:
+        rows = [("PROFILE", "CAM 1 (first follower)"), ("PROFILE_2", "CAM 2 (second follower)")]
+    elif kind in ("constant_width", "constant_diameter"):
+        width = spec.follower.width_mm or 0.0
+        word = "width" if kind == "constant_width" else "diameter"
+        rows = [("PROFILE", f"CAM: one profile, followers at 0° and 180° (constant {word} {width:g} mm)")]
+    else:
+        return
+    for i, (layer, label) in enumerate(rows):
+        y = y1 - 3.0 - 5.0 * i
+        msp.add_line((x0, y), (x0 + 8.0, y), dxfattribs={"layer": layer})
+        put_text(msp, label, (x0 + 10.0, y), 2.5, "ANNOTATION", "MIDDLE_LEFT")
 
 
 def _view(msp, spec, geometry, shapes, layout: SheetLayout) -> None:
     s, (cx, cy) = layout.scale, layout.centre
     f, m = spec.follower, spec.manufacturing
-    for loop in shapes.profiles:
-        msp.add_lwpolyline(place(loop, s, (cx, cy)), format="xyseb", close=True, dxfattribs={"layer": "PROFILE"})
+    for i, loop in enumerate(shapes.profiles):
+        msp.add_lwpolyline(place(loop, s, (cx, cy)), format="xyseb", close=True,
+                           dxfattribs={"layer": "PROFILE" if i == 0 else "PROFILE_2"})
     if m.bore_mm > 0:
         msp.add_lwpolyline(place(bore_loop(m.bore_mm, m.keyway), s, (cx, cy)), format="xyseb", close=True,
                            dxfattribs={"layer": "BORE"})
@@ -195,7 +251,7 @@ def _view(msp, spec, geometry, shapes, layout: SheetLayout) -> None:
         clipped_circle(msp, (cx, cy), (f.base_radius_mm + c.roller_radius) * s, layout.view, "PRIME_CIRCLE")
     elif f.type == FollowerType.ROLLER and f.roller_radius_mm:
         msp.add_circle((cx, cy), (f.base_radius_mm + f.roller_radius_mm) * s, dxfattribs={"layer": "PRIME_CIRCLE"})
-    rmax = max([float(np.max(np.hypot(*lp.points.T))) for lp in shapes.profiles] + [geometry.max_radius])
+    rmax = _extent(geometry, shapes)
     reach = rmax * s + 4.0
     msp.add_line((cx - reach, cy), (cx + reach, cy), dxfattribs={"layer": "CENTRE_LINES"})
     msp.add_line((cx, cy - reach), (cx, cy + reach), dxfattribs={"layer": "CENTRE_LINES"})
@@ -219,23 +275,52 @@ def _view(msp, spec, geometry, shapes, layout: SheetLayout) -> None:
                                        cy + (ra + 2) * math.sin(math.radians(55))), 2.5, "ANNOTATION")
 
 
+def _extent(geometry, shapes) -> float:
+    return max([float(np.max(np.hypot(*lp.points.T))) for lp in shapes.profiles] + [geometry.max_radius])
+
+
+def _side_view(msp, spec, layout: SheetLayout, y_lo: float, y_hi: float, bore: bool) -> None:
+    """The plate seen from the side, in ``layout.side`` at the height of the main view (true ``y_lo`` …
+    ``y_hi`` about the view's reference ``layout.centre``): its outline, the thickness dimensioned, the bore
+    and keyseat as hidden lines and the axis as a centre line."""
+    if layout.side is None:
+        return
+    s, (_, cy) = layout.scale, layout.centre
+    m = spec.manufacturing
+    x0, _, x1, _ = layout.side
+    t = m.thickness_mm * s
+    a = (x0 + x1) / 2 - t / 2
+    b = a + t
+    lo, hi = cy + y_lo * s, cy + y_hi * s
+    msp.add_lwpolyline([(a, lo), (b, lo), (b, hi), (a, hi)], close=True, dxfattribs={"layer": "SIDE_VIEW"})
+    if bore and m.bore_mm > 0:
+        r = m.bore_mm / 2
+        ys = [-r, r] + ([r + keyway_size(m.bore_mm)[1]] if m.keyway else [])
+        for y in ys:
+            msp.add_line((a, cy + y * s), (b, cy + y * s), dxfattribs={"layer": "HIDDEN"})
+        msp.add_line((a - 3.0, cy), (b + 3.0, cy), dxfattribs={"layer": "CENTRE_LINES"})
+    _dim(msp, "linear", dim_value(m.thickness_mm), s, base=((a + b) / 2, lo - 8.0), p1=(a, lo), p2=(b, lo))
+
+
 def build_drawing(spec, geometry, report, shapes, *, paper: str = "auto", lift_step_deg: float = 10.0):
     """The ezdxf document of :func:`drawing_sheet` and its :class:`SheetLayout`."""
     from ..design.tables import lift_table
 
     tpl = load_template()
     if not geometry.closed:
-        table = lift_table(geometry, 360.0 / _plate_table_intervals(geometry.period))
-        return _build_plate_drawing(spec, geometry, report, shapes, table, paper, tpl)
+        return _build_plate_drawing(spec, geometry, report, shapes, _plate_table(geometry), paper, tpl)
     table = lift_table(geometry, lift_step_deg)
-    extent = max([float(np.max(np.hypot(*lp.points.T))) for lp in shapes.profiles] + [geometry.max_radius])
-    layout = sheet_layout(extent, len(table.angle), paper)
+    extent = _extent(geometry, shapes)
+    layout = sheet_layout(extent, len(table.angle), paper, spec.manufacturing.thickness_mm)
     doc, msp = new_document(spec, layout, shapes, tpl)
     title_block(msp, layout, title_fields(spec, report, layout))
     lift_table_block(msp, layout, table, geometry.closed)
     notes_column(msp, layout, notes_text(spec, geometry, report, shapes, layout))
     _view(msp, spec, geometry, shapes, layout)
+    _cam_labels(msp, spec, geometry, shapes, layout)
     _dimensions(msp, spec, geometry, layout)
+    pts = np.concatenate([lp.points for lp in shapes.profiles])
+    _side_view(msp, spec, layout, float(pts[:, 1].min()), float(pts[:, 1].max()), True)
     return doc, layout
 
 
@@ -252,6 +337,20 @@ def _plate_table_intervals(length: float, most: int = 40) -> int:
     return 36
 
 
+def _plate_table(geometry):
+    """A translating cam's lift table over its whole length: the rows of
+    :func:`~camfab.design.tables.lift_table` and the end of the plate (travel = length)."""
+    from ..design.tables import LiftTable, lift_table
+
+    t = lift_table(geometry, 360.0 / _plate_table_intervals(geometry.period))
+    c = geometry.profiles[0]
+    x = np.array([geometry.period])
+    lift = c.motion.evaluate(x, (0,))[0]
+    height = c.evaluate(x).pitch[:, 1]
+    return LiftTable(np.append(t.angle, geometry.to_user(x)), np.append(t.lift, lift), np.append(t.radius, height),
+                     t.lift_unit, t.radius_label)
+
+
 def _plate_box(shapes) -> tuple[float, float, float, float]:
     pts = np.concatenate([lp.flatten(1e-3) for lp in shapes.profiles])
     return float(pts[:, 0].min()), float(pts[:, 1].min()), float(pts[:, 0].max()), float(pts[:, 1].max())
@@ -261,7 +360,7 @@ def _build_plate_drawing(spec, geometry, report, shapes, table, paper, tpl):
     from dataclasses import replace
 
     x0, y0, x1, y1 = _plate_box(shapes)
-    layout = sheet_layout(((x1 - x0) / 2, (y1 - y0) / 2), len(table.angle), paper)
+    layout = sheet_layout(((x1 - x0) / 2, (y1 - y0) / 2), len(table.angle), paper, spec.manufacturing.thickness_mm)
     vx0, vy0, vx1, vy1 = layout.view
     s = layout.scale
     # the true origin (bottom edge, travel 0 end) lands so that the plate's box is centred in the view
@@ -271,6 +370,7 @@ def _build_plate_drawing(spec, geometry, report, shapes, table, paper, tpl):
     lift_table_block(msp, layout, table, geometry.closed)
     notes_column(msp, layout, plate_notes(spec, geometry, report, shapes, layout))
     _plate_view(msp, spec, geometry, shapes, layout, (x0, y0, x1, y1))
+    _side_view(msp, spec, layout, y0, y1, False)
     return doc, layout
 
 
@@ -278,15 +378,14 @@ def plate_notes(spec, geometry, report, shapes, layout: SheetLayout) -> list[str
     """The numbered notes of a translating cam's sheet."""
     m, f = spec.manufacturing, spec.follower
     c = geometry.profiles[0]
-    dev = max(shapes.profile_deviation) if shapes.profile_deviation else 0.0
     top = geometry.radius_extremes().max
     slide = "LEFT" if spec.cam.direction == "left" else "RIGHT"
     start = "left" if spec.cam.direction == "left" else "right"
     verdict = _verdict_note(report)
     return [
-        f"Material: {m.material or 'to be specified'}.",
-        f"Plate thickness {m.thickness_mm:g} mm; length {c.period:g} mm; no bore (sliding plate).",
-        f"Profile tolerance ±{m.tolerance_mm:g} mm; drawn arcs lie within {dev:.2g} mm of the exact profile.",
+        f"Material: {_material(spec)}.",
+        f"Plate thickness {m.thickness_mm:g} mm (side view); length {c.period:g} mm; no bore (sliding plate).",
+        *_tolerance_notes(spec, shapes),
         f"All dimensions in mm (true size); scale {layout.scale_label}.",
         f"The cam slides {slide} as drawn; travel 0 is at its {start} end (marked 0), where the follower "
         "starts; the lift table gives the follower lift after the cam has travelled the given distance.",
@@ -303,6 +402,7 @@ def _plate_view(msp, spec, geometry, shapes, layout: SheetLayout, box) -> None:
     s, (cx, cy) = layout.scale, layout.centre
     x0, y0, x1, y1 = box
     f = spec.follower
+    c = geometry.profiles[0]
 
     def at(x, y):
         return (cx + s * x, cy + s * y)
@@ -311,7 +411,9 @@ def _plate_view(msp, spec, geometry, shapes, layout: SheetLayout, box) -> None:
         msp.add_lwpolyline(place(loop, s, (cx, cy)), format="xyseb", close=True, dxfattribs={"layer": "PROFILE"})
     h = f.base_height_mm
     msp.add_line(at(x0, h), at(x1, h), dxfattribs={"layer": "BASE_CIRCLE"})  # the S = 0 line
-    put_text(msp, "S = 0", (at(x1, h)[0] + 1.0, at(x1, h)[1]), 2.0, "ANNOTATION", "MIDDLE_LEFT")
+    # the S = 0 line runs on past the highest-point dimension (8 mm right of the plate) to its label
+    msp.add_line(at(x1, h), (at(x1, h)[0] + 10.0, at(x1, h)[1]), dxfattribs={"layer": "BASE_CIRCLE"})
+    put_text(msp, "S = 0", (at(x1, h)[0] + 11.0, at(x1, h)[1]), 2.0, "ANNOTATION", "MIDDLE_LEFT")
     left = spec.cam.direction == "left"
     zero = x0 if left else x1
     put_text(msp, "0", (at(zero, y1)[0], at(zero, y1)[1] + 2.0), 2.5, "ANNOTATION", "BOTTOM_CENTER")
@@ -324,17 +426,14 @@ def _plate_view(msp, spec, geometry, shapes, layout: SheetLayout, box) -> None:
     msp.add_solid([(tip, ya), (tip + d, ya + 1.0), (tip + d, ya - 1.0)], dxfattribs={"layer": "ANNOTATION"})
     put_text(msp, f"CAM SLIDES {'LEFT' if left else 'RIGHT'}", ((xa0 + xa1) / 2, ya + 1.5), 2.5, "ANNOTATION",
           "BOTTOM_CENTER")
-    over = {"dimlfac": 1.0 / s}
-    attrs = {"layer": "DIMENSIONS"}
     dims = [  # overall length under the plate; S = 0 height at the left end; highest point at the right end
-        dict(base=(at(x0, y0)[0], at(x0, y0)[1] - 8.0), p1=at(x0, y0), p2=at(x1, y0)),
-        dict(base=(at(x0, 0)[0] - 8.0, at(x0, 0)[1]), p1=at(x0, y0), p2=at(x0, h), angle=90.0),
-        dict(base=(at(x1, 0)[0] + 8.0, at(x1, 0)[1]), p1=at(x1, y0), p2=at(_x_of_top(geometry), y1),
-             angle=90.0),
+        (c.period, dict(base=(at(x0, y0)[0], at(x0, y0)[1] - 8.0), p1=at(x0, y0), p2=at(x1, y0))),
+        (h - y0, dict(base=(at(x0, 0)[0] - 8.0, at(x0, 0)[1]), p1=at(x0, y0), p2=at(x0, h), angle=90.0)),
+        (y1 - y0, dict(base=(at(x1, 0)[0] + 8.0, at(x1, 0)[1]), p1=at(x1, y0), p2=at(_x_of_top(geometry), y1),
+                       angle=90.0)),
     ]
-    for kw in dims:
-        dim = msp.add_linear_dim(dimstyle="CAMFAB", override=dict(over), dxfattribs=attrs, **kw)
-        dim.render()
+    for value, kw in dims:
+        _dim(msp, "linear", dim_value(value), s, **kw)
 
 
 def _x_of_top(geometry) -> float:
