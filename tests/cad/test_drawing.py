@@ -130,7 +130,7 @@ def test_dimensions_are_real_dimension_entities(e9):
     dims = _dims(doc)
     assert all(d.dxf.layer == "DIMENSIONS" for d in doc.modelspace().query("DIMENSION"))
     assert sorted(dims[3]) == pytest.approx([12.0, 70.0])  # bore and base-circle diameters (true size)
-    assert dims[4] == pytest.approx([geom.max_radius], abs=1e-9)  # DMAX radius
+    assert dims[4] == pytest.approx([geom.max_radius], abs=1e-9)  # R max
     # keyway width b, the plate thickness (side view) and d + t2 (DIN 6885: 12 mm bore)
     assert sorted(dims[0]) == pytest.approx([4.0, 10.0, 13.8])
     # rendered: each dimension has its block with the measurement text
