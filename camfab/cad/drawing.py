@@ -57,8 +57,10 @@ from .plate import bore_loop, keyway_size
 from .sheet import (
     LAYERS,
     PAPERS,
+    Occupancy,
     SheetLayout,
     clipped_circle,
+    dimension_parts,
     lift_table_block,
     load_template,
     new_document,
@@ -67,6 +69,7 @@ from .sheet import (
     place,
     put_text,
     sheet_layout,
+    text_width,
     title_block,
 )
 
@@ -179,41 +182,102 @@ def notes_text(spec, geometry, report, shapes, layout: SheetLayout) -> list[str]
     ]
 
 
-def _dim(msp, kind: str, text: str, s: float, **kw):
+def _dim(msp, kind: str, text: str, s: float, extra: dict | None = None, **kw):
     """A rendered DIMENSION with its value as explicit text (no ``<>``: LibreCAD ignores the per-entity
     ``dimlfac`` and would show the paper length); ``dimlfac = 1/scale`` is still set so that a CAD program
     that re-measures it gets the true size."""
     add = {"linear": msp.add_linear_dim, "diameter": msp.add_diameter_dim, "radius": msp.add_radius_dim}[kind]
-    d = add(dimstyle="CAMFAB", override={"dimlfac": 1.0 / s}, dxfattribs={"layer": "DIMENSIONS"}, text=text, **kw)
+    d = add(dimstyle="CAMFAB", override={"dimlfac": 1.0 / s, **(extra or {})}, dxfattribs={"layer": "DIMENSIONS"},
+            text=text, **kw)
     d.render()
     return d
 
 
-def _dimensions(msp, spec, geometry, layout: SheetLayout) -> None:
-    s, (cx, cy) = layout.scale, layout.centre
+def _place(msp, occ: Occupancy, s: float, kind: str, text: str, options: list[dict]) -> None:
+    """The dimension at the first of ``options`` (keyword sets) where it keeps the layout rule against what
+    ``occ`` holds (the first when none does: the layout test then names it)."""
+    doc = msp.doc
+    for kw in options:
+        d = _dim(msp, kind, text, s, **kw)
+        quads, segs = dimension_parts(doc, d.dimension)
+        if occ.free(quads, segs):
+            occ.add(quads, segs)
+            return
+        block = d.dimension.dxf.geometry
+        msp.delete_entity(d.dimension)
+        doc.blocks.delete_block(block, safe=False)
+    d = _dim(msp, kind, text, s, **options[0])
+    occ.add(*dimension_parts(doc, d.dimension))
+
+
+def _radial_at(centre, deg: float, inner: float, text: str) -> tuple[float, float]:
+    """Where a radial dimension's text (written along the radius) goes so that it starts ``inner`` paper mm
+    from ``centre`` in the direction ``deg``."""
+    d = inner + text_width(text, load_template()["dimensions"]["text_height_mm"]) / 2
+    return (centre[0] + d * math.cos(math.radians(deg)), centre[1] + d * math.sin(math.radians(deg)))
+
+
+def _dimensions(msp, spec, geometry, shapes, layout: SheetLayout, occ: Occupancy) -> None:
+    """R max, base circle Ø, bore Ø with its fit, keyway width and depth with their DIN 6885 tolerances, each
+    at the first of a few positions where its text crosses no line and no text (``occ``)."""
+    s, c = layout.scale, layout.centre
+    cx, cy = c
     rb, rmax = spec.follower.base_radius_mm, geometry.max_radius
-    # base-circle diameter along 210°/30°, text outside the cam at lower left
-    _dim(msp, "diameter", f"%%c{dim_value(2 * rb)}", s, center=(cx, cy), radius=rb * s, angle=210.0)
+    reach = _extent(geometry, shapes) * s
+    h = load_template()["dimensions"]["text_height_mm"]
+    theta, r_at = _rmax_point(geometry)
+    text = f"R{dim_value(rmax)}"
+    _place(msp, occ, s, "radius", text, [dict(center=c, radius=r_at * s, location=_radial_at(c, theta, reach + k, text))
+                                         for k in (2.0, 8.0, 14.0)])
+    text = f"%%c{dim_value(2 * rb)}"
+    _place(msp, occ, s, "diameter", text, [dict(center=c, radius=rb * s, angle=a,
+                                                location=_radial_at(c, a, reach + k, text))
+                                           for k in (2.0, 8.0)
+                                           for a in (210.0, 330.0, 150.0, 30.0, 240.0, 300.0, 120.0, 60.0)])
+    m, d = spec.manufacturing, spec.drawing
+    if m.bore_mm <= 0:
+        return
+    r = m.bore_mm / 2
+    text = f"%%c{dim_value(m.bore_mm)} {d.bore_fit}"
+    angles = (300.0, 240.0, 330.0, 210.0, 270.0, 285.0, 255.0)
+    _place(msp, occ, s, "diameter", text, [dict(center=c, radius=r * s, angle=a, location=_radial_at(c, a, inner, text))
+                                           for inner in (r * s + 2.0, reach + 2.0, reach + 8.0) for a in angles])
+    if not m.keyway:
+        return
+    b, t2 = keyway_size(m.bore_mm)
+    top = cy + (r + t2) * s
+    lead = {"dimtmove": 1}  # a text moved off its dimension line gets a leader
+    text = f"{dim_value(m.bore_mm + t2)} +{keyway_depth_tolerance(m.bore_mm):g}/0"
+    w = text_width(text, h)
+    options = []
+    for side in (-1.0, 1.0):
+        xd = cx + side * (r * s + 5.0)
+        base = dict(base=(xd, cy), p1=(cx, cy - r * s), p2=(cx + side * b / 2 * s, top), angle=90.0)
+        tx = xd - 0.625 - h / 2
+        for loc, ex in (((tx, top + 1.5 + w / 2), None), ((tx, cy - r * s - 1.5 - w / 2), None),
+                        ((tx, cy + reach + 2.0 + w / 2), lead), ((tx, cy - reach - 2.0 - w / 2), lead),
+                        ((tx - 6.0 * side, cy + reach + 2.0 + w / 2), lead)):
+            options.append(dict(base, location=loc, extra=ex))
+    _place(msp, occ, s, "linear", text, options)
+    text = f"{dim_value(b)} {d.keyway_width_fit}"
+    w = text_width(text, h)
+    up = top + 5.0 + 0.625 + h / 2
+    _place(msp, occ, s, "linear", text, [
+        dict(base=(cx, top + 5.0), p1=(cx - b / 2 * s, top), p2=(cx + b / 2 * s, top), location=loc, extra=ex)
+        for loc, ex in (((cx + b / 2 * s + 1.5 + w / 2, up), None), ((cx - b / 2 * s - 1.5 - w / 2, up), None),
+                        *(((cx + sign * (2.0 + w / 2), cy + reach + k), lead) for k in (3.0, 9.0, 15.0)
+                          for sign in (1.0, -1.0)))])
+
+
+def _rmax_point(geometry) -> tuple[float, float]:
+    """The angle (degrees, sheet frame) and distance of the profile point at R max."""
     ext = geometry.radius_extremes()
     p = geometry.evaluate(np.array([ext.at_max])).point[0]
-    u = p / np.hypot(*p)
-    loc = np.array([cx, cy]) + u * (rmax * s + 8.0)
-    _dim(msp, "radius", f"R{dim_value(rmax)}", s, center=(cx, cy), radius=float(np.hypot(*p)) * s,
-         location=tuple(loc))
-    m, d = spec.manufacturing, spec.drawing
-    if m.bore_mm > 0:
-        r = m.bore_mm / 2
-        _dim(msp, "diameter", f"%%c{dim_value(m.bore_mm)} {d.bore_fit}", s, center=(cx, cy), radius=r * s,
-             angle=315.0, location=(cx + (r * s + 6) * math.cos(math.radians(315)),
-                                    cy + (r * s + 6) * math.sin(math.radians(315))))
-        if m.keyway:
-            b, t2 = keyway_size(m.bore_mm)
-            top = cy + (r + t2) * s
-            _dim(msp, "linear", f"{dim_value(b)} {d.keyway_width_fit}", s, base=(cx, top + 5.0),
-                 p1=(cx - b / 2 * s, top), p2=(cx + b / 2 * s, top))
-            xd = cx - (r * s + 5.0)
-            _dim(msp, "linear", f"{dim_value(m.bore_mm + t2)} +{keyway_depth_tolerance(m.bore_mm):g}/0", s,
-                 base=(xd, cy), p1=(cx, cy - r * s), p2=(cx - b / 2 * s, top), angle=90.0)
+    return math.degrees(math.atan2(p[1], p[0])), float(np.hypot(*p))
+
+
+def _rmax_angle(geometry) -> float:
+    return _rmax_point(geometry)[0]
 
 
 def _cam_labels(msp, spec, geometry, shapes, layout: SheetLayout) -> None:
@@ -227,13 +291,14 @@ def _cam_labels(msp, spec, geometry, shapes, layout: SheetLayout) -> None:
     elif kind in ("constant_width", "constant_diameter"):
         width = spec.follower.width_mm or 0.0
         word = "width" if kind == "constant_width" else "diameter"
-        rows = [("PROFILE", f"CAM: one profile, followers at 0° and 180° (constant {word} {width:g} mm)")]
+        rows = [("PROFILE", "CAM (one profile, two followers"), ("", f"at 0° and 180°, constant {word} {width:g})")]
     else:
         return
     for i, (layer, label) in enumerate(rows):
-        y = y1 - 3.0 - 5.0 * i
-        msp.add_line((x0, y), (x0 + 8.0, y), dxfattribs={"layer": layer})
-        put_text(msp, label, (x0 + 10.0, y), 2.5, "ANNOTATION", "MIDDLE_LEFT")
+        y = y1 - 3.0 - 4.5 * i
+        if layer:
+            msp.add_line((x0, y), (x0 + 8.0, y), dxfattribs={"layer": layer})
+        put_text(msp, label, (x0 + 10.0, y), 2.5, "ANNOTATION", "MIDDLE_LEFT", width=layout.view[2] - x0 - 10.0)
 
 
 def _view(msp, spec, geometry, shapes, layout: SheetLayout) -> None:
@@ -259,11 +324,15 @@ def _view(msp, spec, geometry, shapes, layout: SheetLayout) -> None:
     msp.add_line((cx - mark, cy), (cx + mark, cy), dxfattribs={"layer": "CENTRE_MARKS"})
     msp.add_line((cx, cy - mark), (cx, cy + mark), dxfattribs={"layer": "CENTRE_MARKS"})
     put_text(msp, "0°", (cx + 1.0, cy + reach), 2.5, "ANNOTATION", "BOTTOM_LEFT")
-    # rotation arrow: an arc at 40°…70° with an arrowhead in the sense of rotation
+    # rotation arrow: an arc at 40°…70° (110°…140° when R max is on the right) with an arrowhead in the sense
+    # of rotation
     ra = rmax * s + 6.0
-    msp.add_arc((cx, cy), ra, 40.0, 70.0, dxfattribs={"layer": "ANNOTATION"})
+    if c.curved_face and abs((f.base_radius_mm + c.roller_radius) * s - ra) < 6.0:  # clear of the chain line
+        ra = (f.base_radius_mm + c.roller_radius) * s + 6.0
+    a0 = 110.0 if math.cos(math.radians(_rmax_angle(geometry))) >= -1e-9 else 40.0
+    msp.add_arc((cx, cy), ra, a0, a0 + 30.0, dxfattribs={"layer": "ANNOTATION"})
     cw = spec.cam.rotation == "cw"
-    tip_deg = 40.0 if cw else 70.0
+    tip_deg = a0 if cw else a0 + 30.0
     t = math.radians(tip_deg)
     tip = np.array([cx + ra * math.cos(t), cy + ra * math.sin(t)])
     fwd = np.array([math.sin(t), -math.cos(t)]) * (1 if cw else -1)
@@ -271,8 +340,9 @@ def _view(msp, spec, geometry, shapes, layout: SheetLayout) -> None:
     back = tip - 3.0 * fwd
     msp.add_solid([tuple(tip), tuple(back + 1.0 * side), tuple(back - 1.0 * side)],
                   dxfattribs={"layer": "ANNOTATION"})
-    put_text(msp, "CW" if cw else "CCW", (cx + (ra + 2) * math.cos(math.radians(55)),
-                                       cy + (ra + 2) * math.sin(math.radians(55))), 2.5, "ANNOTATION")
+    mid = math.radians(a0 + 15.0)
+    put_text(msp, "CW" if cw else "CCW", (cx + (ra + 2) * math.cos(mid), cy + (ra + 2) * math.sin(mid)), 2.5,
+             "ANNOTATION", "BOTTOM_LEFT" if a0 < 90 else "BOTTOM_RIGHT")
 
 
 def _extent(geometry, shapes) -> float:
@@ -318,9 +388,9 @@ def build_drawing(spec, geometry, report, shapes, *, paper: str = "auto", lift_s
     notes_column(msp, layout, notes_text(spec, geometry, report, shapes, layout))
     _view(msp, spec, geometry, shapes, layout)
     _cam_labels(msp, spec, geometry, shapes, layout)
-    _dimensions(msp, spec, geometry, layout)
     pts = np.concatenate([lp.points for lp in shapes.profiles])
     _side_view(msp, spec, layout, float(pts[:, 1].min()), float(pts[:, 1].max()), True)
+    _dimensions(msp, spec, geometry, shapes, layout, Occupancy(doc, layout))
     return doc, layout
 
 
@@ -411,9 +481,8 @@ def _plate_view(msp, spec, geometry, shapes, layout: SheetLayout, box) -> None:
         msp.add_lwpolyline(place(loop, s, (cx, cy)), format="xyseb", close=True, dxfattribs={"layer": "PROFILE"})
     h = f.base_height_mm
     msp.add_line(at(x0, h), at(x1, h), dxfattribs={"layer": "BASE_CIRCLE"})  # the S = 0 line
-    # the S = 0 line runs on past the highest-point dimension (8 mm right of the plate) to its label
-    msp.add_line(at(x1, h), (at(x1, h)[0] + 10.0, at(x1, h)[1]), dxfattribs={"layer": "BASE_CIRCLE"})
-    put_text(msp, "S = 0", (at(x1, h)[0] + 11.0, at(x1, h)[1]), 2.0, "ANNOTATION", "MIDDLE_LEFT")
+    # the label sits on the S = 0 line's extension, between the plate and the dimension of its height
+    put_text(msp, "S=0", (at(x0, h)[0] - 0.5, at(x0, h)[1] + 0.5), 1.8, "ANNOTATION", "BOTTOM_RIGHT")
     left = spec.cam.direction == "left"
     zero = x0 if left else x1
     put_text(msp, "0", (at(zero, y1)[0], at(zero, y1)[1] + 2.0), 2.5, "ANNOTATION", "BOTTOM_CENTER")
@@ -424,7 +493,7 @@ def _plate_view(msp, spec, geometry, shapes, layout: SheetLayout, box) -> None:
     msp.add_line((tail, ya), (tip, ya), dxfattribs={"layer": "ANNOTATION"})
     d = 3.0 if tip < tail else -3.0
     msp.add_solid([(tip, ya), (tip + d, ya + 1.0), (tip + d, ya - 1.0)], dxfattribs={"layer": "ANNOTATION"})
-    put_text(msp, f"CAM SLIDES {'LEFT' if left else 'RIGHT'}", ((xa0 + xa1) / 2, ya + 1.5), 2.5, "ANNOTATION",
+    put_text(msp, f"CAM SLIDES {'LEFT' if left else 'RIGHT'}", ((xa0 + xa1) / 2, ya + 2.0), 2.5, "ANNOTATION",
           "BOTTOM_CENTER")
     dims = [  # overall length under the plate; S = 0 height at the left end; highest point at the right end
         (c.period, dict(base=(at(x0, y0)[0], at(x0, y0)[1] - 8.0), p1=at(x0, y0), p2=at(x1, y0))),

@@ -22,7 +22,8 @@ from .dxf import ezdxf_module
 
 __all__ = ["PAPERS", "LAYERS", "SheetLayout", "load_template", "parse_scale", "sheet_layout", "put_text", "rect",
            "place", "fmt", "title_block", "lift_table_block", "notes_column", "clipped_circle", "new_document",
-           "text_width", "wrap", "NOTE_PITCH"]
+           "text_width", "wrap", "NOTE_PITCH", "SheetItems", "sheet_items", "layout_problems", "Occupancy",
+           "dimension_parts", "REFERENCE_LAYERS"]
 
 PAPERS = ("A4", "A3")
 
@@ -279,7 +280,7 @@ def lift_table_block(msp, layout: SheetLayout, table, closed: bool) -> None:
 
 #: MTEXT line spacing: the factor written, and the pitch (× text height) a box of the notes assumes (AutoCAD
 #: draws 5/3 × height × factor; LibreCAD less)
-NOTE_SPACING = 1.2
+NOTE_SPACING = 1.0
 NOTE_PITCH = 5.0 / 3.0 * NOTE_SPACING
 
 
@@ -356,3 +357,234 @@ def new_document(spec, layout: SheetLayout, shapes, tpl):
     rect(msp, (0.0, 0.0, *layout.size), "FRAME")
     rect(msp, layout.frame, "FRAME")
     return doc, msp
+
+
+# ---------------------------------------------------------------------------
+# the layout rule, checked on the written sheet: boxes of every text, table, view and title block
+_GROUP_OF_LAYER = {"TITLE_BLOCK": "title", "LIFT_TABLE": "table", "NOTES": "notes"}
+#: thin reference circles (base circle, prime or face-centre circle) that may pass behind a text; a face-centre
+#: circle can be larger than the cam, and a small base circle runs close round the bore's texts
+REFERENCE_LAYERS = ("BASE_CIRCLE", "PRIME_CIRCLE")
+_HALIGN = {"LEFT": 0.0, "CENTER": 0.5, "MIDDLE": 0.5, "RIGHT": 1.0, "ALIGNED": 0.0, "FIT": 0.0}
+
+
+@dataclass(frozen=True)
+class SheetItems:
+    """What lies on a sheet, in paper mm: the text boxes and line segments with their group (``title``,
+    ``table``, ``notes``, ``view``, ``side``) and owner (the handle of the DIMENSION they belong to, else
+    ``""``)."""
+
+    texts: list[tuple[str, str, str, np.ndarray]]  # (text, group, owner, corners (4, 2) of its box)
+    segments: np.ndarray  # (n, 4) x0, y0, x1, y1
+    seg_group: list[str]
+    seg_owner: list[str]
+    seg_reference: np.ndarray  # (n,) bool: on a layer of REFERENCE_LAYERS
+
+
+def _rotated_box(x: float, y: float, local: tuple[float, float, float, float], deg: float) -> np.ndarray:
+    """The corners (4, 2) of the box ``local`` = (u0, v0, u1, v1) turned by ``deg`` about (0, 0) and moved to
+    (x, y)."""
+    a = math.radians(deg)
+    c, s = math.cos(a), math.sin(a)
+    u0, v0, u1, v1 = local
+    uv = np.array([(u0, v0), (u1, v0), (u1, v1), (u0, v1)])
+    return np.column_stack([x + uv[:, 0] * c - uv[:, 1] * s, y + uv[:, 0] * s + uv[:, 1] * c])
+
+
+def _text_box(e) -> tuple[str, np.ndarray]:
+    """A TEXT's or MTEXT's text and its conservative box (:func:`text_width`; TEXT from the baseline less a
+    quarter height for descenders to the cap height; MTEXT lines at :data:`NOTE_PITCH`)."""
+    if e.dxftype() == "TEXT":
+        align, p1, p2 = e.get_placement()
+        h = e.dxf.height
+        w = text_width(e.dxf.text, h)
+        name = align.name  # e.g. MIDDLE_CENTER, BOTTOM_LEFT, LEFT
+        v, _, hname = name.partition("_") if "_" in name else ("BASELINE", "", name)
+        at = p1 if name in ("LEFT",) else (p2 if p2 is not None else p1)
+        u0 = -_HALIGN.get(hname, 0.0) * w
+        v0 = {"TOP": -h, "MIDDLE": -h / 2, "BOTTOM": -0.25 * h}.get(v, -0.25 * h)
+        v1 = {"TOP": 0.0, "MIDDLE": h / 2}.get(v, h)
+        return e.dxf.text, _rotated_box(at[0], at[1], (u0, v0, u0 + w, v1), e.dxf.rotation)
+    lines = e.text.split("\\P")
+    h = e.dxf.char_height
+    w, tall = max(text_width(line, h) for line in lines), h + (len(lines) - 1) * h * NOTE_PITCH
+    ap = e.dxf.attachment_point
+    u0 = -w * ((ap - 1) % 3) / 2
+    v1 = {0: 0.0, 1: tall / 2, 2: tall}[(ap - 1) // 3]
+    direction = e.dxf.get("rotation", 0.0)
+    if e.dxf.hasattr("text_direction"):
+        d = e.dxf.text_direction
+        direction = math.degrees(math.atan2(d[1], d[0]))
+    x, y = e.dxf.insert[0], e.dxf.insert[1]
+    return e.text, _rotated_box(x, y, (u0, v1 - tall, u0 + w, v1), direction)
+
+
+def _segments(e, flat: float = 0.05) -> list[tuple[float, float, float, float]]:
+    from ezdxf import path as ezpath
+
+    kind = e.dxftype()
+    if kind == "INSERT":
+        return [s for v in e.virtual_entities() for s in _segments(v, flat)]
+    if kind not in ("LINE", "LWPOLYLINE", "ARC", "CIRCLE", "SOLID"):
+        return []
+    pts = [(p.x, p.y) for p in ezpath.make_path(e).flattening(flat)]
+    return [(a[0], a[1], b[0], b[1]) for a, b in zip(pts[:-1], pts[1:], strict=True)]
+
+
+def sheet_items(doc, layout: SheetLayout) -> SheetItems:
+    """Every text box and line segment of a sheet (the frame excepted), grouped: by layer for the title
+    block, lift table and notes, by position for the side view (right of ``layout.side``'s left edge),
+    the rest is the cam view; a DIMENSION's lines and text are owned by it."""
+    texts, segs, groups, owners, refs = [], [], [], [], []
+
+    def group_of(e, x: float) -> str:
+        g = _GROUP_OF_LAYER.get(e.dxf.layer)
+        if g:
+            return g
+        return "side" if layout.side is not None and x >= layout.side[0] else "view"
+
+    for e in doc.modelspace():
+        if e.dxf.layer == "FRAME" or e.dxftype() == "POINT":
+            continue
+        if e.dxftype() == "DIMENSION":
+            block = doc.blocks.get(e.dxf.geometry)
+            parts = [(t, _text_box(t)) for t in block if t.dxftype() == "MTEXT"]
+            lines = [s for t in block for s in _segments(t)]
+            x = min(s[0] for s in lines)
+            g = group_of(e, x)
+            for _, (text, box) in parts:
+                texts.append((text, g, e.dxf.handle, box))
+            segs += lines
+            groups += [g] * len(lines)
+            owners += [e.dxf.handle] * len(lines)
+            refs += [False] * len(lines)
+        elif e.dxftype() in ("TEXT", "MTEXT"):
+            text, box = _text_box(e)
+            texts.append((text, group_of(e, float(box[:, 0].min())), "", box))
+        else:
+            lines = _segments(e)
+            if lines:
+                g = group_of(e, min(min(s[0], s[2]) for s in lines))
+                segs += lines
+                groups += [g] * len(lines)
+                owners += [""] * len(lines)
+                refs += [e.dxf.layer in REFERENCE_LAYERS] * len(lines)
+    return SheetItems(texts, np.array(segs, dtype=float).reshape(-1, 4), groups, owners, np.array(refs, dtype=bool))
+
+
+def _axes(quad: np.ndarray) -> np.ndarray:
+    """The two edge normals of a box given by its corners (4, 2)."""
+    e = np.array([quad[1] - quad[0], quad[3] - quad[0]])
+    return np.column_stack([-e[:, 1], e[:, 0]])
+
+
+def _crosses(quad: np.ndarray, seg: np.ndarray, eps: float = 0.05) -> np.ndarray:
+    """Which segments pass through the inside of the box ``quad`` (corners (4, 2)) shrunk by ``eps``
+    (separating axes: the box's two edge normals and each segment's normal)."""
+    hit = np.ones(len(seg), dtype=bool)
+    for n in _axes(quad):
+        n = n / np.hypot(*n)
+        q = quad @ n
+        lo, hi = q.min() + eps, q.max() - eps
+        a, b = seg[:, :2] @ n, seg[:, 2:] @ n
+        hit &= (np.maximum(a, b) > lo) & (np.minimum(a, b) < hi)
+    nx, ny = seg[:, 1] - seg[:, 3], seg[:, 2] - seg[:, 0]
+    d = nx * (quad[:, :1] - seg[:, 0]) + ny * (quad[:, 1:] - seg[:, 1])  # (4, n): the corners' sides
+    return hit & (d.max(axis=0) > 0) & (d.min(axis=0) < 0)
+
+
+def _overlap(a: np.ndarray, b: np.ndarray, eps: float = 0.05) -> bool:
+    """Whether two boxes (corners (4, 2)) share more than a rim of ``eps``."""
+    for n in np.vstack([_axes(a), _axes(b)]):
+        n = n / np.hypot(*n)
+        pa, pb = a @ n, b @ n
+        if pa.max() - eps <= pb.min() or pb.max() - eps <= pa.min():
+            return False
+    return True
+
+
+def _quad(b) -> np.ndarray:
+    return np.array([(b[0], b[1]), (b[2], b[1]), (b[2], b[3]), (b[0], b[3])], dtype=float)
+
+
+def layout_problems(doc, layout: SheetLayout) -> list[str]:
+    """The layout rule (docs/decisions.md, "Drawing layout rule") checked on a sheet: everything inside the
+    frame; the title block, lift table, notes, cam view and side view (each the box of all it holds) apart;
+    no two texts overlapping; no line through a text except its own dimension's and the thin reference
+    circles (:data:`REFERENCE_LAYERS`).  Returns the
+    violations (empty when the sheet keeps the rule)."""
+    it = sheet_items(doc, layout)
+    out: list[str] = []
+    fx0, fy0, fx1, fy1 = layout.frame
+    for text, _, _, q in it.texts:
+        if q[:, 0].min() < fx0 or q[:, 1].min() < fy0 or q[:, 0].max() > fx1 or q[:, 1].max() > fy1:
+            out.append(f"text {text!r} {_fmt_box(q)} leaves the frame")
+    s = it.segments
+    if len(s):
+        outside = ((np.minimum(s[:, 0], s[:, 2]) < fx0 - 1e-6) | (np.maximum(s[:, 0], s[:, 2]) > fx1 + 1e-6)
+                   | (np.minimum(s[:, 1], s[:, 3]) < fy0 - 1e-6) | (np.maximum(s[:, 1], s[:, 3]) > fy1 + 1e-6))
+        for i in np.flatnonzero(outside)[:5]:
+            out.append(f"a {it.seg_group[i]} line {s[i].round(2).tolist()} leaves the frame")
+    boxes: dict[str, list[float]] = {}
+    for _, g, _, q in it.texts:
+        b = [q[:, 0].min(), q[:, 1].min(), q[:, 0].max(), q[:, 1].max()]
+        boxes.setdefault(g, list(b))
+        boxes[g] = [min(boxes[g][0], b[0]), min(boxes[g][1], b[1]), max(boxes[g][2], b[2]), max(boxes[g][3], b[3])]
+    for g in set(it.seg_group):
+        m = np.array([x == g for x in it.seg_group])
+        sg = s[m]
+        b = [float(np.minimum(sg[:, 0], sg[:, 2]).min()), float(np.minimum(sg[:, 1], sg[:, 3]).min()),
+             float(np.maximum(sg[:, 0], sg[:, 2]).max()), float(np.maximum(sg[:, 1], sg[:, 3]).max())]
+        old = boxes.get(g, b)
+        boxes[g] = [min(old[0], b[0]), min(old[1], b[1]), max(old[2], b[2]), max(old[3], b[3])]
+    names = sorted(boxes)
+    for i, ga in enumerate(names):
+        for gb in names[i + 1:]:
+            if _overlap(_quad(boxes[ga]), _quad(boxes[gb])):
+                out.append(f"the {ga} {_fmt_box(boxes[ga])} and the {gb} {_fmt_box(boxes[gb])} overlap")
+    for i, (ta, _, _, ba) in enumerate(it.texts):
+        for tb, _, _, bb in it.texts[i + 1:]:
+            if _overlap(ba, bb):
+                out.append(f"texts {ta!r} {_fmt_box(ba)} and {tb!r} {_fmt_box(bb)} overlap")
+        owner = it.texts[i][2]
+        hit = (_crosses(ba, s) & np.array([o != owner or not owner for o in it.seg_owner], dtype=bool)
+               & ~it.seg_reference)
+        for k in np.flatnonzero(hit)[:2]:
+            out.append(f"a {it.seg_group[k]} line {s[k].round(2).tolist()} runs through text {ta!r} {_fmt_box(ba)}")
+    return out
+
+
+def _fmt_box(b) -> str:
+    b = np.asarray(b, dtype=float)
+    if b.ndim == 2:
+        b = np.array([b[:, 0].min(), b[:, 1].min(), b[:, 0].max(), b[:, 1].max()])
+    return "(" + ", ".join(f"{v:.1f}" for v in b) + ")"
+
+
+def dimension_parts(doc, dim) -> tuple[list[np.ndarray], np.ndarray]:
+    """A rendered DIMENSION's text boxes (corners) and line segments (n, 4)."""
+    block = doc.blocks.get(dim.dxf.geometry)
+    quads = [_text_box(t)[1] for t in block if t.dxftype() == "MTEXT"]
+    return quads, np.array([s for t in block for s in _segments(t)], dtype=float).reshape(-1, 4)
+
+
+class Occupancy:
+    """The text boxes and line segments already on a sheet, to place a new dimension where its text crosses
+    no line and no text, and its lines cross no text (the layout rule, applied while drawing)."""
+
+    def __init__(self, doc, layout: SheetLayout) -> None:
+        it = sheet_items(doc, layout)
+        self.quads = [q for *_, q in it.texts]
+        self.segments = it.segments[~it.seg_reference]
+
+    def free(self, quads: list[np.ndarray], segments: np.ndarray) -> bool:
+        for q in quads:
+            if len(self.segments) and _crosses(q, self.segments).any():
+                return False
+            if any(_overlap(q, other) for other in self.quads):
+                return False
+        return not (len(segments) and any(_crosses(q, segments).any() for q in self.quads))
+
+    def add(self, quads: list[np.ndarray], segments: np.ndarray) -> None:
+        self.quads += quads
+        self.segments = np.vstack([self.segments.reshape(-1, 4), segments.reshape(-1, 4)])
