@@ -388,8 +388,8 @@ def build_drawing(spec, geometry, report, shapes, *, paper: str = "auto", lift_s
     notes_column(msp, layout, notes_text(spec, geometry, report, shapes, layout))
     _view(msp, spec, geometry, shapes, layout)
     _cam_labels(msp, spec, geometry, shapes, layout)
-    pts = np.concatenate([lp.points for lp in shapes.profiles])
-    _side_view(msp, spec, layout, float(pts[:, 1].min()), float(pts[:, 1].max()), True)
+    _, y_lo, _, y_hi = _plate_box(shapes)  # the outline's extent (its arcs bulge past their end points)
+    _side_view(msp, spec, layout, y_lo, y_hi, True)
     _dimensions(msp, spec, geometry, shapes, layout, Occupancy(doc, layout))
     return doc, layout
 
