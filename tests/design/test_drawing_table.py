@@ -84,9 +84,12 @@ def test_the_sheet_shows_the_table():
     for v in ("CF-0042", "B", "2026-11-25", "A. Ruiz", "M. Vidal", "16MnCr5", "ISO 2768-fH", "Taller Sur", "P-7"):
         assert v in title
     dims = {d.dxf.text for d in doc.modelspace().query("DIMENSION")}
-    assert {"%%c12 H8", "4 P9", "13.8 +0.1/0"} <= dims
+    assert {"%%c12 H8", "4 P9"} <= dims
+    # the depth with its DIN 6885 tolerance, or (no room for that text in the hub) the bare value and the note
+    assert dims & {"13.8 +0.1/0", "13.8"}
     (notes,) = doc.modelspace().query("MTEXT[layer=='NOTES']")
     text = " ".join(line.strip() for line in notes.plain_text().splitlines())
+    assert "width 4 P9, d + t2 = 13.8 +0.1/0 mm" in text
     assert "ISO 2768-fH" in text and "Ra 0.8 µm" in text and "±0.05 mm of the true profile" in text
     assert "Material: 16MnCr5" in text  # [drawing] material before [manufacturing] material
 
