@@ -178,11 +178,11 @@ def _find(pattern: tuple[np.ndarray, np.ndarray], tree, verts: np.ndarray, near,
     for deg in angles:
         c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
         rot = np.array([[c, -s], [s, c]])
-        probe = pv @ rot.T
+        probe = (pv @ rot.T)[:12]
         full = dense @ rot.T
-        for q in cand:
-            if (tree.query(probe[:12] + q, distance_upper_bound=TOL_MM)[0] > TOL_MM).any():
-                continue
+        # every candidate placement's 12 probe vertices in one query; the full pattern only where they all hit
+        dist = tree.query((cand[:, None, :] + probe[None, :, :]).reshape(-1, 2), distance_upper_bound=TOL_MM)[0]
+        for q in cand[(dist.reshape(len(cand), -1) <= TOL_MM).all(axis=1)]:
             if (tree.query(full + q, distance_upper_bound=TOL_MM)[0] <= TOL_MM).mean() >= 0.98:
                 return True
     return False
