@@ -88,7 +88,7 @@ def _to_pdf(exe: str, dxf: Path) -> Path:
     subprocess.run([exe, "dxf2pdf", "-s", "1", "-t", str(dxf.parent), str(dxf)], env=env, check=True,
                    capture_output=True, timeout=120)
     pdf = dxf.with_suffix(".pdf")
-    assert pdf.exists() and pdf.stat().st_size > 3000, "LibreCAD wrote no drawing"
+    assert pdf.exists(), "LibreCAD wrote no PDF"
     return pdf
 
 
@@ -126,6 +126,7 @@ def _strokes(pdf: Path) -> tuple[np.ndarray, np.ndarray]:
                     segs += path
                     verts += pverts
                 path, pverts, cur = [], [], None
+    assert len(segs) > 4, f"LibreCAD drew nothing into {pdf.name}"
     return np.array(segs), np.array(verts)
 
 
@@ -139,6 +140,13 @@ def _dense(segs: np.ndarray, step: float = 0.03) -> np.ndarray:
     return np.column_stack([s[:, 0] + t * (s[:, 2] - s[:, 0]), s[:, 1] + t * (s[:, 3] - s[:, 1])])
 
 
+def _extents(doc, w: float, h: float) -> None:
+    """The drawing's extents in the header (LibreCAD prints nothing without them; ezdxf writes the model
+    space's, which it only keeps when they do not start at 0, 0, 0)."""
+    doc.modelspace().dxf.extmin = (1e-3, 1e-3, 0.0)
+    doc.modelspace().dxf.extmax = (w, h, 0.0)
+
+
 @cache
 def _glyphs(exe: str, tmp: str, texts: tuple[str, ...], height: float) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Each text as LibreCAD draws a TEXT of that height: (dense points, vertices) relative to its first vertex."""
@@ -150,8 +158,7 @@ def _glyphs(exe: str, tmp: str, texts: tuple[str, ...], height: float) -> dict[s
         y = 20.0 + 12.0 * i
         msp.add_text(t, height=height).set_placement((20.0, y))
         rows[t] = y
-    doc.header["$EXTMIN"] = (0.0, 0.0, 0.0)  # LibreCAD prints nothing without the extents
-    doc.header["$EXTMAX"] = (400.0, 280.0, 0.0)
+    _extents(doc, 400.0, 280.0)
     path = Path(tmp) / "glyphs.dxf"
     doc.saveas(path)
     segs, _ = _strokes(_to_pdf(exe, path))
@@ -284,3 +291,27 @@ def test_layout_is_free_of_overlaps_on_every_example(name):
     for paper in ("auto", "A4", "A3"):
         doc, lay = build_drawing(*_job(name), paper=paper)
         assert layout_problems(doc, lay) == [], (name, paper)
+
+
+def test_the_read_back_sees_the_old_fault(tmp_path):
+    """The read-back is able to fail: a ``<>`` dimension of Ø45 on paper with ``dimlfac = 2`` (a 1:2 sheet's
+    Ø90, as camfab wrote them before) reads 45 in LibreCAD, not %%c90."""
+    exe = _librecad()
+    doc = ezdxf.new("R2010", units=4)
+    doc.dimstyles.new("CAMFAB", dxfattribs={"dimtxt": 2.5, "dimasz": 2.5, "dimtad": 1, "dimdec": 2, "dimzin": 8})
+    msp = doc.modelspace()
+    msp.add_lwpolyline([(0, 0), (297, 0), (297, 210), (0, 210)], close=True)
+    d = msp.add_diameter_dim((150.0, 100.0), radius=22.5, angle=30.0, dimstyle="CAMFAB", override={"dimlfac": 2.0})
+    d.render()
+    _extents(doc, 297.0, 210.0)
+    dxf = tmp_path / "old.dxf"
+    doc.saveas(dxf)
+    segs, verts = _strokes(_to_pdf(exe, dxf))
+    lo = segs[:, :2].min(axis=0)
+    segs, verts = segs - np.tile(lo, 2), verts - lo
+    tree = KDTree(_dense(segs))
+    glyphs = _glyphs(exe, str(tmp_path), ("%%c90", "45"), 2.5)
+    (mt,) = [e for e in doc.blocks.get(d.dimension.dxf.geometry) if e.dxftype() == "MTEXT"]
+    at, deg = (mt.dxf.insert.x, mt.dxf.insert.y), mt.dxf.get("rotation", 0.0)
+    assert _find(glyphs["45"], tree, verts, at, (deg, deg + 180.0))
+    assert not _find(glyphs["%%c90"], tree, verts, at, (deg, deg + 180.0))
