@@ -57,10 +57,8 @@ from .plate import bore_loop, keyway_size
 from .sheet import (
     LAYERS,
     PAPERS,
-    Occupancy,
     SheetLayout,
     clipped_circle,
-    dimension_parts,
     lift_table_block,
     load_template,
     new_document,
@@ -72,6 +70,7 @@ from .sheet import (
     text_width,
     title_block,
 )
+from .sheet_check import Occupancy, dimension_parts
 
 __all__ = ["PAPERS", "LAYERS", "SheetLayout", "load_template", "sheet_layout", "parse_scale", "drawing_sheet",
            "build_drawing", "title_fields", "notes_text"]

@@ -27,7 +27,7 @@ import pytest
 from camfab.cad.drawing import build_drawing, dim_value, drawing_sheet
 from camfab.cad.export import cam_shapes
 from camfab.cad.plate import keyway_size
-from camfab.cad.sheet import layout_problems
+from camfab.cad.sheet_check import layout_problems
 from camfab.design.assemble import check_design, geometry_from_spec
 from camfab.design.drawing import keyway_depth_tolerance
 from camfab.formats import load_design
