@@ -161,6 +161,7 @@ def test_drawing_names_the_curved_face_and_draws_its_centre_circle(run):
     doc = ezdxf.readfile(_one(out, "*_drawing.dxf"))
     assert not doc.audit().has_errors
     text = doc.modelspace().query("MTEXT[layer=='NOTES']")[0].plain_text()
+    text = " ".join(line.strip() for line in text.splitlines())  # the notes are wrapped to their column
     assert f"{f.motion} curved-face follower, face radius R{f.face_radius_mm:g} mm" in text
     assert "roller" not in text
     assert f"Face-centre circle (chain line) R{f.base_radius_mm + f.face_radius_mm:g} mm" in text

@@ -21,7 +21,8 @@ from ..textsafe import dxf_mtext, dxf_string, dxf_text
 from .dxf import ezdxf_module
 
 __all__ = ["PAPERS", "LAYERS", "SheetLayout", "load_template", "parse_scale", "sheet_layout", "put_text", "rect",
-           "place", "fmt", "title_block", "lift_table_block", "notes_column", "clipped_circle", "new_document"]
+           "place", "fmt", "title_block", "lift_table_block", "notes_column", "clipped_circle", "new_document",
+           "text_width", "wrap", "NOTE_PITCH"]
 
 PAPERS = ("A4", "A3")
 
@@ -32,6 +33,7 @@ LAYERS = {
     "BORE": (7, "Continuous", 50), "BASE_CIRCLE": (3, "PHANTOM", 18), "PRIME_CIRCLE": (1, "CENTER", 18),
     "CENTRE_LINES": (8, "CENTER", 18), "CENTRE_MARKS": (8, "Continuous", 18), "DIMENSIONS": (4, "Continuous", 18),
     "LIFT_TABLE": (7, "Continuous", 25), "NOTES": (7, "Continuous", 25), "ANNOTATION": (6, "Continuous", 25),
+    "PROFILE_2": (5, "DASHED", 50), "HIDDEN": (7, "DASHED2", 25), "SIDE_VIEW": (7, "Continuous", 50),
 }
 
 
@@ -53,7 +55,8 @@ class SheetLayout:
     """Where everything goes on the sheet (paper mm, origin at the sheet's lower-left corner).
 
     Boxes are ``(x0, y0, x1, y1)``.  ``fits`` is False when even the smallest
-    scale does not fit the view (the cam is then drawn at that scale anyway).
+    scale does not fit the view (the cam is then drawn at that scale anyway).  ``side`` is the box of
+    the side view (the plate's thickness), to the right of ``view``, when one was asked for.
     """
 
     paper: str
@@ -69,9 +72,11 @@ class SheetLayout:
     notes: tuple[float, float, float, float]
     view: tuple[float, float, float, float]
     fits: bool
+    side: tuple[float, float, float, float] | None = None
 
 
-def _layout_on(paper: str, extent_mm: float | tuple[float, float], n_rows: int, tpl: dict[str, Any]) -> SheetLayout:
+def _layout_on(paper: str, extent_mm: float | tuple[float, float], n_rows: int, tpl: dict[str, Any],
+               thickness_mm: float | None = None) -> SheetLayout:
     w, h = tpl["paper"][paper]["width_mm"], tpl["paper"][paper]["height_mm"]
     fr, gap = tpl["frame"], tpl["frame"]["gap_mm"]
     fx0, fy0, fx1, fy1 = fr["left_mm"], fr["bottom_mm"], w - fr["right_mm"], h - fr["top_mm"]
@@ -85,21 +90,36 @@ def _layout_on(paper: str, extent_mm: float | tuple[float, float], n_rows: int, 
     rows = math.ceil(n_rows / groups)
     table = (fx1 - groups * colw, fy1 - (rows + 2.5) * rh, fx1, fy1)
     notes = (fx0, fy0, fx0 + tpl["notes"]["width_mm"], fy1)
-    view = (notes[2] + gap, title[3] + gap, table[0] - gap, fy1)
-    clear = tpl["view"]["clearance_mm"]
+    area = (notes[2] + gap, title[3] + gap, table[0] - gap, fy1)
+    clear, side_gap, side_pad = tpl["view"]["clearance_mm"], tpl["view"]["side_gap_mm"], tpl["view"]["side_pad_mm"]
     half_w, half_h = (cast(float, extent_mm),) * 2 if np.isscalar(extent_mm) else cast(tuple[float, float], extent_mm)
-    room_w, room_h = (view[2] - view[0]) / 2 - clear, (view[3] - view[1]) / 2 - clear
-    if np.isscalar(extent_mm):  # a disc cam: a circle of radius extent in the square part of the view
-        room_w = room_h = min(room_w, room_h)
     labels = tpl["view"]["scales"]
-    fits = [s for s in labels if half_w * parse_scale(s) <= room_w and half_h * parse_scale(s) <= room_h]
-    label = fits[0] if fits else labels[-1]
+
+    def boxes(scale: float):
+        """The cam view and the side view in the area at ``scale``."""
+        if thickness_mm is None:
+            return area, None
+        sw = thickness_mm * scale + 2 * side_pad
+        split = area[2] - sw
+        return (area[0], area[1], split - side_gap, area[3]), (split, area[1], area[2], area[3])
+
+    def fits(scale: float) -> bool:
+        view, _ = boxes(scale)
+        room_w, room_h = (view[2] - view[0]) / 2 - clear, (view[3] - view[1]) / 2 - clear
+        if np.isscalar(extent_mm):  # a disc cam: a circle of radius extent in the square part of the view
+            room_w = room_h = min(room_w, room_h)
+        return half_w * scale <= room_w and half_h * scale <= room_h
+
+    good = [s for s in labels if fits(parse_scale(s))]
+    label = good[0] if good else labels[-1]
+    view, side = boxes(parse_scale(label))
     centre = ((view[0] + view[2]) / 2, (view[1] + view[3]) / 2)
     return SheetLayout(paper, (w, h), parse_scale(label), label, centre, (fx0, fy0, fx1, fy1), title, table,
-                       groups, rows, notes, view, bool(fits))
+                       groups, rows, notes, view, bool(good), side)
 
 
-def sheet_layout(extent_mm: float | tuple[float, float], n_rows: int, paper: str = "auto") -> SheetLayout:
+def sheet_layout(extent_mm: float | tuple[float, float], n_rows: int, paper: str = "auto",
+                 thickness_mm: float | None = None) -> SheetLayout:
     """Choose paper and scale for a cam of outer radius ``extent_mm`` and a lift table of ``n_rows`` rows.
 
     Parameters
@@ -110,6 +130,9 @@ def sheet_layout(extent_mm: float | tuple[float, float], n_rows: int, paper: str
     n_rows : int
         Data rows of the lift table.
     paper : {"auto", "A4", "A3"}
+    thickness_mm : float, optional
+        The plate thickness (true mm): a side view this wide (at the sheet's scale) is kept to the
+        right of the cam view.
 
     Raises
     ------
@@ -120,8 +143,8 @@ def sheet_layout(extent_mm: float | tuple[float, float], n_rows: int, paper: str
         raise InputError(f"'{paper}' is not a valid paper, must be one of: auto, {', '.join(PAPERS)}")
     tpl = load_template()
     if paper != "auto":
-        return _layout_on(paper, extent_mm, n_rows, tpl)
-    options = [_layout_on(p, extent_mm, n_rows, tpl) for p in PAPERS]
+        return _layout_on(paper, extent_mm, n_rows, tpl, thickness_mm)
+    options = [_layout_on(p, extent_mm, n_rows, tpl, thickness_mm) for p in PAPERS]
     return max(options, key=lambda lay: (lay.fits, min(lay.scale, 1.0), -PAPERS.index(lay.paper)))
 
 
@@ -129,12 +152,54 @@ def put_text(msp, text: str, at, height: float, layer: str, align: str = "BOTTOM
     """A TEXT entity at ``at`` (paper mm), shrunk to fit ``width`` when one is given (never below 1 mm)."""
     from ezdxf.enums import TextEntityAlignment
 
-    tpl = load_template()
     if width is not None and text:
-        height = max(1.0, min(height, width / (tpl["text"]["width_factor"] * len(text))))
+        height = max(1.0, min(height, width / text_width(text, 1.0)))
     t = msp.add_text(text, height=height, dxfattribs={"layer": layer})
     t.set_placement((float(at[0]), float(at[1])), align=TextEntityAlignment[align])
     return t
+
+
+def text_width(text: str, height: float) -> float:
+    """A conservative width (paper mm) of ``text`` at ``height``: at least what LibreCAD's ISO 3098 stroke
+    font takes (lower case and digits ``width_factor`` × height, capitals 1.0, W M % Ø 1.25, a space 0.75),
+    wider than the TrueType fonts of other viewers.  DXF special codes count as the character they show."""
+    lower = load_template()["text"]["width_factor"]
+    text = text.replace("%%c", "Ø").replace("%%C", "Ø").replace("%%d", "°").replace("%%p", "±")
+    total = 0.0
+    for c in text:
+        if c in "WM%Ø@":
+            total += 1.25
+        elif c == " ":
+            total += 0.75
+        elif c.isupper():
+            total += 1.0
+        else:
+            total += lower
+    return total * height
+
+
+def wrap(text: str, width: float, height: float, indent: str = "") -> list[str]:
+    """``text`` broken at spaces into lines no wider than ``width`` (paper mm, by :func:`text_width` at
+    ``height``); continuation lines start with ``indent``; a word longer than a line is cut."""
+    lines: list[str] = []
+    line = ""
+    for word in text.split(" "):
+        trial = f"{line} {word}" if line else (indent if lines else "") + word
+        if text_width(trial, height) <= width:
+            line = trial
+            continue
+        if line:
+            lines.append(line)
+        line = (indent if lines else "") + word
+        while text_width(line, height) > width and len(line) > len(indent) + 1:  # a very long word: cut it
+            cut = len(line) - 1
+            while cut > len(indent) + 1 and text_width(line[:cut], height) > width:
+                cut -= 1
+            lines.append(line[:cut])
+            line = indent + line[cut:]
+    if line:
+        lines.append(line)
+    return lines
 
 
 def rect(msp, box, layer: str) -> None:
@@ -169,7 +234,8 @@ def title_block(msp, layout: SheetLayout, fields: dict[str, str]) -> None:
         cx, cy = x0 + cell["x_mm"], y0 + cell["y_mm"]
         cw, ch = cell["width_mm"], cell["height_mm"]
         rect(msp, (cx, cy, cx + cw, cy + ch), "TITLE_BLOCK")
-        put_text(msp, cell["label"], (cx + 1.0, cy + ch - 1.0), th["label_height_mm"], "TITLE_BLOCK", "TOP_LEFT")
+        put_text(msp, cell["label"], (cx + 1.0, cy + ch - 1.0), th["label_height_mm"], "TITLE_BLOCK", "TOP_LEFT",
+                 width=cw - 2.0)
         value = fields[cell["field"]]
         if value:
             h = th["title_height_mm"] if cell.get("large") else th["value_height_mm"]
@@ -211,16 +277,29 @@ def lift_table_block(msp, layout: SheetLayout, table, closed: bool) -> None:
                       width=widths[k] - 1)
 
 
-def notes_column(msp, layout: SheetLayout, notes: list[str]) -> None:
-    """The numbered notes in the left column."""
+#: MTEXT line spacing: the factor written, and the pitch (× text height) a box of the notes assumes (AutoCAD
+#: draws 5/3 × height × factor; LibreCAD less)
+NOTE_SPACING = 1.0
+NOTE_PITCH = 5.0 / 3.0 * NOTE_SPACING
+
+
+def notes_column(msp, layout: SheetLayout, notes: list[str]) -> tuple[float, float, float, float]:
+    """The numbered notes in the left column, each wrapped to the column by :func:`wrap` and written with
+    explicit ``\\P`` line breaks (a viewer that does not wrap MTEXT shows the same lines); returns the box of
+    the text."""
     tpl = load_template()["notes"]
     x0, y0, x1, y1 = layout.notes
     h = tpl["text_height_mm"]
     put_text(msp, "NOTES", (x0 + 2, y1 - 2), 3.5, "NOTES", "TOP_LEFT")
-    body = "\\P".join(f"{i}. {dxf_mtext(n)}" for i, n in enumerate(notes, 1))  # a note is text, never codes
-    mt = msp.add_mtext(body, dxfattribs={"layer": "NOTES", "char_height": h, "width": x1 - x0 - 4,
+    width = x1 - x0 - 4
+    lines: list[str] = []
+    for i, n in enumerate(notes, 1):
+        lines += wrap(f"{i}. {n}", width, h, indent="    ")
+    body = "\\P".join(dxf_mtext(line) for line in lines)  # a note is text, never codes
+    mt = msp.add_mtext(body, dxfattribs={"layer": "NOTES", "char_height": h, "width": width,
                                          "insert": (x0 + 2, y1 - 8), "attachment_point": 1})
-    mt.dxf.line_spacing_factor = 1.2
+    mt.dxf.line_spacing_factor = NOTE_SPACING
+    return (x0 + 2, y1 - 8 - len(lines) * h * NOTE_PITCH, x0 + 2 + width, y1 - 8)
 
 
 def _dimstyle(doc, tpl) -> None:
@@ -257,9 +336,14 @@ def new_document(spec, layout: SheetLayout, shapes, tpl):
     doc.header["$MEASUREMENT"] = 1
     doc.header["$LTSCALE"] = 1.0
     doc.header["$LWDISPLAY"] = 1
-    doc.header["$EXTMIN"] = (0.0, 0.0, 0.0)
+    # ezdxf writes the header's extents and limits from the model space's layout record: set them there
+    msp = doc.modelspace()
+    msp.dxf.extmin = (0.0, 0.0, 0.0)
+    msp.dxf.extmax = (layout.size[0], layout.size[1], 0.0)
+    msp.dxf.limmin = (0.0, 0.0)
+    msp.dxf.limmax = layout.size
+    doc.header["$EXTMIN"] = (0.0, 0.0, 0.0)  # (ezdxf keeps these when the layout's extents start at 0, 0, 0)
     doc.header["$EXTMAX"] = (layout.size[0], layout.size[1], 0.0)
-    doc.header["$LIMMAX"] = layout.size
     doc.header.custom_vars.append("CAMFAB_NAME", dxf_string(spec.name))
     doc.header.custom_vars.append("CAMFAB_PAPER", layout.paper)
     doc.header.custom_vars.append("CAMFAB_SCALE", f"{layout.scale!r}")

@@ -76,11 +76,11 @@ class StepMeta:
 
 
 def design_meta(spec) -> StepMeta:
-    """The header of a design's STEP files: its ``[drawing]`` author, organisation and part number when the
-    design has that table (fields of the same names), else the defaults of :meth:`StepMeta.of`."""
-    d = getattr(spec, "drawing", None)
-    return StepMeta.of(spec.name, author=getattr(d, "author", None), organisation=getattr(d, "organisation", None),
-                       part_number=getattr(d, "part_number", None))
+    """The header of a design's STEP files: its ``[drawing]`` author, organisation and part number where the
+    design gives them, else the defaults of :meth:`StepMeta.of`."""
+    d = spec.drawing
+    return StepMeta.of(spec.name, author=d.author or None, organisation=d.organisation or None,
+                       part_number=d.part_number or d.number or None)
 
 
 _FILE_NAME = re.compile(r"FILE_NAME\(.*?\);", re.S)

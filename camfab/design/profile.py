@@ -375,7 +375,7 @@ class CamGeometry:
 
     # ---- extremes and area --------------------------------------------
     def radius_extremes(self, profile: int = 0) -> Extremes:
-        """DMIN/DMAX: extremes of the profile's distance from the cam centre (mm); found once per
+        """R min / R max: extremes of the profile's distance from the cam centre (mm); found once per
         profile (the geometry is immutable), as the summaries, drawings and reports each ask for them."""
         memo = self.__dict__.setdefault("_radius_extremes", {})
         if profile not in memo:

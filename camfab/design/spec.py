@@ -20,6 +20,7 @@ from typing import Any
 from ..errors import Problem, SpecError
 from ..limits import MAX_DEPTH_LEVELS, MAX_LENGTH_MM, MAX_LIFT_MM, MAX_SEGMENTS, data_problems
 from ..units import DEG, RPM
+from .drawing import DrawingSpec, drawing_section
 from .kinds import CamKind, Direction, FollowerMotion, FollowerType, LiftUnit, Rotation
 from .knots import KnotFile, KnotTable, build_knot_table
 from .laws import law_names
@@ -48,6 +49,7 @@ __all__ = [
     "AssemblySpec",
     "DynamicsSpec",
     "DesignSpec",
+    "DrawingSpec",
     "design_from_dict",
     "dynamics_items",
     "POSTS",
@@ -55,7 +57,7 @@ __all__ = [
 
 
 _TOP_KEYS = ("name", "description", "cam", "follower", "motion", "motion_table", "manufacturing", "machining",
-             "outputs", "checks", "dynamics", "assembly")
+             "outputs", "checks", "dynamics", "assembly", "drawing")
 _CAM_KEYS = ("kind", "rotation", "direction", "speed_rpm", "omega_rad_s", "speed_mm_s")
 _FOLLOWER_FLOATS = ("base_radius_mm", "roller_radius_mm", "offset_mm", "pivot_distance_mm",
                     "arm_length_mm", "face_offset_mm", "follower_distance_mm",
@@ -181,6 +183,7 @@ class DesignSpec:
     dynamics: DynamicsSpec | None = None
     machining: MachiningSpec = field(default_factory=MachiningSpec)
     assembly: AssemblySpec = field(default_factory=AssemblySpec)
+    drawing: DrawingSpec = field(default_factory=DrawingSpec)
 
     @property
     def is_translating_cam(self) -> bool:
@@ -306,6 +309,7 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
     machining = machining_section(v, v.table(data, "machining"))
     assembly = assembly_section(v, v.table(data, "assembly"))
     _depth_levels(v, mfg, machining)
+    drawing = drawing_section(v, v.table(data, "drawing"), mfg.tolerance_mm)
     checks = v.table(data, "checks")
     v.keys(checks, _CHECK_KEYS, "checks")
     pa = v.number(checks, "pressure_angle_limit_deg", "checks", None, lo=0.0, hi=90.0, lo_open=True, hi_open=True)
@@ -313,7 +317,7 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
     dyn = _dynamics(v, data, cam, fol)
     return DesignSpec(name.strip(), cam, fol, motion, table, mfg, out, pressure_angle_limit_deg=pa,
                       description=str(data.get("description", "")), source=source, face_margin_mm=margin,
-                      dynamics=dyn, machining=machining, assembly=assembly)
+                      dynamics=dyn, machining=machining, assembly=assembly, drawing=drawing)
 
 
 def _depth_levels(v: Validator, mfg: ManufacturingSpec, machining: MachiningSpec) -> None:

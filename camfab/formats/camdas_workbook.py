@@ -446,9 +446,11 @@ def _checks_sheet(ws, spec, report) -> None:
             xlsx_put(ws.cell(row, col), v)
     row += 2
     ws.cell(row, 1, "Summary").font = bold
-    for label, value, unit in (("Base radius (min distance)", report.base_radius_mm, "mm"),
-                               ("Max radius (DMAX)", report.max_radius_mm, "mm"), ("Profile area", report.area_mm2,
-                                                                                     "mm2"),
+    rmax = report.max_radius_mm
+    for label, value, unit in (("Smallest radius R min", report.base_radius_mm, "mm"),
+                               ("Largest radius R max", rmax, "mm"),
+                               ("Blank diameter Ø max = 2·R max", None if rmax is None else 2 * rmax, "mm"),
+                               ("Profile area", report.area_mm2, "mm2"),
                                ("Initial arm angle", report.initial_arm_angle_deg, "deg")):
         if value is not None:
             row += 1

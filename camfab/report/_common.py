@@ -210,11 +210,11 @@ def key_values(report) -> list[tuple[str, str, float | None]]:
     out = []
     rb, rmax = report.base_radius_mm, report.max_radius_mm
     if rb is not None:
-        out.append(("Minimum radius Rmin (mm)", fmt(rb, 3), rb))
-        out.append(("DMIN = 2·Rmin (mm)", fmt(2 * rb, 3), 2 * rb))
+        out.append(("Smallest radius R min (mm)", fmt(rb, 3), rb))
+        out.append(("Smallest diameter Ø min = 2·R min (mm)", fmt(2 * rb, 3), 2 * rb))
     if rmax is not None:
-        out.append(("Maximum radius Rmax (mm)", fmt(rmax, 3), rmax))
-        out.append(("DMAX = 2·Rmax (mm)", fmt(2 * rmax, 3), 2 * rmax))
+        out.append(("Largest radius R max (mm)", fmt(rmax, 3), rmax))
+        out.append(("Blank diameter Ø max = 2·R max (mm)", fmt(2 * rmax, 3), 2 * rmax))
     if report.area_mm2 is not None:
         out.append(("Profile area (mm²)", fmt(report.area_mm2, 2), report.area_mm2))
     if report.initial_arm_angle_deg is not None:

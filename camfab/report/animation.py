@@ -47,7 +47,7 @@ def animation_data(spec, geometry, report, *, frames: int = 360, outline_points:
     spec : DesignSpec
     geometry : CamGeometry
     report : Report
-        For the pressure-angle limit and DMAX.
+        For the pressure-angle limit and R max.
     frames : int
         Number of frames over one cycle.
     outline_points : int

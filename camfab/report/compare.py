@@ -199,8 +199,8 @@ def comparison_rows(items) -> list[dict[str, Any]]:
     add("Base radius Rb (mm)", lambda s, r: _c(s.follower.base_radius_mm))
     add("Roller radius (mm)", lambda s, r: _c(s.follower.roller_radius_mm if s.follower.type == "roller" else None))
     add("Face radius (mm)", lambda s, r: _c(s.follower.face_radius_mm))
-    add("DMIN (mm)", lambda s, r: _c(None if r.base_radius_mm is None else 2 * r.base_radius_mm))
-    add("DMAX (mm)", lambda s, r: _c(None if r.max_radius_mm is None else 2 * r.max_radius_mm))
+    add("Ø min = 2·R min (mm)", lambda s, r: _c(None if r.base_radius_mm is None else 2 * r.base_radius_mm))
+    add("Ø max = 2·R max, blank (mm)", lambda s, r: _c(None if r.max_radius_mm is None else 2 * r.max_radius_mm))
     add("Profile area (mm²)", lambda s, r: _c(r.area_mm2))
     for q, unit in (("S", "{u}"), ("V", "{u}/s"), ("A", "{u}/s²"), ("J", "{u}/s³")):
         for key in ("max", "min"):

@@ -47,7 +47,7 @@ PLOT_TEXT = {
              "junctions, dots the exact extremes."),
     "profile": ("Cam profile",
                 "Cam frame (the follower sits at +Y at 0°); contact points every 30°, labelled every 90°; "
-                "DMIN/DMAX are the smallest and largest diameters of the profile."),
+                "R min/R max are the smallest and largest radii of the profile (Ø min/Ø max their diameters)."),
     "curvature": ("Radius of curvature",
                   "Signed: positive is convex. A roller needs the convex pitch radius to exceed the roller radius "
                   "(else undercut); red bands mark undercuts, cusps and stretches too tight for the cutter."),
@@ -66,7 +66,8 @@ PLOT_TEXT = {
 CURVED_PLOT_TEXT = {
     "profile": ("Cam profile",
                 "Cam frame (the follower sits at +Y at 0°); contact points every 30°, labelled every 90°; "
-                "DMIN/DMAX are the smallest and largest diameters of the profile. The path of the face's centre "
+                "R min/R max are the smallest and largest radii of the profile (Ø min/Ø max their diameters). "
+                "The path of the face's centre "
                 "of curvature, a face radius further out, is in the workbook and on the DXF's PITCH_CURVE layer."),
     "curvature": ("Radius of curvature",
                   "Signed: positive is convex. A curved face touches the cam as a roller of the face radius centred "

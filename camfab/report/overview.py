@@ -52,7 +52,7 @@ def cam_summary(spec, geometry, report, deviations: Iterable[float | None] = ())
             continue
         seen.add(f.code)
         reasons.append({"code": str(f.code), "severity": str(f.severity), "message": bounded(f.message)})
-    number = getattr(getattr(spec, "drawing", None), "number", None)
+    number = spec.drawing.number or None
     return {"drawing_number": plain(str(number)) if number else None, "figures": figures, "reasons": reasons[:6],
             "outline": _outline(spec, geometry)}
 

@@ -186,7 +186,7 @@ def _circle(ax, r: float, **kw) -> None:
 
 
 def profile_figure(spec, geometry, report):
-    """The cam profile(s) in the cam frame with base, prime, DMIN/DMAX circles and pitch curve (not for a
+    """The cam profile(s) in the cam frame with base, prime, R min/R max circles and pitch curve (not for a
     curved face: its centre of curvature runs a face radius further out and would dwarf the cam).
 
     Parameters
@@ -194,7 +194,7 @@ def profile_figure(spec, geometry, report):
     spec : DesignSpec
     geometry : CamGeometry
     report : Report
-        For the exact DMIN/DMAX (minimum and maximum radius).
+        For the exact R min/R max (smallest and largest radius).
 
     Returns
     -------
@@ -228,10 +228,10 @@ def profile_figure(spec, geometry, report):
                     _circle(ax, rb + rr, color="0.35", lw=0.8, ls="-.", label=f"prime circle Rp = {rb + rr:g} mm")
             if report.base_radius_mm is not None:
                 _circle(ax, report.base_radius_mm, color=_BAD, lw=0.8,
-                        label=f"DMIN = {fmt(2 * report.base_radius_mm)} mm")
+                        label=f"R min = {fmt(report.base_radius_mm)} mm (Ø min = {fmt(2 * report.base_radius_mm)} mm)")
             if report.max_radius_mm is not None:
                 _circle(ax, report.max_radius_mm, color=_BAD, lw=0.8, ls=(0, (1, 1.5)),
-                        label=f"DMAX = {fmt(2 * report.max_radius_mm)} mm")
+                        label=f"R max = {fmt(report.max_radius_mm)} mm (Ø max = {fmt(2 * report.max_radius_mm)} mm)")
             if spec.manufacturing.bore_mm:
                 _circle(ax, spec.manufacturing.bore_mm / 2, color="0.1", lw=0.8,
                         label=f"bore Ø{spec.manufacturing.bore_mm:g} mm")

@@ -66,9 +66,12 @@ def test_reads_back_and_audits_clean(e9):
 def test_title_block(e9):
     (spec, geom, report, shapes), _, doc = e9
     texts = _texts(doc, "TITLE_BLOCK")
-    for label in ("TITLE", "SCALE", "MATERIAL", "PROFILE TOLERANCE", "UNITS", "CHECK VERDICT", "DRAWN BY", "DATE"):
+    for label in ("TITLE", "SCALE", "MATERIAL", "UNITS", "CHECK VERDICT", "DRAWN BY", "CHECKED BY", "DATE",
+                  "DRAWING NO.", "REV.", "GENERAL TOLERANCES"):
         assert label in texts
-    assert "Ejemplo9RT" in texts and "C45E" in texts and "±0.002 mm" in texts and "mm" in texts
+    # the CAD approximation tolerance is no shop tolerance: it is not in the title block
+    assert "PROFILE TOLERANCE" not in texts and not any("0.002" in t for t in texts)
+    assert "Ejemplo9RT" in texts and "C45E" in texts and "ISO 2768-m" in texts and "mm" in texts
     assert report.verdict in texts and "1:1" in texts and "A4" in texts
     assert any(t.startswith("camfab ") for t in texts)
     # the title block sits inside the frame's bottom-right corner
@@ -127,8 +130,9 @@ def test_dimensions_are_real_dimension_entities(e9):
     dims = _dims(doc)
     assert all(d.dxf.layer == "DIMENSIONS" for d in doc.modelspace().query("DIMENSION"))
     assert sorted(dims[3]) == pytest.approx([12.0, 70.0])  # bore and base-circle diameters (true size)
-    assert dims[4] == pytest.approx([geom.max_radius], abs=1e-9)  # DMAX radius
-    assert sorted(dims[0]) == pytest.approx([4.0, 13.8])  # keyway width b and d + t2 (DIN 6885: 12 mm bore)
+    assert dims[4] == pytest.approx([geom.max_radius], abs=1e-9)  # R max
+    # keyway width b, the plate thickness (side view) and d + t2 (DIN 6885: 12 mm bore)
+    assert sorted(dims[0]) == pytest.approx([4.0, 10.0, 13.8])
     # rendered: each dimension has its block with the measurement text
     for d in doc.modelspace().query("DIMENSION"):
         block = doc.blocks.get(d.dxf.geometry)
@@ -156,8 +160,11 @@ def test_notes(e9):
     _, _, doc = e9
     (mt,) = doc.modelspace().query("MTEXT[layer=='NOTES']")
     text = mt.plain_text()
-    for word in ("Material: C45E", "±0.002 mm", "All dimensions in mm", "CLOCKWISE", "Zero-angle reference",
-                 "0°", "not_for_high_speed", "Plate thickness 10 mm", "keyway DIN 6885"):
+    text = " ".join(line.strip() for line in text.splitlines())  # the notes are wrapped to the column
+    for word in ("Material: C45E", "tolerance 0.002 mm, not a manufacturing tolerance", "All dimensions in mm",
+                 "CLOCKWISE", "Zero-angle reference", "0°", "not_for_high_speed", "Plate thickness 10 mm",
+                 "bore Ø12 H7", "keyway DIN 6885-1", "width 4 JS9", "d + t2 = 13.8 +0.1/0 mm", "ISO 2768-m",
+                 "Ra 1.6 µm", "±0.02 mm of the true profile", "R max = 45.000 mm", "Ø max = 2 × R max = 90.000 mm"):
         assert word in text
     assert "NOTES" in _texts(doc, "NOTES")
 
@@ -169,7 +176,8 @@ def test_paper_and_scale_for_small_and_large_cams():
     tiny = design_from_dict(base_design(follower={"type": "roller", "motion": "translating",
                                                   "base_radius_mm": 12.0, "roller_radius_mm": 3.0}))
     doc = ezdxf.read(io.StringIO(drawing_sheet(*_job(tiny))))
-    assert doc.header.custom_vars.get("CAMFAB_PAPER") == "A4" and _centre_scale(doc)[1] == 2.0
+    # a tiny cam is enlarged (the side view takes room beside it: 1:1 on A4 rather than 2:1)
+    assert doc.header.custom_vars.get("CAMFAB_PAPER") == "A4" and _centre_scale(doc)[1] >= 1.0
     big = design_from_dict(base_design(follower={"type": "roller", "motion": "translating",
                                                  "base_radius_mm": 150.0, "roller_radius_mm": 10.0},
                                        manufacturing={"bore_mm": 40.0, "keyway": True}))
@@ -218,7 +226,8 @@ def test_oscillating_and_flat_followers_draw():
     rows = _table_rows(doc)
     assert rows[:, 2] == pytest.approx(100.0 + rows[:, 1], abs=1e-3)
     dims = _dims(doc)
-    assert dims[3] == pytest.approx([200.0]) and 0 not in dims  # no bore: only the base circle (and DMAX)
+    # no bore: only the base circle, R max and the plate thickness (side view)
+    assert dims[3] == pytest.approx([200.0]) and dims[0] == pytest.approx([10.0])
 
 
 def test_translating_cam_is_drawn_as_a_plate():
@@ -239,14 +248,15 @@ def test_translating_cam_is_drawn_as_a_plate():
     x0, y0, x1, y1 = lay.view
     assert x0 <= rows[:, 0].min() and rows[:, 0].max() <= x1 and y0 <= rows[:, 1].min() and rows[:, 1].max() <= y1
     # overall length, the S = 0 line's height and the highest point, true size
-    assert sorted(_dims(doc)[0]) == pytest.approx(sorted([300.0, 20.0, 20.0 + 20.0]), abs=1e-9)
+    # (and the plate thickness in the side view)
+    assert sorted(_dims(doc)[0]) == pytest.approx(sorted([300.0, 20.0, 20.0 + 20.0, 12.0]), abs=1e-9)
     texts = _texts(doc, "LIFT_TABLE")
     assert "LIFT TABLE (step 10 mm)" in texts and "TRAVEL mm" in texts and "HEIGHT mm" in texts
     ents = [(e.dxf.text, e.dxf.align_point.x, e.dxf.align_point.y) for e in
             doc.modelspace().query("TEXT[layer=='LIFT_TABLE']")]
     travel = sorted(float(t) for t, *_ in ents if t.replace(".", "").isdigit() and float(t) % 10 == 0
                     and len(t.split(".")) == 1)
-    assert travel == pytest.approx(np.arange(0, 300, 10))
+    assert travel == pytest.approx(np.arange(0, 310, 10))  # the whole plate, 0 … 300 mm
     assert "CAM SLIDES LEFT" in _texts(doc, "ANNOTATION")
     text = doc.modelspace().query("MTEXT")[0].plain_text()
     assert "slides LEFT" in text and "no bore" in text and "length 300 mm" in text

@@ -84,7 +84,7 @@ def test_side_by_side_table_matches_the_reports(compared):
             assert [float(c["value"]) for c in by_label[f"{q} {key}"]] == [d["peaks"][q][key] for d in ds]
     assert [c["text"] for c in by_label["Verdict"]] == ["Not suitable for high speeds",
                                                          "Not suitable for high speeds", "Cam KO (unacceptable)"]
-    assert float(by_label["DMAX (mm)"][0]["value"]) == 2 * ds[0]["max_radius_mm"]
+    assert float(by_label["Ø max = 2·R max, blank (mm)"][0]["value"]) == 2 * ds[0]["max_radius_mm"]
     assert [c["value"] and float(c["value"]) for c in by_label["Pressure angle max (°)"]] == \
         [ds[0]["pressure_angle_deg"]["max"], None, ds[2]["pressure_angle_deg"]["max"]]
     assert by_label["Face length left (mm)"][1]["value"] is not None

@@ -71,7 +71,7 @@ def test_profile_plot_has_the_circles(e9):
     ax = report_figures(spec, geom, rep)["profile"].axes[0]
     labels = [t.get_text() for t in ax.get_legend().get_texts()]
     assert "base circle Rb = 35 mm" in labels and "prime circle Rp = 42 mm" in labels
-    assert "DMIN = 70.00 mm" in labels and "DMAX = 90.00 mm" in labels
+    assert "R min = 35.00 mm (Ø min = 70.00 mm)" in labels and "R max = 45.00 mm (Ø max = 90.00 mm)" in labels
     assert "pitch curve" in labels and "cam centre" in labels
 
 

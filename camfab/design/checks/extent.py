@@ -1,4 +1,4 @@
-"""The extent rule: the smallest and largest radius of a disc cam (DMIN/DMAX) and the profile area.
+"""The extent rule: the smallest and largest radius of a disc cam (R min / R max) and the profile area.
 
 No findings: the numbers go into the report (``base_radius_mm``, ``max_radius_mm``, ``area_mm2``).
 """
