@@ -12,12 +12,8 @@ import contextlib
 import contextvars
 import dataclasses
 import json
-import logging
 import math
-import os
-import signal
 import sys
-import threading
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -27,6 +23,7 @@ from .errors import ApiError, CamfabError, InternalError, MissingDependencyError
 from .io import atomic_write, inside, output_folder, write_all
 from .pipeline import Cam, Output, Request
 from .results import Severity, Verdict
+from .terminal import first_interrupt_only, log_to_stderr, stdout_to_devnull
 from .textsafe import plain
 from .version import __version__
 
@@ -508,24 +505,6 @@ _OUTSIDE_HELP = ("let a design read a knot file ([motion_table] file) outside it
                  "you trust)")
 
 
-@contextlib.contextmanager
-def _log_to_stderr(verbose: bool):
-    """The ``camfab`` logger's records on stderr while a command runs: WARNING and above, INFO too if ``verbose``."""
-    logger = logging.getLogger("camfab")
-    handler = logging.StreamHandler(sys.stderr)
-    handler.setFormatter(logging.Formatter("camfab: %(levelname)s: %(message)s [%(name)s]"))
-    handler.setLevel(logging.INFO if verbose else logging.WARNING)
-    level = logger.level
-    if verbose:
-        logger.setLevel(logging.INFO)
-    logger.addHandler(handler)
-    try:
-        yield
-    finally:
-        logger.removeHandler(handler)
-        logger.setLevel(level)
-
-
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit code (testable in-process)."""
     parser = build_parser()
@@ -537,7 +516,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help(sys.stderr)
         return EXIT_INPUT
     try:
-        with _log_to_stderr(args.verbose), _first_interrupt_only():
+        with log_to_stderr(args.verbose), first_interrupt_only():
             code = _guarded(args)
     except KeyboardInterrupt:  # Ctrl-C: one line, no traceback; what was being written has been removed
         print(f"camfab {args.command}: interrupted", file=sys.stderr)
@@ -545,38 +524,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         sys.stdout.flush()  # a pipe closed by the reader shows here when the output fitted in its buffer
     except BrokenPipeError:
-        _stdout_to_devnull()
+        stdout_to_devnull()
     return code
-
-
-@contextlib.contextmanager
-def _first_interrupt_only():
-    """The first Ctrl-C raises KeyboardInterrupt (the command cleans up and exits 130); it also restores the
-    default action, so a second Ctrl-C ends the process at once.  Only in the main thread, and only where
-    Ctrl-C has Python's default handler (a shell that made the command ignore it is obeyed)."""
-    if threading.current_thread() is not threading.main_thread() or \
-            signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
-        yield
-        return
-
-    def first(signum: int, frame: Any) -> None:
-        signal.signal(signal.SIGINT, signal.SIG_DFL)
-        signal.default_int_handler(signum, frame)  # raises KeyboardInterrupt
-
-    signal.signal(signal.SIGINT, first)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, signal.default_int_handler)
-
-
-def _stdout_to_devnull() -> None:
-    """The reader of stdout has gone (``camfab check X | head -1``): send what is left to /dev/null, so that
-    neither the command nor the interpreter's last flush complains (the Python docs' recipe, "Note on SIGPIPE")."""
-    with contextlib.suppress(OSError, ValueError):
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-        os.close(devnull)
 
 
 def _guarded(args: argparse.Namespace) -> int:
@@ -592,7 +541,7 @@ def _guarded(args: argparse.Namespace) -> int:
         print(f"camfab {args.command}: error: {exc}", file=sys.stderr)
         return EXIT_IO
     except BrokenPipeError:  # stdout closed by its reader: stop quietly, as a command killed by SIGPIPE does
-        _stdout_to_devnull()
+        stdout_to_devnull()
         return EXIT_BROKEN_PIPE
     except (ApiError, InternalError):
         raise

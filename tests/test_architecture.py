@@ -46,6 +46,7 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "camfab.package": BASE + ("camfab.io", "camfab.design", "camfab.formats", "camfab.pipeline",
                               "camfab.assets", "camfab.package", "camfab.cad", "camfab.report"),
     "camfab.cli": ("camfab",),
+    "camfab.terminal": (),
     "camfab.__main__": ("camfab.cli",),
     "camfab": ("camfab",),  # the façade re-exports
 }
