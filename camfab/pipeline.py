@@ -372,7 +372,8 @@ def _gcode(cam: Cam, req: Request) -> list[Artifact]:
     n = len(cam.geometry.profiles)
     out = []
     for i, contact in enumerate(cam.geometry.profiles):
-        cp = cam_program(contact, job, tol=tol, compensation=m.compensation, arcs_allowed=not m.lines_only)
+        cp = cam_program(contact, job, tol=tol, compensation=m.compensation, arcs_allowed=not m.lines_only,
+                         post=req.post)
         out.append(Artifact(f"{safe_stem(cam.name)}{_suffix(i, n)}.nc", dumps(cp.program, req.post).encode(), "gcode",
                             cp.entities, cp.deviation_mm, req.post))
     return out

@@ -15,13 +15,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..design.kinds import ContactKind
-from ..discretize import ArcDiscretisation, arcs, measure_deviation, validate_tol
+from ..discretize import ArcDiscretisation, arcs, arcs_within_radius, measure_deviation, validate_tol
 from ..discretize.curve import discontinuities
 from ..discretize.tolerance import within
 from ..errors import GeometryError
 from ..geom2d import ArcChain
 from ..io import atomic_write, inside, safe_stem
 from ..offset.cutter import pitch_curve, profile_curve, tool_centre_path
+from ..tolerances import MAX_ARC_RADIUS_MM
 from . import dxf as dxf_mod
 from . import step, stl
 from .plate import PlateSpec, bore_loop
@@ -153,16 +154,20 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
             data = stl.dumps(fine, plate, tol=tol / 2, name=spec.name)
             out.append(Artifact(f"{safe_stem(spec.name)}{_suffix(i, n)}.stl", data, "stl", None, dev))
     if "step" in formats:
-        for i, (loop, dev) in enumerate(zip(shapes.profiles, shapes.profile_deviation, strict=True)):
+        # an arc of a huge radius (a near-straight stretch) is a cylinder OCCT cannot intersect: chords instead
+        loops = [arcs_within_radius(p, c, tol=tol, max_radius_mm=MAX_ARC_RADIUS_MM)
+                 for p, c in zip(shapes.profiles, shapes.curves, strict=True)]
+        devs = [float(lp.max_deviation or 0.0) for lp in loops]
+        for i, (loop, dev) in enumerate(zip(loops, devs, strict=True)):
             say(f"STEP{_suffix(i, n)}")
             text = step.dumps(loop, plate, name=f"{spec.name}{_suffix(i, n)}")
             out.append(Artifact(f"{safe_stem(spec.name)}{_suffix(i, n)}.step", text.encode("utf-8"), "step",
                                 loop.n_entities, dev))
         if n > 1:
             say("STEP pair on the shaft")
-            text = step.stack_dumps(shapes.profiles, plate, name=f"{spec.name}_pair")
+            text = step.stack_dumps(loops, plate, name=f"{spec.name}_pair")
             out.append(Artifact(f"{safe_stem(spec.name)}_pair.step", text.encode("utf-8"), "step",
-                                sum(lp.n_entities for lp in shapes.profiles), max(shapes.profile_deviation),
+                                sum(lp.n_entities for lp in loops), max(devs),
                                 "both cams positioned along the shaft"))
     return out
 
