@@ -102,13 +102,28 @@ def finishing_points(calls: list[tuple[str, str]], step_mm: float = 0.05) -> tup
     return np.concatenate(pts), radii
 
 
+def arc_radii(calls: list[tuple[str, str]]) -> list[float]:
+    """The start radius of every arc the interpreter runs (mm), roughing and lead arcs included."""
+    out, pos, scale = [], None, 1.0
+    for name, args in calls:
+        if name == "USE_LENGTH_UNITS":
+            scale = 25.4 if "INCHES" in args else 1.0
+        elif name in ("STRAIGHT_TRAVERSE", "STRAIGHT_FEED", "ARC_FEED"):
+            v = [float(x) * scale for x in args.split(",")]
+            if name == "ARC_FEED" and pos is not None:
+                out.append(float(np.hypot(pos[0] - v[2], pos[1] - v[3])))
+            pos = v[:2]
+    return out
+
+
 def _check(name: str, post: str, tmp_path: Path) -> None:
     cam, texts = _programs(name, post)
     tol = cam.tolerance()
     job = pipeline.gcode_job(cam.spec, tol=tol)
     for contact, text in zip(cam.geometry.profiles, texts, strict=True):
-        pts, radii = finishing_points(interpret(text, tmp_path))
-        assert max(radii, default=0.0) <= MAX_ARC_RADIUS_MM
+        calls = interpret(text, tmp_path)
+        pts, _ = finishing_points(calls)
+        assert max(arc_radii(calls)) <= MAX_ARC_RADIUS_MM
         exact = CurveDistance(offset_curve(contact, job.tool_radius_mm))
         dev = float(np.max(np.abs(exact(pts))))
         assert dev <= tol, f"{name} {post}: rs274's finishing path is {dev:.6f} mm off the exact tool-centre curve"

@@ -50,8 +50,10 @@ def rounding_allowance_mm(decimals: int, units: str, max_sweep_deg: float) -> fl
     return h / math.sqrt(2.0) + h * math.sqrt(2.0) * (1.0 - math.cos(math.radians(max_sweep_deg) / 2.0))
 
 
-def header_lines(program: Program, post_name: str, arc_note: str = "", decimals: int | None = None) -> list[str]:
-    """The header comment texts: design, post, units, tool, tolerance, deviation, speeds, depths."""
+def header_lines(program: Program, post_name: str, arc_note: str = "", decimals: int | None = None,
+                 rounding_mm: float | None = None) -> list[str]:
+    """The header comment texts: design, post, units, tool, tolerance, deviation, speeds, depths (and the bound
+    on how far the rounding moves the path, when given)."""
     job = program.job
     inch = job.units == "inch"
     u = "in" if inch else "mm"
@@ -82,6 +84,7 @@ def header_lines(program: Program, post_name: str, arc_note: str = "", decimals:
         f"tolerance: {mm_in(job.tolerance_mm)}",
         f"achieved deviation: {dev}",
         f"output resolution: {10.0 ** -d:.{d}f} {u}",
+        *([f"rounding: path moved at most {mm_in(rounding_mm)}"] if rounding_mm is not None else []),
         f"spindle: {round(job.spindle_rpm)} rpm cw",
         f"feed: {job.feed_mm_min * k:.{fd}f} {u}/min, plunge {job.plunge_feed_mm_min * k:.{fd}f} {u}/min",
         f"stock top Z0, final depth Z{L(-job.depth_mm)}, safe Z{L(job.safe_z_mm)}",
@@ -279,7 +282,8 @@ class _Writer:
             onum = self.opts.get("program_number", 1000)
             self.lines.append(f"O{onum:04d} ({post.sanitize_comment(job.design_name)[:16]})")
         note = ", arcs by R" if self.arc_format == "r" else ", arcs by I J"
-        for text in header_lines(self.program, post.name, note, self.d):
+        rounding = rounding_allowance_mm(self.d, self.units, post.arc_piece_deg(self.arc_format))
+        for text in header_lines(self.program, post.name, note, self.d, rounding):
             self.comment(text)
         self.block(post.preamble(self.units))
         for item in self.program.items:
