@@ -394,7 +394,7 @@ def _lift_table(cam: Cam, req: Request) -> list[Artifact]:
 
 
 def _lift_meta(cam: Cam, step_deg: float, unit: str, n: int) -> dict[str, str]:
-    """The lift table's metadata lines (docs/decisions.md, "Lift table format")."""
+    """The lift table's metadata lines (docs/decisions.md, "Lift table header and units")."""
     f, spec = cam.spec.follower, cam.spec
     roller = {"roller": f.roller_radius_mm, "curved": f.face_radius_mm}.get(str(f.type))
     lift = "arm angle of the oscillating follower, deg" if unit == "deg" else "follower travel, mm"

@@ -67,15 +67,16 @@ def cam_program(contact, job: Job, *, tol: float, compensation: str | None = Non
     tol_fit = max(share * (1.0 - REFIT_SHARE), 1e-6)
     # the offset's shapely cross-check runs at the usual share; a finer fit (a coarse post's rounding) follows
     path = tool_centre_path(contact, r, tol=max(tol_fit, tol * FIT_SHARE * (1.0 - REFIT_SHARE)))
-    fit = path.arcs if path.tol <= tol_fit else arcs(path.curve, tol=tol_fit)
     if compensation:
+        # the program carries the part contour (the controller offsets it exactly): its deviation is the claim
         curve = profile_curve(contact)
         part = arcs_within_radius(arcs(curve, tol=tol_fit), curve, tol=share, max_radius_mm=max_r)
-        job = replace(job, achieved_deviation_mm=fit.max_deviation)
+        job = replace(job, achieved_deviation_mm=part.max_deviation)
         prog = contour_toolpath(part, job, compensation=compensation)
         return CamProgram(prog, float(part.max_deviation or 0.0), path.shapely_deviation, part.n_entities)
     contour: ArcChain
     if arcs_allowed:
+        fit = path.arcs if path.tol <= tol_fit else arcs(path.curve, tol=tol_fit)
         contour = arcs_within_radius(fit, path.curve, tol=share, max_radius_mm=max_r)
         dev = float(contour.max_deviation or 0.0)
     else:
