@@ -36,6 +36,8 @@ __all__ = [
     "bulge_centre",
     "bulge_midpoint",
     "ArcChain",
+    "chord_sagitta",
+    "chord_large_arcs",
 ]
 
 #: a full turn in radians
@@ -330,3 +332,75 @@ class ArcChain:
         """The same chain traversed the other way (sweeps and bulges change sign)."""
         return ArcChain(self.ends[::-1].copy(), self.starts[::-1].copy(), self.centres[::-1].copy(),
                         -self.sweeps[::-1], -self.bulges[::-1], self.closed, self.max_deviation)
+
+
+# --------------------------------------------------------------------------------------
+# arcs too large for a controller or a CAD kernel
+# --------------------------------------------------------------------------------------
+def chord_sagitta(radius, sweep):
+    """Largest distance (mm) between an arc of ``radius`` and ``sweep`` (rad) and its chord: the sagitta
+    ``r (1 - cos(sweep / 2)) = 2 r sin²(sweep / 4)`` (≈ ``c² / (8 r)`` for a chord ``c``), written without the
+    cancellation of ``1 - cos`` so that it stays exact for radii of 10⁷ mm; broadcasts."""
+    return 2.0 * np.asarray(radius, dtype=float) * np.sin(np.abs(np.asarray(sweep, dtype=float)) / 4.0) ** 2
+
+
+def chord_large_arcs(chain: ArcChain, max_radius_mm: float, max_sagitta_mm: float) -> tuple[ArcChain, float]:
+    """Replace every arc of radius above ``max_radius_mm`` by equal chords, each within ``max_sagitta_mm`` of it.
+
+    An arc of radius ``r`` and sweep ``θ`` becomes ``n = ceil(|θ| / α)`` lines through points of the arc, with
+    ``α = 4 asin(sqrt(s / (2 r)))`` the largest sweep whose chord has sagitta ``s`` (see :func:`chord_sagitta`).
+    The end points of every entity are kept bit for bit (so a closed chain stays closed), lines and smaller
+    arcs are untouched.  Each chord lies within its sagitta of the arc and the arc within the sagitta of the
+    chords, so the two-way distance from any curve grows by at most the returned sagitta (the triangle
+    inequality); the tangent turns by half a chord's sweep at each new vertex (``c / (2 r)`` rad, below
+    ``sqrt(2 s / r)``).
+
+    Parameters
+    ----------
+    chain : ArcChain
+    max_radius_mm : float
+        Arcs with a larger radius become lines.
+    max_sagitta_mm : float
+        Largest distance (mm) allowed between an arc and its chords (> 0).
+
+    Returns
+    -------
+    (ArcChain, float)
+        The chain (the same object when no arc is that large; otherwise ``max_deviation`` is the old one plus
+        the sagitta, an upper bound: measure again where the exact curve is known) and the largest sagitta
+        of the chords written (0 when none), mm.
+    """
+    if not (max_sagitta_mm > 0 and max_radius_mm > 0):
+        raise GeometryError(f"chord_large_arcs needs a positive radius limit and sagitta, got {max_radius_mm!r} "
+                            f"and {max_sagitta_mm!r} mm")
+    radii = chain.radii
+    big = ~chain.is_line & (radii > max_radius_mm)
+    if not big.any():
+        return chain, 0.0
+    th = np.abs(chain.sweeps)
+    alpha = 4.0 * np.arcsin(np.sqrt(np.minimum(max_sagitta_mm / (2.0 * np.where(big, radii, 1.0)), 0.5)))
+    n = np.where(big, np.maximum(1, np.ceil(th / alpha - 1e-12)), 1).astype(int)
+    sag = float(np.max(chord_sagitta(np.where(big, radii, 0.0), th / n)))
+    starts, ends, centres, sweeps, bulges = [], [], [], [], []
+    for i in range(chain.n_entities):
+        if not big[i]:
+            starts.append(chain.starts[i:i + 1])
+            ends.append(chain.ends[i:i + 1])
+            centres.append(chain.centres[i:i + 1])
+            sweeps.append(chain.sweeps[i:i + 1])
+            bulges.append(chain.bulges[i:i + 1])
+            continue
+        c, r, k = chain.centres[i], radii[i], n[i]
+        a0 = math.atan2(chain.starts[i, 1] - c[1], chain.starts[i, 0] - c[0])
+        ang = a0 + chain.sweeps[i] * np.arange(1, k) / k
+        mid = c + r * np.column_stack([np.cos(ang), np.sin(ang)])
+        pts = np.vstack([chain.starts[i:i + 1], mid, chain.ends[i:i + 1]])
+        starts.append(pts[:-1])
+        ends.append(pts[1:])
+        centres.append(np.full((k, 2), np.nan))
+        sweeps.append(np.zeros(k))
+        bulges.append(np.zeros(k))
+    dev = None if chain.max_deviation is None else chain.max_deviation + sag
+    out = ArcChain(np.concatenate(starts), np.concatenate(ends), np.concatenate(centres), np.concatenate(sweeps),
+                   np.concatenate(bulges), chain.closed, dev)
+    return out, sag

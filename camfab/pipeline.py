@@ -396,22 +396,23 @@ def _step(cam: Cam, req: Request) -> list[Artifact]:
 def _iges(cam: Cam, req: Request) -> list[Artifact]:
     """``<stem>.igs`` (``_cam1``/``_cam2`` for a pair): the plate for older CAM systems."""
     from .cad import iges
-    from .cad.export import plate_of
+    from .cad.export import plate_of, solid_outlines
 
-    shapes = cam.shapes(req.tol)
-    n = len(shapes.profiles)
+    loops, devs = solid_outlines(cam.shapes(req.tol), cam.tolerance(req.tol))
+    n = len(loops)
     return [Artifact(f"{safe_stem(cam.name)}{_suffix(i, n)}.igs",
                      iges.dumps(loop, plate_of(cam.spec), name=f"{cam.name}{_suffix(i, n)}").encode("ascii"),
                      "iges", loop.n_entities, dev)
-            for i, (loop, dev) in enumerate(zip(shapes.profiles, shapes.profile_deviation, strict=True))]
+            for i, (loop, dev) in enumerate(zip(loops, devs, strict=True))]
 
 
 def _assembly(cam: Cam, req: Request) -> list[Artifact]:
     """``<stem>_assembly.step``: the mechanism at ``req.angle``; with ``req.poses`` = N, also N poses at
     equally spaced angles, ``<stem>_assembly_pose<k>.step``."""
     from .cad import assembly
+    from .cad.export import solid_outlines
 
-    shapes = cam.shapes(req.tol)
+    outlines, devs = solid_outlines(cam.shapes(req.tol), cam.tolerance(req.tol))
     axis, geometry = cam.geometry.axis, cam.geometry
     if not math.isfinite(req.angle) or abs(req.angle) > 1e6:
         raise InputError(f"--angle {req.angle}: must be a finite number of at most 1e6 (degrees; mm of travel "
@@ -424,8 +425,7 @@ def _assembly(cam: Cam, req: Request) -> list[Artifact]:
                          f"its length {span:g}")
     stem = safe_stem(cam.name)
     dims = assembly.dimensions(cam.spec, geometry)
-    outlines = list(shapes.profiles)
-    dev = max(shapes.profile_deviation)
+    dev = max(devs)
 
     def one(user: float) -> bytes:
         x = float(axis.from_user(user % span))
@@ -452,7 +452,8 @@ def _gcode(cam: Cam, req: Request) -> list[Artifact]:
     n = len(cam.geometry.profiles)
     out = []
     for i, contact in enumerate(cam.geometry.profiles):
-        cp = cam_program(contact, job, tol=tol, compensation=m.compensation, arcs_allowed=not m.lines_only)
+        cp = cam_program(contact, job, tol=tol, compensation=m.compensation, arcs_allowed=not m.lines_only,
+                         post=req.post)
         out.append(Artifact(f"{safe_stem(cam.name)}{_suffix(i, n)}.nc", dumps(cp.program, req.post).encode(), "gcode",
                             cp.entities, cp.deviation_mm, req.post))
     return out
@@ -465,8 +466,29 @@ def _lift_table(cam: Cam, req: Request) -> list[Artifact]:
     if not prog.axis.rotating:
         raise GeometryError("a polar lift table needs a rotating cam")
     ang = lift_angles(req.lift_step_deg)
-    text = lift_table_csv(ang, prog(np.radians(ang)), lift_unit=prog.axis.lift_unit)
+    t = np.radians(ang)
+    radii = [np.hypot(*np.asarray(c.evaluate(t).point, dtype=float).reshape(-1, 2).T) for c in cam.geometry.profiles]
+    text = lift_table_csv(ang, prog(t), lift_unit=prog.axis.lift_unit, radii_mm=radii,
+                          meta=_lift_meta(cam, req.lift_step_deg, str(prog.axis.lift_unit), len(radii)))
     return [Artifact(f"{safe_stem(cam.name)}_lift.csv", text.encode(), "lift_table")]
+
+
+def _lift_meta(cam: Cam, step_deg: float, unit: str, n: int) -> dict[str, str]:
+    """The lift table's metadata lines (docs/decisions.md, "Lift table header and units")."""
+    f, spec = cam.spec.follower, cam.spec
+    roller = {"roller": f.roller_radius_mm, "curved": f.face_radius_mm}.get(str(f.type))
+    lift = "arm angle of the oscillating follower, deg" if unit == "deg" else "follower travel, mm"
+    col = "radius_mm" if n == 1 else f"radius_cam1_mm ... radius_cam{n}_mm"
+    meta = {"table": "camfab polar lift table", "design": spec.name, "follower": f"{f.type.title}, {f.motion}",
+            "roller radius": "none" if roller is None else f"{roller:g} mm",
+            "base radius": "none" if f.base_radius_mm is None else f"{f.base_radius_mm:g} mm",
+            "cam rotation": f"{spec.cam.rotation}",
+            "units": f"angle_deg in degrees, lift_{unit} in {unit}, radius in mm",
+            "angle step": f"{step_deg:g} deg",
+            "angle 0": "the start of the first [[motion]] segment (S = 0 mark on the drawing)",
+            "lift": f"{lift}; 0 = the follower on the base circle (its lowest position)",
+            col: "distance from the cam centre to the contact point on the profile at that cam angle, mm"}
+    return meta
 
 
 def _xlsx(cam: Cam, req: Request) -> list[Artifact]:

@@ -10,6 +10,7 @@ __all__ = [
     "DEFAULT_EXPORT_TOL_MM",
     "MIN_EXPORT_TOL_MM",
     "MAX_EXPORT_TOL_MM",
+    "MAX_ARC_RADIUS_MM",
 ]
 
 #: absolute tolerance for "equal" lengths in mm
@@ -27,3 +28,6 @@ CAMDAS_STEP_DEG = 1.0
 DEFAULT_EXPORT_TOL_MM = 0.001
 MIN_EXPORT_TOL_MM = 1e-6
 MAX_EXPORT_TOL_MM = 0.1
+#: arcs of a larger radius (mm) are written as chords within the tolerance in STEP and, by default, in G-code
+#: (``Post.max_arc_radius_mm``): docs/decisions.md, "Arc radius limit"
+MAX_ARC_RADIUS_MM = 5000.0

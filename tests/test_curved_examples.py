@@ -116,11 +116,12 @@ def test_gcode_verifies_against_the_exact_profile(run, capsys):
 
 def test_lift_table_csv(run):
     name, spec, geom, out = run
-    lines = _one(out, "*_lift.csv").read_text().splitlines()
+    lines = [ln for ln in _one(out, "*_lift.csv").read_text().splitlines() if not ln.startswith("#")]
     unit = "deg" if name == "finger_follower" else "mm"
-    assert lines[0] == f"angle_deg,lift_{unit}"
+    assert lines[0] == f"angle_deg,lift_{unit},radius_mm"
     table = np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]])
     S = spec.program().evaluate(np.radians(table[:, 0]))[0]
+    assert table[:, 2].min() >= (spec.follower.base_radius_mm or 0.0) - 1e-6  # the contact never inside the base circle
     np.testing.assert_allclose(table[:, 1], S, atol=6e-7)
 
 

@@ -10,6 +10,7 @@ the command does (:func:`camfab.gcode.cam.verify_cam_program`: the design's job,
 """
 from __future__ import annotations
 
+import math
 import re
 
 import pytest
@@ -46,7 +47,7 @@ def _check(case, text):
     return verify_cam_program(text, case["contact"], case["job"], tol=TOL, part=case["part"])
 
 
-# -- editing helpers: fanuc lines carry N numbers, grbl comments keep their case ------------------------------
+# -- editing helpers: fanuc lines carry N numbers (and 3 decimals), grbl comments keep their case --------------
 _N = re.compile(r"^(N\d+\s+)?(.*)$")
 
 
@@ -86,14 +87,14 @@ def _deleting(find, after=None):
     return edit
 
 
-m_finish_depth = _replacing(r"^G1 Z-10\.", r"Z-10\.0000", "Z-5.0000", "FINISH PASS LEVEL 1 OF 1")
-m_rough_depth = _replacing(r"^G1 Z-5\.0000", r"Z-5\.0000", "Z-10.0000")
+m_finish_depth = _replacing(r"^G1 Z-10\.", r"Z-10\.0+", "Z-5.0000", "FINISH PASS LEVEL 1 OF 1")
+m_rough_depth = _replacing(r"^G1 Z-5\.0+\b", r"Z-5\.0+", "Z-10.0000")
 m_feed_lower = _replacing(r"F600\.0", r"F600\.0", "F550.0", "FINISH LEAD-IN")
 m_plunge_feed = _replacing(r"^G1 Z-10\.", r"F200\.0", "F2000.0", "FINISH PASS LEVEL 1 OF 1")
 m_m3_to_m4 = _replacing(r"\bM3\b", r"\bM3\b", "M4")
 m_spindle_speed = _replacing(r"\bM3\b", r"S3000", "S30000")
 m_m8_to_m7 = _replacing(r"^M8$", r"M8", "M7")
-m_rapid_plunge = _replacing(r"^G1 Z-10\.", r"^G1 Z-10\.0000 F200\.0", "G0 Z-10.0000", "FINISH PASS LEVEL 1 OF 1")
+m_rapid_plunge = _replacing(r"^G1 Z-10\.", r"^G1 Z-10\.0+ F200\.0", "G0 Z-10.0000", "FINISH PASS LEVEL 1 OF 1")
 m_other_tool = _replacing(r"^T1 M6$", r"^T1", "T2")
 m_no_length_offset = _replacing(r"G43 H1", r"G43 H1 ", "")
 m_inch = _replacing(r"\bG21\b", r"\bG21\b", "G20")
@@ -162,10 +163,25 @@ def _xy(line):
 
 
 def m_arc_centre(L):
-    # an arc of moderate radius (moving the centre of a 2 m radius arc by 0.05 mm hardly moves the arc)
-    i = next(k for k in _finish_moves(L) if " I" in L[k] and abs(float(re.search(r"I(-?[\d.]+)", L[k]).group(1))) +
-             abs(float(re.search(r"J(-?[\d.]+)", L[k]).group(1))) < 60)
-    _sub(L, i, r"I(-?[\d.]+)", _num("I", 0.05))
+    # the finishing arc of moderate radius whose ends differ most in x for their radius: moving the centre of a
+    # 2 m radius arc by 0.05 mm hardly moves the arc, and neither does it on a short arc, whose written ends pin
+    # the path; I + e changes the two radii by e (x_start - x_end) / r apart
+    def word(line, a):
+        m = re.search(a + r"(-?[\d.]+)", _code(line))
+        return None if m is None else float(m.group(1))
+
+    moves = _finish_moves(L)
+    x, y = word(L[moves[0] - 2], "X"), word(L[moves[0] - 2], "Y")  # the lead-in arc ends where the contour starts
+    best, chord = None, 0.0
+    for k in moves:
+        ex, ey = word(L[k], "X"), word(L[k], "Y")
+        ex, ey = x if ex is None else ex, y if ey is None else ey
+        i, j = word(L[k], "I"), word(L[k], "J")
+        if i is not None and j is not None and math.hypot(i, j) < 60 and abs(ex - x) / math.hypot(i, j) > chord:
+            best, chord = k, abs(ex - x) / math.hypot(i, j)
+        x, y = ex, ey
+    assert best is not None
+    _sub(L, best, r"I(-?[\d.]+)", _num("I", 0.05))
 
 
 def m_flip_arc(L):
@@ -181,8 +197,8 @@ def m_coordinate_typo(L):
 
 def m_safe_z_low(L):
     for i, t in enumerate(L):
-        if re.search(r"^G0 .*Z25\.0000", _code(t)):
-            _sub(L, i, r"Z25\.0000", "Z1.0000")
+        if re.search(r"^G0 .*Z25\.0+\b", _code(t)):
+            _sub(L, i, r"Z25\.0+", "Z1.0000")
 
 
 def m_plunge_deeper(L):

@@ -15,13 +15,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..design.kinds import ContactKind
-from ..discretize import ArcDiscretisation, arcs, measure_deviation, validate_tol
+from ..discretize import ArcDiscretisation, arcs, arcs_within_radius, measure_deviation, validate_tol
 from ..discretize.curve import discontinuities
 from ..discretize.tolerance import within
 from ..errors import GeometryError
 from ..geom2d import ArcChain
 from ..io import atomic_write, inside, safe_stem
 from ..offset.cutter import pitch_curve, profile_curve, tool_centre_path
+from ..tolerances import MAX_ARC_RADIUS_MM
 from . import dxf as dxf_mod
 from . import step, stl
 from .plate import PlateSpec, bore_loop
@@ -158,18 +159,28 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
             data = stl.dumps(fine, plate, tol=tol / 2, name=spec.name)
             out.append(Artifact(f"{safe_stem(spec.name)}{_suffix(i, n)}.stl", data, "stl", None, dev))
     if "step" in formats:
-        for i, (loop, dev) in enumerate(zip(shapes.profiles, shapes.profile_deviation, strict=True)):
+        loops, devs = solid_outlines(shapes, tol)
+        for i, (loop, dev) in enumerate(zip(loops, devs, strict=True)):
             say(f"STEP{_suffix(i, n)}")
             text = step.dumps(loop, plate, name=f"{spec.name}{_suffix(i, n)}", meta=design_meta(spec))
             out.append(Artifact(f"{safe_stem(spec.name)}{_suffix(i, n)}.step", text.encode("utf-8"), "step",
                                 loop.n_entities, dev))
         if n > 1:
             say("STEP pair on the shaft")
-            text = step.stack_dumps(shapes.profiles, plate, name=f"{spec.name}_pair", meta=design_meta(spec))
+            text = step.stack_dumps(loops, plate, name=f"{spec.name}_pair", meta=design_meta(spec))
             out.append(Artifact(f"{safe_stem(spec.name)}_pair.step", text.encode("utf-8"), "step",
-                                sum(lp.n_entities for lp in shapes.profiles), max(shapes.profile_deviation),
+                                sum(lp.n_entities for lp in loops), max(devs),
                                 "both cams positioned along the shaft"))
     return out
+
+
+def solid_outlines(shapes: CamShapes, tol: float) -> tuple[list, list[float]]:
+    """The outlines a solid (STEP, assembly, IGES) is built from, with their measured deviations: the arc fits
+    with every arc above :data:`~camfab.tolerances.MAX_ARC_RADIUS_MM` replaced by chords within ``tol`` (an arc
+    of a huge radius, a near-straight stretch, is a cylinder OpenCascade cannot intersect reliably)."""
+    loops = [arcs_within_radius(p, c, tol=tol, max_radius_mm=MAX_ARC_RADIUS_MM)
+             for p, c in zip(shapes.profiles, shapes.curves, strict=True)]
+    return loops, [float(lp.max_deviation or 0.0) for lp in loops]
 
 
 def _dxf(spec, geometry, shapes: CamShapes, plate: PlateSpec, tol: float, flavour: str,

@@ -12,7 +12,7 @@ Modules, in dependency order: ``tolerance``, ``curve``, ``surrogate``, ``entitie
 """
 from .chain import Chain
 from .curve import CurveError, ParametricCurve, curvature_at, points_at
-from .fit import arcs, polyline
+from .fit import arcs, arcs_within_radius, polyline
 from .measure import max_deviation, measure_deviation
 from .results import ArcDiscretisation, Deviation, Discretisation
 from .tolerance import ToleranceError, validate_tol
@@ -26,6 +26,7 @@ __all__ = [
     "ParametricCurve",
     "ToleranceError",
     "arcs",
+    "arcs_within_radius",
     "curvature_at",
     "max_deviation",
     "measure_deviation",

@@ -39,6 +39,8 @@ import logging
 
 import numpy as np
 
+from ..errors import GeometryError
+from ..geom2d import ArcChain, chord_large_arcs
 from ..threads import one_blas_thread
 from ..tolerances import DEFAULT_EXPORT_TOL_MM
 from .arcspline import fit_spline
@@ -50,7 +52,11 @@ from .results import ArcDiscretisation, Discretisation
 from .surrogate import fit_surrogate
 from .tolerance import validate_tol, within
 
-__all__ = ["polyline", "arcs"]
+__all__ = ["polyline", "arcs", "arcs_within_radius", "REFIT_SHARE"]
+
+#: when the room a fit leaves below ``tol`` is less than this share of it, :func:`arcs_within_radius` fits again
+#: at ``tol·(1 - REFIT_SHARE)`` so that the chords of its large arcs have that much room
+REFIT_SHARE = 0.1
 
 log = logging.getLogger(__name__)
 
@@ -160,3 +166,35 @@ def _arcs(curve: ParametricCurve, tol: float) -> ArcDiscretisation:
         nodes, _ = fit_grid(curve, tol, "biarc", lambda nodes: build(nodes)[1], sur)
         chain, measured = build(nodes)
     return ArcDiscretisation.from_chain(chain, nodes, measured, tol, curve.closed)
+
+
+def arcs_within_radius(fit: ArcChain, curve: ParametricCurve, *, tol: float, max_radius_mm: float) -> ArcChain:
+    """``fit`` (an arc chain within ``tol`` of ``curve``) with every arc of radius above ``max_radius_mm`` replaced
+    by chords (:func:`~camfab.geom2d.chord_large_arcs`), still within ``tol`` of the curve, measured.
+
+    The chords get the room the fit leaves: sagitta ``<= tol - measured deviation``, so the two-way distance
+    stays below ``tol`` by the triangle inequality.  When that room is less than :data:`REFIT_SHARE` of ``tol``
+    the curve is fitted again at ``tol·(1 - REFIT_SHARE)`` first (fewer, shorter chords than a sliver of room
+    would need).  The result's deviation is measured again on the exact curve (``max_deviation``).  A chain
+    without such arcs comes back unchanged (the same object).
+
+    Raises
+    ------
+    GeometryError
+        If the measured result exceeds ``tol`` (it cannot, but it is checked, never assumed).
+    """
+    tol = validate_tol(tol)
+    if not np.any(~fit.is_line & (fit.radii > max_radius_mm)):
+        return fit
+    dev = fit.max_deviation
+    if dev is None:
+        dev = float(measure_deviation(fit, curve).max)
+    if tol - dev < REFIT_SHARE * tol:
+        fit = arcs(curve, tol=tol * (1.0 - REFIT_SHARE))
+        dev = float(fit.max_deviation)
+    chords, _ = chord_large_arcs(fit, max_radius_mm, tol - dev)
+    measured = float(measure_deviation(chords, curve).max)
+    if not within(measured, tol):
+        raise GeometryError(f"arcs above R{max_radius_mm:g} mm as chords deviate {measured:.3g} mm from the curve "
+                            f"(> tol {tol:g} mm); give a larger tolerance")
+    return chords.with_deviation(measured)

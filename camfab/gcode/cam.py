@@ -11,7 +11,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-from ..discretize import ParametricCurve, arcs, polyline
+from ..discretize import ParametricCurve, arcs, arcs_within_radius, polyline
+from ..discretize.fit import REFIT_SHARE
 from ..geom2d import ArcChain
 from ..offset.cutter import offset_curve, profile_curve, tool_centre_path
 from .distance import CurveDistance
@@ -19,7 +20,7 @@ from .model import Job, Program
 from .toolpath import contour_toolpath
 from .verify import VerifyReport, verify_program
 
-__all__ = ["FIT_SHARE", "CamProgram", "cam_program", "signed_distance", "verify_cam_program"]
+__all__ = ["FIT_SHARE", "CamProgram", "cam_program", "contour_tolerance", "signed_distance", "verify_cam_program"]
 
 
 @dataclass(frozen=True)
@@ -32,43 +33,68 @@ class CamProgram:
     entities: int
 
 
-#: share of the tolerance given to the arc fit; the rest absorbs the rounding of the written
-#: coordinates and arc centres (the posts write at least tol/10 resolution)
+#: share of the tolerance the contour may use at most; the rest (and never less than the post's
+#: :meth:`~camfab.gcode.posts.base.Post.rounding_allowance_mm`) absorbs the rounding of the written coordinates
+#: and arc centres
 FIT_SHARE = 0.8
 
 
+def contour_tolerance(tol: float, post=None, units: str = "mm") -> float:
+    """The share of ``tol`` (mm) the finishing contour may deviate from the exact curve: ``FIT_SHARE·tol``, less
+    when the post's rounding needs more room (``tol - rounding allowance``; docs/decisions.md, "Fanuc decimals
+    and the rounding budget")."""
+    from .post import get_post
+
+    room = tol - get_post(post or "linuxcnc").rounding_allowance_mm(units, tol)
+    return max(min(tol * FIT_SHARE, room), 1e-6)
+
+
 def cam_program(contact, job: Job, *, tol: float, compensation: str | None = None,
-                arcs_allowed: bool = True) -> CamProgram:
-    """The contour-milling program of one profile (periphery, outside).
+                arcs_allowed: bool = True, post=None) -> CamProgram:
+    """The contour-milling program of one profile (periphery, outside), for ``post`` (name or
+    :class:`~camfab.gcode.posts.base.Post`; default linuxcnc), which sets the rounding budget and the
+    largest arc radius written (larger arcs become chords within the tolerance).
 
     ``arcs_allowed=False`` writes the finishing contour as G1 lines only (a polyline within the
     same tolerance), for controllers or shops that do not want G2/G3.
     """
+    from .post import get_post
+
+    max_r = get_post(post or "linuxcnc").max_arc_radius_mm
     r = job.tool_radius_mm
-    tol_fit = max(tol * FIT_SHARE, 1e-6)
-    path = tool_centre_path(contact, r, tol=tol_fit)
+    share = contour_tolerance(tol, post, job.units)
+    # the arcs get (1 - REFIT_SHARE) of the share, the chords of arcs above max_r the room the fit leaves
+    tol_fit = max(share * (1.0 - REFIT_SHARE), 1e-6)
+    # the offset's shapely cross-check runs at the usual share; a finer fit (a coarse post's rounding) follows
+    path = tool_centre_path(contact, r, tol=max(tol_fit, tol * FIT_SHARE * (1.0 - REFIT_SHARE)))
     if compensation:
-        part = arcs(profile_curve(contact), tol=tol_fit)
-        job = replace(job, achieved_deviation_mm=path.max_deviation)
+        # the program carries the part contour (the controller offsets it exactly): its deviation is the claim
+        curve = profile_curve(contact)
+        part = arcs_within_radius(arcs(curve, tol=tol_fit), curve, tol=share, max_radius_mm=max_r)
+        job = replace(job, achieved_deviation_mm=part.max_deviation)
         prog = contour_toolpath(part, job, compensation=compensation)
-        return CamProgram(prog, part.max_deviation, path.shapely_deviation, part.n_entities)
+        return CamProgram(prog, float(part.max_deviation or 0.0), path.shapely_deviation, part.n_entities)
     contour: ArcChain
     if arcs_allowed:
-        contour, dev = path.arcs, path.max_deviation
+        fit = path.arcs if path.tol <= tol_fit else arcs(path.curve, tol=tol_fit)
+        contour = arcs_within_radius(fit, path.curve, tol=share, max_radius_mm=max_r)
+        dev = float(contour.max_deviation or 0.0)
     else:
         line = polyline(path.curve, tol=tol_fit)
         contour, dev = line.arc_chain(), line.max_deviation
     job = replace(job, achieved_deviation_mm=dev)
-    prog = contour_toolpath(contour, job, roughing_contours=_rough(contact, job, tol))
+    prog = contour_toolpath(contour, job, roughing_contours=_rough(contact, job, tol, max_r))
     return CamProgram(prog, dev, path.shapely_deviation, contour.n_entities)
 
 
-def _rough(contact, job: Job, tol: float) -> list[ArcChain]:
+def _rough(contact, job: Job, tol: float, max_r: float) -> list[ArcChain]:
     """Roughing contours, outermost first: exact offsets by tool radius + allowance + k·step-over."""
     out: list[ArcChain] = []
+    rough_tol = max(tol, 1e-3)
     for k in range(job.roughing_passes, 0, -1):
         d = job.tool_radius_mm + job.roughing_allowance_mm + (k - 1) * job.stepover
-        out.append(arcs(offset_curve(contact, d), tol=max(tol, 1e-3)))
+        curve = offset_curve(contact, d)
+        out.append(arcs_within_radius(arcs(curve, tol=rough_tol), curve, tol=rough_tol, max_radius_mm=max_r))
     return out
 
 

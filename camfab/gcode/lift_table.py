@@ -1,19 +1,26 @@
-"""Polar lift table for cam grinders: cam angle against follower lift, as CSV.
+"""Polar lift table for cam grinders: cam angle against follower lift (and the cam's radius), as CSV.
 
-Format: header ``angle_deg,lift_mm`` (``angle_deg,lift_deg`` for an oscillating follower, whose lift is
-the arm angle in degrees), one row per angle, both columns with exactly 6 decimals, ``\\n`` line ends and
-a final newline; ``-0.000000`` is written ``0.000000``.  Deterministic.
+Format (docs/decisions.md, "Lift table format"): first the metadata, one ``# key: value`` line each (design
+name, follower type and motion, roller and base radius, rotation sense, units, angle step, what angle 0 and
+lift 0 mean, what the radius column is) - comment lines that ``pandas.read_csv(comment="#")``, spreadsheet
+imports with a skip and ``grep -v '^#'`` pass over; then the column header ``angle_deg,lift_mm``
+(``angle_deg,lift_deg`` for an oscillating follower, whose lift is the arm angle in degrees), with
+``radius_mm`` (``radius_cam1_mm,radius_cam2_mm,...`` for several profiles) when radii are given: the distance
+from the cam centre to the contact point on the profile at that angle.  One row per angle, every column with
+exactly 6 decimals, ``\\n`` line ends and a final newline; ``-0.000000`` is written ``0.000000``.
+Deterministic.  Without metadata and radii the table is the two columns alone.
 """
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 
 from camfab.errors import Problem, SpecError
 from camfab.io import atomic_write
+from camfab.textsafe import plain
 
 __all__ = ["HEADER", "lift_table_csv", "lift_angles", "write_lift_table"]
 
@@ -42,7 +49,8 @@ def lift_angles(step_deg: float) -> np.ndarray:
     return np.arange(int(round(n))) * float(step_deg)
 
 
-def lift_table_csv(angles_deg, lift_mm, *, lift_unit: str = "mm") -> str:
+def lift_table_csv(angles_deg, lift_mm, *, lift_unit: str = "mm", radii_mm: Sequence | None = None,
+                   meta: Mapping[str, str] | None = None) -> str:
     """The polar lift table as CSV text.
 
     Parameters
@@ -53,6 +61,11 @@ def lift_table_csv(angles_deg, lift_mm, *, lift_unit: str = "mm") -> str:
         Follower lift at each angle in mm, or a function of the angle array (degrees) returning it.
     lift_unit : {"mm", "deg"}
         The unit of the lift, written into the header: "deg" for an oscillating follower's arm angle.
+    radii_mm : sequence of array_like (n,), optional
+        Per profile, the cam radius at the contact point at each angle (mm): column ``radius_mm`` for one
+        profile, ``radius_cam1_mm``, ``radius_cam2_mm``, ... for several.
+    meta : mapping of str to str, optional
+        Metadata written first as ``# key: value`` lines (values made one line of plain text).
 
     Returns
     -------
@@ -65,21 +78,29 @@ def lift_table_csv(angles_deg, lift_mm, *, lift_unit: str = "mm") -> str:
     """
     a = np.asarray(angles_deg, dtype=float).reshape(-1)
     lift = np.asarray(lift_mm(a) if callable(lift_mm) else lift_mm, dtype=float).reshape(-1)
+    radii = [np.asarray(r, dtype=float).reshape(-1) for r in (radii_mm or ())]
     problems = []
     if a.size == 0:
         problems.append(Problem("angles_deg", [], "must not be empty", "give at least one angle"))
     if a.shape != lift.shape:
         problems.append(Problem("lift_mm", f"{lift.size} values", f"must match the {a.size} angles", ""))
+    if any(r.shape != a.shape for r in radii):
+        problems.append(Problem("radii_mm", [r.size for r in radii], f"must each match the {a.size} angles", ""))
     if not np.all(np.isfinite(a)):
         problems.append(Problem("angles_deg", "non-finite", "must be finite", ""))
     if not np.all(np.isfinite(lift)):
         problems.append(Problem("lift_mm", "non-finite", "must be finite", ""))
+    if not all(np.all(np.isfinite(r)) for r in radii):
+        problems.append(Problem("radii_mm", "non-finite", "must be finite", ""))
     if lift_unit not in ("mm", "deg"):
         problems.append(Problem("lift_unit", lift_unit, "is not a valid option", "must be one of: mm, deg"))
     if problems:
         raise SpecError(problems)
-    rows = [f"angle_deg,lift_{lift_unit}"]
-    rows += [f"{_f6(x)},{_f6(y)}" for x, y in zip(a.tolist(), lift.tolist(), strict=True)]
+    rows = [f"# {plain(k)}: {plain(v)}" for k, v in (meta or {}).items()]
+    names = ["radius_mm"] if len(radii) == 1 else [f"radius_cam{i + 1}_mm" for i in range(len(radii))]
+    rows.append(",".join(["angle_deg", f"lift_{lift_unit}", *names]))
+    cols = [a.tolist(), lift.tolist(), *(r.tolist() for r in radii)]
+    rows += [",".join(_f6(v) for v in row) for row in zip(*cols, strict=True)]
     return "\n".join(rows) + "\n"
 
 

@@ -46,6 +46,7 @@ _G_GROUPS = {
     "length": {"43", "49"},
     "wcs": {"54", "55", "56", "57", "58", "59"},
     "feed_mode": {"94"},
+    "spindle_mode": {"97"},  # constant rpm (stated in the safety block)
     "dwell": {"4"},
 }
 _G_GROUP_OF = {code: g for g, codes in _G_GROUPS.items() for code in codes}

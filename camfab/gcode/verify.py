@@ -50,7 +50,8 @@ Checks (vectorised over the moves' sample points; each move is sampled every ``s
   (``STEP_DOWN``), and the finishing pass in the job's milling direction (``DIRECTION``: climb is
   clockwise around the part);
 * **end** - the program ends with the tool below the stock top (``RETRACT_MISSING``);
-* **arcs** - an arc whose start and end radius differ by more than ``tol`` (as programmed);
+* **arcs** - an arc whose start and end radius differ by more than ``tol`` (as programmed; plus ``√2`` output
+  increments of the post's rounding when the post is known);
 * **coverage** (``part_curve`` or ``curve_points``) - the thickest material the finishing moves at final
   depth leave on the part (the finishing samples projected onto the part, the part measured where no
   continuous cut covers it and at 4096 points along it), or the largest distance from the given points of
@@ -251,11 +252,17 @@ def verify(moves, *, exact_curve_distance: Callable[[np.ndarray], np.ndarray] | 
                      "were not checked against one")
 
     # -- arcs ----------------------------------------------------------------------------------------
+    # rounding the two ends to the post's increment h moves each radius by up to h/√2 (docs/decisions.md, "Fanuc
+    # decimals and the rounding budget"): a known post's programs get that room on top of tol
+    units = job.units if job is not None else "mm"
+    slack = 0.0 if the_post is None else (
+        math.sqrt(2.0) * 10.0 ** -the_post.decimals(units, tol) * (25.4 if units == "inch" else 1.0))
     for m in moves:
-        if m.kind == "arc" and abs(m.radius_start - m.radius_end) > tol:
+        if m.kind == "arc" and abs(m.radius_start - m.radius_end) > tol + slack:
             problems.append(Finding.at_line(
                 IssueCode.ARC_RADIUS_MISMATCH, f"arc start and end radii differ by "
-                f"{abs(m.radius_start - m.radius_end):.4f} mm (> tol {tol} mm)", m.line))
+                f"{abs(m.radius_start - m.radius_end):.4f} mm (> tol {tol} mm"
+                f"{f' + rounding {slack:.4f} mm' if slack else ''})", m.line))
 
     # -- cutter compensation: simulate it, then check the tool-centre path ------------------------------
     programmed = moves

@@ -117,9 +117,10 @@ def test_stadium_compensated_program_is_the_exact_tool_centre_path(post, comp):
     path = simulate_compensation(parse(text).moves, R_TOOL)
     fin = finish_moves(path)
     L = sum(move_lengths([m for m, _ in fin]))
-    assert pytest.approx(4 * HALF + 2 * math.pi * (RP + R_TOOL), abs=1e-6) == L
+    # (Fanuc writes 0.001 mm increments in 30-degree arc pieces: the length agrees within the tolerance)
+    assert pytest.approx(4 * HALF + 2 * math.pi * (RP + R_TOOL), abs=1e-6 if post == "linuxcnc" else TOL) == L
     pts = sample([m for m, _ in fin], 0.02).points[:, :2]
-    assert np.abs(centre(pts)).max() < 1e-9
+    assert np.abs(centre(pts)).max() < (1e-9 if post == "linuxcnc" else TOL / 10)
 
 
 @pytest.fixture(scope="module")

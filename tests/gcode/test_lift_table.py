@@ -55,9 +55,56 @@ def test_header_names_the_lift_unit(tmp_path, example, unit):
 
     assert main(["run", example, "-o", str(tmp_path), "--outputs", "lift_table"]) == 0
     (table,) = tmp_path.glob("*_lift.csv")
-    assert table.read_text().splitlines()[0] == f"angle_deg,lift_{unit}"
+    first = next(line for line in table.read_text().splitlines() if not line.startswith("#"))
+    assert first.split(",")[:2] == ["angle_deg", f"lift_{unit}"]
 
 
 def test_bad_lift_unit():
     with pytest.raises(SpecError):
         lift_table_csv([0.0], [0.0], lift_unit="inch")
+
+
+def _read(path) -> tuple[dict[str, str], list[str], np.ndarray]:
+    """Metadata (``# key: value`` lines), column names and rows, read as a shop's script would."""
+    import csv
+
+    lines = path.read_text(encoding="utf-8").splitlines()
+    meta = dict(line[2:].split(": ", 1) for line in lines if line.startswith("# "))
+    rows = list(csv.reader(line for line in lines if not line.startswith("#")))
+    return meta, rows[0], np.array(rows[1:], dtype=float)
+
+
+def test_metadata_header_and_radius_column(tmp_path):
+    """The oscillating roller follower's table: metadata names roller, base radius, rotation, units and step; the
+    lift is in degrees; read with the csv module after dropping the ``#`` lines."""
+    from camfab.cli import main
+
+    assert main(["run", "press_feed_oscillating", "-o", str(tmp_path), "--outputs", "lift_table"]) == 0
+    (table,) = tmp_path.glob("*_lift.csv")
+    meta, cols, data = _read(table)
+    assert cols == ["angle_deg", "lift_deg", "radius_mm"] and data.shape == (360, 3)
+    assert meta["design"] == "PressFeedLever" and meta["follower"] == "roller, oscillating"
+    assert meta["roller radius"] == "11 mm" and meta["base radius"] == "55 mm" and meta["cam rotation"] == "ccw"
+    assert meta["angle step"] == "1 deg" and "lift_deg in deg" in meta["units"] and "radius_mm" in meta
+    # the contact point on the base circle at S = 0, and never inside it
+    assert data[0, 1] == 0.0 and data[0, 2] == pytest.approx(55.0, abs=1e-6)
+    assert data[:, 2].min() >= 55.0 - 1e-6
+
+
+def test_radius_column_is_the_flat_face_contact_radius(tmp_path):
+    """A radial flat-faced translating follower touches the cam where r² = (R_b + s)² + (ds/dθ)² (the contact
+    point lies ds/dθ along the face from the follower axis): the radius column against that formula."""
+    from camfab import pipeline
+    from camfab.cli import main
+
+    assert main(["run", "ejemplo10ex", "-o", str(tmp_path), "--outputs", "lift_table"]) == 0
+    (table,) = tmp_path.glob("*_lift.csv")
+    meta, cols, data = _read(table)
+    cam = pipeline.load("ejemplo10ex")
+    rb = cam.spec.follower.base_radius_mm
+    t = np.radians(data[:, 0])
+    prog = cam.spec.program()
+    expected = np.hypot(rb + prog(t), prog(t, 1))
+    assert cols == ["angle_deg", "lift_mm", "radius_mm"] and meta["follower"] == "flat-face, translating"
+    assert np.allclose(data[:, 2], expected, rtol=0, atol=2e-6)  # 6 decimals written
+    assert np.allclose(data[:, 1], prog(t), rtol=0, atol=1e-6)

@@ -95,7 +95,8 @@ def test_unknown_post_lists_the_valid_ones():
 
 # ---- controller syntax ---------------------------------------------------------------------------
 
-LINUXCNC_G = {"0", "1", "2", "3", "17", "20", "21", "40", "41", "42", "43", "49", "54", "80", "90", "94"}
+LINUXCNC_G = {"0", "1", "2", "3", "17", "20", "21", "40", "41", "42", "43", "49", "54", "80", "90", "91.1", "94",
+              "97"}
 LINUXCNC_M = {"2", "3", "5", "6", "7", "8", "9"}
 
 
@@ -154,18 +155,20 @@ def test_r_mode_splits_arcs_over_180_degrees():
     ij = parse(dumps(prog, "fanuc"))
     r = parse(dumps(prog, "fanuc", arc_format="r"))
     fin = lambda bp: [m for m in bp.moves if m.kind == "arc" and m.label == "FINISH CONTOUR"]  # noqa: E731
-    assert [round(abs(m.sweep), 9) for m in fin(ij)] == [round(math.pi, 9)] * 2
-    assert len(fin(r)) == 4 and all(abs(m.sweep) <= math.pi / 2 + 1e-9 for m in fin(r))
+    # Fanuc writes arcs in pieces of at most 30 degrees (its rounding budget), I J and R alike
+    for bp in (ij, r):
+        assert len(fin(bp)) == 12 and all(abs(m.sweep) <= math.pi / 6 + 1e-5 for m in fin(bp))  # + rounding
+        assert sum(abs(m.sweep) for m in fin(bp)) == pytest.approx(2 * math.pi, abs=1e-4)
     radii = [float(m.group(1)) for line in dumps(prog, "fanuc", arc_format="r").splitlines()
              if not line.startswith("(") and (m := re.search(r" R(-?[\d.]+)", line))]
-    assert len(radii) == 6 and all(v > 0 for v in radii)  # 4 contour pieces + 2 lead arcs
+    assert len(radii) == 18 and all(v > 0 for v in radii)  # 12 contour pieces + 2 lead arcs of 3
     for bp in (ij, r):
         rep = verify(bp, exact_curve_distance=circle_distance(20.0), part_distance=circle_distance(17.0),
                      tool_radius=R_TOOL, tol=TOL, safe_z=SAFE_Z)
         assert rep.ok, rep.to_dict()
 
 
-GRBL_G = {"0", "1", "2", "3", "17", "20", "21", "40", "54", "90", "94"}
+GRBL_G = {"0", "1", "2", "3", "17", "20", "21", "40", "54", "90", "91.1", "94"}
 GRBL_M = {"2", "3", "5", "7", "8", "9", "30"}
 
 
@@ -243,3 +246,44 @@ def test_r_and_ij_back_plots_agree(r, cx, cy, units):
         rep = verify(parse(dumps(prog, post, **opts)), exact_curve_distance=exact, part_distance=part,
                      tool_radius=R_TOOL, tol=TOL, safe_z=SAFE_Z)
         assert rep.ok, (post, opts, rep.to_dict())
+
+
+def test_grbl_tool_comment_reads_well():
+    """GRBL has no tool changer: the operator's comment is one plain sentence (it read
+    ``(load T1 D6.0000 mm by hand no M6 , set Z zero)`` once the post had stripped its parentheses)."""
+    text = dumps(_program(), "grbl")
+    (c,) = [line for line in text.splitlines() if "by hand" in line]
+    assert re.fullmatch(r"\(tool change by hand: load T1 end mill \d+(\.\d+)? mm then set Z zero\)", c), c
+
+
+@pytest.mark.parametrize("post,words", [("linuxcnc", "G17 G21 G40 G49 G54 G80 G90 G91.1 G94 G97"),
+                                        ("grbl", "G17 G21 G40 G54 G90 G91.1 G94"),
+                                        ("fanuc", "G17 G21 G40 G49 G80 G54 G90 G94 G97")])
+def test_safety_block_states_the_modal_state(post, words):
+    """Every post states plane, units, compensation, length offset, canned cycles (where the controller has
+    them), work offset, absolute mode, arc-centre mode (LinuxCNC and GRBL: G91.1; Fanuc's I J are always
+    incremental) and feed per minute before the first move."""
+    blocks = [line.split(" ", 1)[1] if line.startswith("N") else line
+              for line in dumps(_program(), post).splitlines() if line and line[0] in "GN"]
+    assert blocks[0] == words
+
+
+def test_fanuc_writes_three_decimals_in_mm_within_the_tolerance():
+    """Fanuc IS-B: X/Y/Z/I/J with 3 decimals in mm (4 in inch) when the contour leaves room for their rounding;
+    the program read back stays within the tolerance of the exact tool-centre curve (camfab verify)."""
+    from camfab.gcode.cam import cam_program, verify_cam_program
+    from camfab.pipeline import gcode_job, load
+
+    cam = load("ejemplo1rt")
+    tol = cam.tolerance()
+    job = gcode_job(cam.spec, tol=tol)
+    contact = cam.geometry.profiles[0]
+    cp = cam_program(contact, job, tol=tol, post="fanuc")
+    text = dumps(cp.program, "fanuc")
+    nums = re.findall(r"\b[XYZIJ](-?\d+\.\d+)", "\n".join(ln for ln in text.splitlines() if not ln.startswith("(")))
+    assert nums and {len(v.split(".")[1]) for v in nums} == {3}
+    rep = verify_cam_program(text, contact, job, tol=tol, post="fanuc")
+    assert rep.ok and rep.max_deviation_mm <= tol
+    # the same contour as LinuxCNC budgets it leaves no room for 0.001 mm rounding: Fanuc falls back to IS-C
+    loose = dumps(cam_program(contact, job, tol=tol).program, "fanuc")
+    assert "OUTPUT RESOLUTION 0.0001 MM" in loose

@@ -5,9 +5,13 @@ numbers, arc format, which codes the controller accepts, comment rules).  Everyt
 conversion, fixed number formatting, modal suppression of unchanged words, arc splitting - lives here so
 the three posts cannot drift apart.
 
-Number formatting is fixed per program: ``decimals = max(4, ceil(-log10(tol)) + 1)`` in mm (4 for the
-default 1 um tolerance) and one more in inch; feeds 1 decimal (mm/min) or 3 (in/min); spindle speed an
-integer.  ``-0`` is written as ``0``.  There are no timestamps: the same program gives the same bytes.
+Number formatting is fixed per program: by default ``decimals = max(4, ceil(-log10(tol)) + 1)`` in mm (4 for
+the default 1 um tolerance) and one more in inch (a post may fix its own: Fanuc writes its least input
+increment); feeds 1 decimal (mm/min) or 3 (in/min); spindle speed an integer.  The rounding of the written
+coordinates and arc centres has a bound (:func:`rounding_allowance_mm`) that the contour's tolerance budget
+leaves room for (:func:`camfab.gcode.cam.contour_tolerance`).  Arcs above :attr:`Post.max_arc_radius_mm` reach
+the program as chords (:func:`camfab.discretize.arcs_within_radius`).  ``-0`` is written as ``0``.  There are
+no timestamps: the same program gives the same bytes.
 """
 from __future__ import annotations
 
@@ -19,8 +23,9 @@ from camfab.errors import ApiError, ExportError, InputError
 from camfab.gcode.model import Arc, Comment, Coolant, CutterComp, Feed, Program, Rapid, Spindle, ToolChange
 from camfab.geom2d import arc_sweep
 from camfab.textsafe import gcode_comment
+from camfab.tolerances import MAX_ARC_RADIUS_MM
 
-__all__ = ["MM_PER_INCH", "Post", "decimals_for", "header_lines"]
+__all__ = ["MM_PER_INCH", "Post", "decimals_for", "header_lines", "rounding_allowance_mm"]
 
 #: millimetres per inch
 MM_PER_INCH = 25.4
@@ -32,13 +37,28 @@ def decimals_for(tolerance_mm: float, units: str) -> int:
     return d + 1 if units == "inch" else d
 
 
-def header_lines(program: Program, post_name: str, arc_note: str = "") -> list[str]:
-    """The header comment texts: design, post, units, tool, tolerance, deviation, speeds, depths."""
+def rounding_allowance_mm(decimals: int, units: str, max_sweep_deg: float) -> float:
+    """Bound (mm) on how far rounding to ``decimals`` moves a written contour off the exact one.
+
+    Each coordinate moves by at most half the increment ``h``, a point by ``h/√2``; the path between two
+    rounded ends follows them (first order), and an arc whose centre moved by ``e`` (at most ``h√2``: the
+    writer picks, of the four grid points around the exact centre, the one that gives both ends one radius)
+    bulges by ``e (1 - cos(sweep/2))`` more at its middle.  So ``h/√2 + h√2 (1 - cos(max_sweep/2))`` with the
+    largest sweep one arc block has (docs/decisions.md, "Fanuc decimals and the rounding budget").
+    """
+    h = 10.0 ** -decimals * (MM_PER_INCH if units == "inch" else 1.0)
+    return h / math.sqrt(2.0) + h * math.sqrt(2.0) * (1.0 - math.cos(math.radians(max_sweep_deg) / 2.0))
+
+
+def header_lines(program: Program, post_name: str, arc_note: str = "", decimals: int | None = None,
+                 rounding_mm: float | None = None) -> list[str]:
+    """The header comment texts: design, post, units, tool, tolerance, deviation, speeds, depths (and the bound
+    on how far the rounding moves the path, when given)."""
     job = program.job
     inch = job.units == "inch"
     u = "in" if inch else "mm"
     k = 1.0 / MM_PER_INCH if inch else 1.0
-    d = decimals_for(job.tolerance_mm, job.units)
+    d = decimals_for(job.tolerance_mm, job.units) if decimals is None else decimals
 
     def L(v):
         return _fmt(v * k, d)
@@ -64,6 +84,7 @@ def header_lines(program: Program, post_name: str, arc_note: str = "") -> list[s
         f"tolerance: {mm_in(job.tolerance_mm)}",
         f"achieved deviation: {dev}",
         f"output resolution: {10.0 ** -d:.{d}f} {u}",
+        *([f"rounding: path moved at most {mm_in(rounding_mm)}"] if rounding_mm is not None else []),
         f"spindle: {round(job.spindle_rpm)} rpm cw",
         f"feed: {job.feed_mm_min * k:.{fd}f} {u}/min, plunge {job.plunge_feed_mm_min * k:.{fd}f} {u}/min",
         f"stock top Z0, final depth Z{L(-job.depth_mm)}, safe Z{L(job.safe_z_mm)}",
@@ -80,6 +101,24 @@ def _fmt(v: float, d: int) -> str:
     if s.startswith("-") and float(s) == 0.0:
         s = s[1:]
     return s
+
+
+def _centre_words(sx: float, sy: float, ex: float, ey: float, cx: float, cy: float, d: int) -> tuple[str, str]:
+    """I and J (program units, ``d`` decimals) of the centre ``(cx, cy)`` of an arc from the written start
+    ``(sx, sy)`` to the written end ``(ex, ey)``: of the four grid points around the exact centre, the one whose
+    distances to the two written ends differ least (so a controller sees one radius), ties to the nearest."""
+    h = 10.0 ** -d
+    best = None
+    for fi in (math.floor, math.ceil):
+        for fj in (math.floor, math.ceil):
+            i = fi((cx - sx) / h) * h
+            j = fj((cy - sy) / h) * h
+            mismatch = abs(math.hypot(i, j) - math.hypot(sx + i - ex, sy + j - ey))
+            key = (round(mismatch / h, 6), math.hypot(sx + i - cx, sy + j - cy))
+            if best is None or key < best[0]:
+                best = (key, i, j)
+    assert best is not None
+    return _fmt(best[1], d), _fmt(best[2], d)
 
 
 class Post:
@@ -105,6 +144,11 @@ class Post:
         ``"ij"`` (incremental centre) and/or ``"r"`` (radius).
     end_code : str
         ``M2`` or ``M30``.
+    max_arc_radius_mm : float
+        Arcs of a larger radius are written as chords within the tolerance (default
+        :data:`~camfab.tolerances.MAX_ARC_RADIUS_MM`, 5000 mm; Fanuc's R word holds at most 99 999.999).
+    max_arc_sweep_deg : float
+        Largest sweep of one arc block; longer arcs are split into equal pieces (R arcs at most 90).
     """
 
     name = "base"
@@ -117,10 +161,25 @@ class Post:
     arc_formats: tuple[str, ...] = ("ij",)
     end_code = "M2"
     mist_code = "M7"
+    max_arc_radius_mm = MAX_ARC_RADIUS_MM
+    max_arc_sweep_deg = 180.0
     #: default values of the options this post accepts
     defaults: dict[str, Any] = {}
 
     # -- hooks -----------------------------------------------------------------------------------
+    def decimals(self, units: str, tolerance_mm: float, achieved_mm: float | None = None) -> int:
+        """Decimals of the written coordinates (default :func:`decimals_for`).  ``achieved_mm``: the contour's
+        measured deviation, when known (a post may write coarser numbers when the contour leaves room)."""
+        return decimals_for(tolerance_mm, units)
+
+    def rounding_allowance_mm(self, units: str, tolerance_mm: float) -> float:
+        """How far (mm) the rounding of this post's numbers can move the contour (:func:`rounding_allowance_mm`)."""
+        return rounding_allowance_mm(self.decimals(units, tolerance_mm), units, self.arc_piece_deg("ij"))
+
+    def arc_piece_deg(self, arc_format: str) -> float:
+        """Largest sweep (degrees) of one written arc block for ``arc_format``."""
+        return min(self.max_arc_sweep_deg, 90.0 if arc_format == "r" else 180.0)
+
     def preamble(self, units: str) -> list[str]:
         """Safety block words: plane, units, compensation/length/canned-cycle off, WCS, modes."""
         return ["G17", "G20" if units == "inch" else "G21", "G40", "G49", "G54", "G80", "G90", "G94"]
@@ -176,7 +235,7 @@ class _Writer:
         job = program.job
         self.units = job.units
         self.k = 1.0 / MM_PER_INCH if job.units == "inch" else 1.0
-        self.d = decimals_for(job.tolerance_mm, job.units)
+        self.d = post.decimals(job.units, job.tolerance_mm, job.achieved_deviation_mm)
         self.fd = 3 if job.units == "inch" else 1
         self.arc_format = opts.get("arc_format", "ij")
         self.lines: list[str] = []
@@ -223,7 +282,8 @@ class _Writer:
             onum = self.opts.get("program_number", 1000)
             self.lines.append(f"O{onum:04d} ({post.sanitize_comment(job.design_name)[:16]})")
         note = ", arcs by R" if self.arc_format == "r" else ", arcs by I J"
-        for text in header_lines(self.program, post.name, note):
+        rounding = rounding_allowance_mm(self.d, self.units, post.arc_piece_deg(self.arc_format))
+        for text in header_lines(self.program, post.name, note, self.d, rounding):
             self.comment(text)
         self.block(post.preamble(self.units))
         for item in self.program.items:
@@ -271,7 +331,8 @@ class _Writer:
             if post.length_offset:
                 self.pending += ["G43", f"H{it.tool}"]
         else:
-            self.comment(f"load T{it.tool} D{self.num(it.diameter_mm)} {u} by hand (no M6), set Z zero")
+            d = self.num(it.diameter_mm).rstrip("0").rstrip(".")
+            self.comment(f"tool change by hand: load T{it.tool} end mill {d} {u} then set Z zero")
 
     def coolant(self, it: Coolant) -> None:
         if it.mode not in ("off", "flood", "mist"):
@@ -333,7 +394,7 @@ class _Writer:
         sx, sy, z0 = self.exact
         cx, cy = it.cx, it.cy
         sweep = arc_sweep((sx, sy), (it.x, it.y), (cx, cy), it.clockwise)
-        max_piece = math.pi / 2 if self.arc_format == "r" else math.pi
+        max_piece = math.radians(self.post.arc_piece_deg(self.arc_format))
         n = max(1, math.ceil(abs(sweep) / max_piece - 1e-9))
         r = math.hypot(it.x - cx, it.y - cy)
         a0 = math.atan2(sy - cy, sx - cx)
@@ -362,8 +423,7 @@ class _Writer:
         else:
             ox, oy = self.out[0], self.out[1]
             assert ox is not None and oy is not None  # arc() starts only from a known position
-            i = _fmt(cx * self.k - float(ox), self.d)
-            j = _fmt(cy * self.k - float(oy), self.d)
+            i, j = _centre_words(float(ox), float(oy), float(ex), float(ey), cx * self.k, cy * self.k, self.d)
             words += [f"I{i}", f"J{j}"]
         self.block(["G2" if clockwise else "G3"] + self.take_pending() + words + self.feed_word(feed))
         self._commit(target)

@@ -32,7 +32,9 @@ class GrblPost(Post):
     defaults = {"coolant": True, "mist": False}
 
     def preamble(self, units: str) -> list[str]:
-        return ["G17", "G20" if units == "inch" else "G21", "G40", "G54", "G90", "G94"]
+        """G17 XY plane, G21/G20, G40 compensation off, G54, G90 absolute, G91.1 incremental arc centres (GRBL's
+        only mode, stated), G94 feed per minute."""
+        return ["G17", "G20" if units == "inch" else "G21", "G40", "G54", "G90", "G91.1", "G94"]
 
     def sanitize_comment(self, text: str) -> str:
         t = re.sub(r"[^A-Za-z0-9 .,\-+/=*#_:]", " ", text)
