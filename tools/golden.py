@@ -37,10 +37,10 @@ from pathlib import Path  # noqa: E402
 ROOT = Path(__file__).resolve().parent.parent
 MANIFEST = ROOT / "tests" / "golden" / "manifest.json"
 #: files whose bytes come from an outside library's writer (compared only at equal versions)
-_LIBRARY_MADE = (".png", ".svg", ".step", ".xlsx", ".pdf")
+_LIBRARY_MADE = (".png", ".svg", ".step", ".xlsx", ".pdf", ".igs")
 _VERSIONED = ("numpy", "scipy", "matplotlib", "ezdxf", "cadquery", "cadquery-ocp", "openpyxl", "trimesh",
               "shapely", "jinja2", "mapbox_earcut")
-_ALL = "dxf,step,stl,gcode,lift_table,xlsx,report,drawing"
+_ALL = "dxf,step,stl,gcode,lift_table,xlsx,report,drawing,pdf,assembly,iges"
 
 
 def _versions() -> dict[str, str | None]:

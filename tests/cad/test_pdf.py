@@ -177,7 +177,7 @@ def test_pdf_output_follows_the_drawing_unless_given():
 def test_run_writes_the_pdf_beside_the_sheet(tmp_path):
     from camfab import pipeline
 
-    d = base_design(outputs={"dxf": False, "report": False, "drawing": True})
+    d = base_design(outputs={"dxf": False, "step": False, "report": False, "drawing": True})
     d["name"] = "RunPdf"
     cam = pipeline.Cam(design_from_dict(d))
     req = pipeline.Request.from_design(cam.spec)

@@ -6,6 +6,7 @@ from types import SimpleNamespace
 import pytest
 
 from camfab.cad.stepheader import StepMeta, design_meta, header_dumps, step_timestamp
+from camfab.design.drawing import DrawingSpec
 from camfab.errors import InputError
 
 OCCT = ("ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION(('Open CASCADE Model'),'2;1');\n"
@@ -15,15 +16,15 @@ OCCT = ("ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION(('Open CASCADE Model'),'2;1');
 
 
 def test_header_from_the_design_and_its_drawing_table():
-    spec = SimpleNamespace(name="Cam 'A' ä", drawing=SimpleNamespace(author="Ann O'Hara", organisation="ACME",
-                                                                    part_number="P-7"))
+    spec = SimpleNamespace(name="Cam 'A' ä", drawing=DrawingSpec(author="Ann O'Hara", organisation="ACME",
+                                                                 part_number="P-7"))
     text = header_dumps(OCCT, spec.name, design_meta(spec))
     head, _, data = text.partition("DATA;")
     assert "FILE_NAME('P-7','1970-01-01T00:00:00',('Ann O''Hara'),('ACME'),'camfab " in head
     assert "FILE_DESCRIPTION(('Cam ''A'' \\X2\\00E4\\X0\\ (camfab cam)'),'2;1');" in head
     assert "Author" not in head and "Open CASCADE Model" not in head
     assert data == "\n#1 = X('Author');\nENDSEC;\n"  # the data section is not touched
-    plain = header_dumps(OCCT, "Ejemplo1RT", design_meta(SimpleNamespace(name="Ejemplo1RT")))
+    plain = header_dumps(OCCT, "Ejemplo1RT", design_meta(SimpleNamespace(name="Ejemplo1RT", drawing=DrawingSpec())))
     assert "FILE_NAME('Ejemplo1RT','1970-01-01T00:00:00',(''),('camfab')," in plain
 
 
