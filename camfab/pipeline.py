@@ -461,6 +461,7 @@ def _gcode(cam: Cam, req: Request) -> list[Artifact]:
 
 def _lift_table(cam: Cam, req: Request) -> list[Artifact]:
     from .gcode import lift_angles, lift_table_csv
+    from .gcode.lift_table import lift_metadata
 
     prog = cam.spec.program()
     if not prog.axis.rotating:
@@ -469,26 +470,8 @@ def _lift_table(cam: Cam, req: Request) -> list[Artifact]:
     t = np.radians(ang)
     radii = [np.hypot(*np.asarray(c.evaluate(t).point, dtype=float).reshape(-1, 2).T) for c in cam.geometry.profiles]
     text = lift_table_csv(ang, prog(t), lift_unit=prog.axis.lift_unit, radii_mm=radii,
-                          meta=_lift_meta(cam, req.lift_step_deg, str(prog.axis.lift_unit), len(radii)))
+                          meta=lift_metadata(cam.spec, req.lift_step_deg, str(prog.axis.lift_unit), len(radii)))
     return [Artifact(f"{safe_stem(cam.name)}_lift.csv", text.encode(), "lift_table")]
-
-
-def _lift_meta(cam: Cam, step_deg: float, unit: str, n: int) -> dict[str, str]:
-    """The lift table's metadata lines (docs/decisions.md, "Lift table header and units")."""
-    f, spec = cam.spec.follower, cam.spec
-    roller = {"roller": f.roller_radius_mm, "curved": f.face_radius_mm}.get(str(f.type))
-    lift = "arm angle of the oscillating follower, deg" if unit == "deg" else "follower travel, mm"
-    col = "radius_mm" if n == 1 else f"radius_cam1_mm ... radius_cam{n}_mm"
-    meta = {"table": "camfab polar lift table", "design": spec.name, "follower": f"{f.type.title}, {f.motion}",
-            "roller radius": "none" if roller is None else f"{roller:g} mm",
-            "base radius": "none" if f.base_radius_mm is None else f"{f.base_radius_mm:g} mm",
-            "cam rotation": f"{spec.cam.rotation}",
-            "units": f"angle_deg in degrees, lift_{unit} in {unit}, radius in mm",
-            "angle step": f"{step_deg:g} deg",
-            "angle 0": "the start of the first [[motion]] segment (S = 0 mark on the drawing)",
-            "lift": f"{lift}; 0 = the follower on the base circle (its lowest position)",
-            col: "distance from the cam centre to the contact point on the profile at that cam angle, mm"}
-    return meta
 
 
 def _xlsx(cam: Cam, req: Request) -> list[Artifact]:

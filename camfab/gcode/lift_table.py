@@ -22,7 +22,7 @@ from camfab.errors import Problem, SpecError
 from camfab.io import atomic_write
 from camfab.textsafe import plain
 
-__all__ = ["HEADER", "lift_table_csv", "lift_angles", "write_lift_table"]
+__all__ = ["HEADER", "lift_table_csv", "lift_angles", "write_lift_table", "lift_metadata"]
 
 #: the CSV header line
 HEADER = "angle_deg,lift_mm"
@@ -108,3 +108,22 @@ def write_lift_table(path: str | Path, angles_deg, lift_mm: np.ndarray | Callabl
                      lift_unit: str = "mm") -> Path:
     """Write :func:`lift_table_csv` atomically to ``path``."""
     return atomic_write(path, lift_table_csv(angles_deg, lift_mm, lift_unit=lift_unit))
+
+
+def lift_metadata(spec, step_deg: float, unit: str, n: int) -> dict[str, str]:
+    """The lift table's metadata lines of the design ``spec`` (a DesignSpec) for ``n`` cams, lift in ``unit``
+    (docs/decisions.md, "Lift table header and units")."""
+    f = spec.follower
+    roller = {"roller": f.roller_radius_mm, "curved": f.face_radius_mm}.get(str(f.type))
+    lift = "arm angle of the oscillating follower, deg" if unit == "deg" else "follower travel, mm"
+    col = "radius_mm" if n == 1 else f"radius_cam1_mm ... radius_cam{n}_mm"
+    meta = {"table": "camfab polar lift table", "design": spec.name, "follower": f"{f.type.title}, {f.motion}",
+            "roller radius": "none" if roller is None else f"{roller:g} mm",
+            "base radius": "none" if f.base_radius_mm is None else f"{f.base_radius_mm:g} mm",
+            "cam rotation": f"{spec.cam.rotation}",
+            "units": f"angle_deg in degrees, lift_{unit} in {unit}, radius in mm",
+            "angle step": f"{step_deg:g} deg",
+            "angle 0": "the start of the first [[motion]] segment (S = 0 mark on the drawing)",
+            "lift": f"{lift}; 0 = the follower on the base circle (its lowest position)",
+            col: "distance from the cam centre to the contact point on the profile at that cam angle, mm"}
+    return meta
