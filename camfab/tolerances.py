@@ -11,6 +11,8 @@ __all__ = [
     "MIN_EXPORT_TOL_MM",
     "MAX_EXPORT_TOL_MM",
     "MAX_ARC_RADIUS_MM",
+    "ARC_RADIUS_OVER_SIZE",
+    "arc_radius_limit",
 ]
 
 #: absolute tolerance for "equal" lengths in mm
@@ -31,3 +33,12 @@ MAX_EXPORT_TOL_MM = 0.1
 #: arcs of a larger radius (mm) are written as chords within the tolerance in STEP and, by default, in G-code
 #: (``Post.max_arc_radius_mm``): docs/decisions.md, "Arc radius limit"
 MAX_ARC_RADIUS_MM = 5000.0
+#: an arc is a near-straight stretch of the fit, not the part's own curvature, above this many times the part's
+#: size (its largest distance from the cam centre): the limit grows with the part (a 10 m cam keeps its arcs)
+ARC_RADIUS_OVER_SIZE = 10.0
+
+
+def arc_radius_limit(size_mm: float, cap_mm: float = float("inf")) -> float:
+    """The largest arc radius written for a part of ``size_mm`` (its largest distance from the cam centre):
+    ``max(MAX_ARC_RADIUS_MM, ARC_RADIUS_OVER_SIZE · size)``, at most ``cap_mm`` (the controller's limit)."""
+    return min(cap_mm, max(MAX_ARC_RADIUS_MM, ARC_RADIUS_OVER_SIZE * float(size_mm)))

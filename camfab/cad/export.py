@@ -14,6 +14,8 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from ..design.kinds import ContactKind
 from ..discretize import ArcDiscretisation, arcs, arcs_within_radius, measure_deviation, validate_tol
 from ..discretize.curve import discontinuities
@@ -22,7 +24,7 @@ from ..errors import GeometryError
 from ..geom2d import ArcChain
 from ..io import atomic_write, inside, safe_stem
 from ..offset.cutter import pitch_curve, profile_curve, tool_centre_path
-from ..tolerances import MAX_ARC_RADIUS_MM
+from ..tolerances import arc_radius_limit
 from . import dxf as dxf_mod
 from . import step, stl
 from .plate import PlateSpec, bore_loop
@@ -176,11 +178,17 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
 
 def solid_outlines(shapes: CamShapes, tol: float) -> tuple[list, list[float]]:
     """The outlines a solid (STEP, assembly, IGES) is built from, with their measured deviations: the arc fits
-    with every arc above :data:`~camfab.tolerances.MAX_ARC_RADIUS_MM` replaced by chords within ``tol`` (an arc
-    of a huge radius, a near-straight stretch, is a cylinder OpenCascade cannot intersect reliably)."""
-    loops = [arcs_within_radius(p, c, tol=tol, max_radius_mm=MAX_ARC_RADIUS_MM)
+    with every arc above :func:`~camfab.tolerances.arc_radius_limit` of the part replaced by chords within
+    ``tol`` (an arc of a huge radius, a near-straight stretch, is a cylinder OpenCascade cannot intersect
+    reliably)."""
+    loops = [arcs_within_radius(p, c, tol=tol, max_radius_mm=arc_radius_limit(_size(p)))
              for p, c in zip(shapes.profiles, shapes.curves, strict=True)]
     return loops, [float(lp.max_deviation or 0.0) for lp in loops]
+
+
+def _size(loop) -> float:
+    """A loop's largest distance from the origin (the cam centre), mm."""
+    return float(np.hypot(*np.asarray(loop.starts, dtype=float).T).max())
 
 
 def _dxf(spec, geometry, shapes: CamShapes, plate: PlateSpec, tol: float, flavour: str,

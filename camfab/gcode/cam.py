@@ -11,10 +11,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+import numpy as np
+
 from ..discretize import ParametricCurve, arcs, arcs_within_radius, polyline
 from ..discretize.fit import REFIT_SHARE
 from ..geom2d import ArcChain
 from ..offset.cutter import offset_curve, profile_curve, tool_centre_path
+from ..tolerances import arc_radius_limit
 from .distance import CurveDistance
 from .model import Job, Program
 from .toolpath import contour_toolpath
@@ -60,13 +63,14 @@ def cam_program(contact, job: Job, *, tol: float, compensation: str | None = Non
     """
     from .post import get_post
 
-    max_r = get_post(post or "linuxcnc").max_arc_radius_mm
+    cap = get_post(post or "linuxcnc").max_arc_radius_mm
     r = job.tool_radius_mm
     share = contour_tolerance(tol, post, job.units)
     # the arcs get (1 - REFIT_SHARE) of the share, the chords of arcs above max_r the room the fit leaves
     tol_fit = max(share * (1.0 - REFIT_SHARE), 1e-6)
     # the offset's shapely cross-check runs at the usual share; a finer fit (a coarse post's rounding) follows
     path = tool_centre_path(contact, r, tol=max(tol_fit, tol * FIT_SHARE * (1.0 - REFIT_SHARE)))
+    max_r = arc_radius_limit(float(np.hypot(*np.asarray(path.arcs.starts, dtype=float).T).max()), cap)
     if compensation:
         # the program carries the part contour (the controller offsets it exactly): its deviation is the claim
         curve = profile_curve(contact)

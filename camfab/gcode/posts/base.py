@@ -23,7 +23,6 @@ from camfab.errors import ApiError, ExportError, InputError
 from camfab.gcode.model import Arc, Comment, Coolant, CutterComp, Feed, Program, Rapid, Spindle, ToolChange
 from camfab.geom2d import arc_sweep
 from camfab.textsafe import gcode_comment
-from camfab.tolerances import MAX_ARC_RADIUS_MM
 
 __all__ = ["MM_PER_INCH", "Post", "decimals_for", "header_lines", "rounding_allowance_mm"]
 
@@ -145,8 +144,9 @@ class Post:
     end_code : str
         ``M2`` or ``M30``.
     max_arc_radius_mm : float
-        Arcs of a larger radius are written as chords within the tolerance (default
-        :data:`~camfab.tolerances.MAX_ARC_RADIUS_MM`, 5000 mm; Fanuc's R word holds at most 99 999.999).
+        The controller's largest arc radius (default 99 999.999 mm: an R or I/J word of 8 digits); below it,
+        arcs above :func:`~camfab.tolerances.arc_radius_limit` of the part are written as chords within the
+        tolerance.
     max_arc_sweep_deg : float
         Largest sweep of one arc block; longer arcs are split into equal pieces (R arcs at most 90).
     """
@@ -161,7 +161,7 @@ class Post:
     arc_formats: tuple[str, ...] = ("ij",)
     end_code = "M2"
     mist_code = "M7"
-    max_arc_radius_mm = MAX_ARC_RADIUS_MM
+    max_arc_radius_mm = 99_999.999
     max_arc_sweep_deg = 180.0
     #: default values of the options this post accepts
     defaults: dict[str, Any] = {}
