@@ -8,6 +8,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import hashlib
+import io
 import os
 import re
 import shutil
@@ -154,7 +155,7 @@ class _Stream:
     def seek(self, offset: int, whence: int = 0) -> int:
         """Only where it stands (a stream is written forward)."""
         if (offset, whence) not in ((self._at, 0), (0, 1)):
-            raise OSError(f"{self._path}: a stream cannot seek")
+            raise io.UnsupportedOperation(f"{self._path}: a stream cannot seek")  # as any unseekable file
         return self._at
 
     def flush(self) -> None:
