@@ -419,9 +419,11 @@ _NAUO = re.compile(r"NEXT_ASSEMBLY_USAGE_OCCURRENCE\('[^']*'")
 def canonical_order(text: str) -> str:
     """The assembly STEP made byte-identical from run to run: OpenCascade numbers the usage occurrences from
     a counter of the process, and writes the colour groups (each one MECHANICAL_DESIGN_GEOMETRIC_PRESENTATION_
-    REPRESENTATION with its styled item … COLOUR_RGB, referring only to themselves and to the shapes before
-    them) in an order that depends on memory addresses.  The occurrences are numbered 1, 2 … in file order and
-    the colour groups sorted by their content, renumbered in place.  Any other layout is left as it is."""
+    REPRESENTATION with its styled item … COLOUR_RGB, referring to the shapes before them and sharing the colours)
+    in an order that depends on memory addresses.  The occurrences are numbered 1, 2 … in file order; the
+    presentation entities are renumbered from the groups sorted by their content (each entity spelled out with
+    what it uses), in pre-order, so a shared colour takes its number at its first use.  Any other layout is left
+    as it is."""
     counter = iter(range(1, 1 << 30))
     text = _NAUO.sub(lambda m: f"NEXT_ASSEMBLY_USAGE_OCCURRENCE('{next(counter)}'", text)
     head, sep, data = text.partition("DATA;")
@@ -431,32 +433,39 @@ def canonical_order(text: str) -> str:
                  None)
     if first is None:
         return text
-    start = ents[first][0]
-    groups: list[list[tuple[int, str]]] = []
-    for n, t in ents[first:]:
-        if t.startswith("MECHANICAL_DESIGN_GEOMETRIC_PRESENTATION") or not groups:
-            groups.append([])
-        groups[-1].append((n, t))
-    ids = [n for n, _ in ents[first:]]
-    if ids != list(range(start, start + len(ids))) or any(
-            int(r) >= start for _, t in ents[:first] for r in _REF.findall(t)):
-        return text  # not the layout described above: leave it
+    tail_ents = dict(ents[first:])
+    if any(int(r) in tail_ents for _, t in ents[:first] for r in _REF.findall(t)):
+        return text  # the shapes refer to the presentation: not the layout described above, leave it
+    sig: dict[int, str] = {}
 
-    def key(group: list[tuple[int, str]]) -> str:  # the group with its own entities numbered from 0
-        own = {n: i for i, (n, _) in enumerate(group)}
-        return "\n".join(_REF.sub(lambda m: f"@{own[int(m.group(1))]}" if int(m.group(1)) in own
-                                   else m.group(0), t) for _, t in group)
+    def signature(n: int) -> str:  # the entity's text with every presentation entity it uses spelled out
+        if n not in sig:
+            sig[n] = ""  # a cycle (none in OpenCascade's output) stops here
+            sig[n] = _REF.sub(lambda m: f"<{signature(int(m.group(1)))}>" if int(m.group(1)) in tail_ents
+                              else m.group(0), tail_ents[n])
+        return sig[n]
 
+    used = {int(r) for t in tail_ents.values() for r in _REF.findall(t)}
+    roots = sorted((n for n in tail_ents if n not in used), key=signature)
     renum: dict[int, int] = {}
-    nxt = start
-    order = sorted(groups, key=key)
-    for g in order:
-        for n, _ in g:
-            renum[n] = nxt
-            nxt += 1
+    nxt = ents[first][0]
+
+    def visit(n: int) -> None:  # numbered in pre-order from the sorted roots: shared colours at first use
+        nonlocal nxt
+        if n in renum:
+            return
+        renum[n] = nxt
+        nxt += 1
+        for r in _REF.findall(tail_ents[n]):
+            if int(r) in tail_ents:
+                visit(int(r))
+
+    for n in roots:
+        visit(n)
+    for n in sorted((n for n in tail_ents if n not in renum), key=signature):
+        visit(n)
     lines = [f"#{n} = {t};" for n, t in ents[:first]]
-    for g in order:
-        for n, t in g:
-            lines.append(f"#{renum[n]} = " + _REF.sub(lambda m: f"#{renum.get(int(m.group(1)), int(m.group(1)))}",
-                                                      t) + ";")
+    for n in sorted(tail_ents, key=renum.__getitem__):
+        lines.append(f"#{renum[n]} = " + _REF.sub(lambda m: f"#{renum.get(int(m.group(1)), int(m.group(1)))}",
+                                                  tail_ents[n]) + ";")
     return head + sep + "\n" + "\n".join(lines) + "\n" + end + tail
