@@ -170,11 +170,7 @@ def atomic_stream(path: str | Path, *, durable: bool | None = None) -> Iterator[
     An ``OSError`` names ``path``."""
     path = Path(path)
     sync = DURABLE if durable is None else durable
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}{TEMP_MARK}tmp-{os.getpid()}-")
-    except OSError as exc:
-        raise named(exc, path) from exc
+    fd, tmp = _new_temp(path)
     try:
         with os.fdopen(fd, "wb") as fh:
             yield _Stream(fh, path)
@@ -193,13 +189,19 @@ def atomic_stream(path: str | Path, *, durable: bool | None = None) -> Iterator[
         fsync_dir(path.parent)
 
 
-def _write_temp(path: Path, raw: bytes, sync: bool) -> str:
-    """``raw`` in a new temporary file beside ``path`` (its name returned); nothing left on failure."""
+def _new_temp(path: Path) -> tuple[int, str]:
+    """A new empty temporary file beside ``path`` (its folder made if missing), named with camfab's temporary
+    mark so that the next run can recognise it: (open descriptor, name).  An ``OSError`` names ``path``."""
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}{TEMP_MARK}tmp-{os.getpid()}-")
+        return tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}{TEMP_MARK}tmp-{os.getpid()}-")
     except OSError as exc:
         raise named(exc, path) from exc
+
+
+def _write_temp(path: Path, raw: bytes, sync: bool) -> str:
+    """``raw`` in a new temporary file beside ``path`` (its name returned); nothing left on failure."""
+    fd, tmp = _new_temp(path)
     try:
         with os.fdopen(fd, "wb") as fh:
             write_bytes(fh, raw, path)

@@ -429,7 +429,8 @@ cio.write_bytes = slow
 main(["run", "ejemplo9rt", "-o", {str(out)!r}, "--outputs", "xlsx"])
 """
     p = subprocess.Popen([sys.executable, "-c", code], env=ENV, start_new_session=True)
-    temps = _until(lambda: [q for q in out.glob(".*") if ".camfab-tmp-" in q.name], 120, "the temporary file")
+    # the xlsx's own temporary file: the output folder's probe makes one too, which lives only for an instant
+    temps = _until(lambda: list(out.glob(".Ejemplo9RT.xlsx.camfab-tmp-*")), 120, "the xlsx's temporary file")
     os.kill(p.pid, signal.SIGKILL)
     p.wait(10)
     assert temps[0].exists() and (out / LOCK).exists()
