@@ -140,33 +140,33 @@ def cutting_data(*, tool_diameter_mm: float, material: str = "", tool_material: 
     z = int(flutes) if flutes is not None else int(row["flutes"])
     band_lo = lo if band == 0 else edges[band - 1]
     if not text:
-        notes.append(f"material: not given in the design, {name} assumed")
+        notes.append(f"material source: not given in the design, {name} assumed")
     notes.append(f"cutting data: camfab table, {name}")
     notes.append(f"material: {row['description']}")
-    notes.append(f"tool: {tool_material}, {z} flutes{' as given' if flutes is not None else ''}")
+    notes.append(f"tool material: {tool_material}, {z} flutes{' as given' if flutes is not None else ''}")
     notes.append(f"table: vc {vc:g} m/min, fz {fz:g} mm for D {band_lo:g}-{edges[band]:g} mm")
     n_table = 1000.0 * vc / (math.pi * D)
     if spindle_rpm is not None:
         n = float(spindle_rpm)
-        notes.append(f"spindle: {n:g} rpm given, table {n_table:.0f} rpm")
+        notes.append(f"spindle source: {n:g} rpm given, table {n_table:.0f} rpm")
     elif max_spindle_rpm is not None and round(n_table) > max_spindle_rpm:
         n = float(math.floor(max_spindle_rpm))
         notes.append(f"spindle LIMITED: table {n_table:.0f} rpm over machine max {max_spindle_rpm:g}")
-        notes.append(f"spindle: {n:g} rpm, feed at the same fz, vc {math.pi * D * n / 1000.0:.0f} m/min")
+        notes.append(f"spindle source: {n:g} rpm, feed at the same fz, vc {math.pi * D * n / 1000.0:.0f} m/min")
     else:
         n = float(round(n_table))
-        notes.append(f"spindle: n = 1000 vc / pi D = {n:g} rpm")
+        notes.append(f"spindle source: n = 1000 vc / pi D = {n:g} rpm")
     if feed_mm_min is not None:
         feed = float(feed_mm_min)
-        notes.append(f"feed: {feed:g} mm/min given")
+        notes.append(f"feed source: {feed:g} mm/min given")
     else:
         feed = fz * z * n
-        notes.append(f"feed = fz x z x n = {fz:g} x {z} x {n:g} = {feed:.1f} mm/min")
+        notes.append(f"feed source: fz x z x n = {fz:g} x {z} x {n:g} = {feed:.1f} mm/min")
     frac = float(data["plunge_fraction"])
     if plunge_feed_mm_min is not None:
         plunge = float(plunge_feed_mm_min)
-        notes.append(f"plunge feed: {plunge:g} mm/min given")
+        notes.append(f"plunge source: {plunge:g} mm/min given")
     else:
         plunge = frac * feed
-        notes.append(f"plunge/helix feed = {frac:g} x feed = {plunge:.1f} mm/min")
+        notes.append(f"plunge source: plunge/helix feed = {frac:g} x feed = {plunge:.1f} mm/min")
     return CuttingData(n, feed, plunge, z, tuple(notes))

@@ -105,7 +105,7 @@ def test_a_spindle_above_the_machine_maximum_is_limited_and_said(tmp_path):
     fz = TABLE["materials"]["AlMgSi1"]["carbide"]["fz"][1]
     assert rpm == 12000 and round(fz * 2 * 12000, 1) in feeds  # the same chip load at the highest speed
     assert f"(spindle LIMITED: table {n_table} rpm over machine max 12000)" in text
-    assert "(spindle: 12000 rpm, feed at the same fz, vc 226 m/min)" in text
+    assert "(spindle source: 12000 rpm, feed at the same fz, vc 226 m/min)" in text
 
 
 def test_final_depth_includes_the_breakthrough_and_the_stock_is_stated(tmp_path):
@@ -115,7 +115,7 @@ def test_final_depth_includes_the_breakthrough_and_the_stock_is_stated(tmp_path)
         assert min(z) == pytest.approx(-(10.0 + brk), abs=1e-9)
         assert f"(depth: plate 10 + breakthrough {brk:g} = {10 + brk:g} mm)" in text
         assert "(stock: round blank D94 x 10 mm on the axis X0 Y0)" in text  # 2 x (45 + 2)
-        assert "(material: not given in the design, C45 assumed)" in text
+        assert "(material source: not given in the design, C45 assumed)" in text
 
 
 @pytest.mark.parametrize("post", ["linuxcnc", "grbl"])
@@ -232,3 +232,20 @@ def test_a_conventional_inch_program_with_its_bore_verifies(tmp_path, capsys):
     assert min(m.end[2] for m in helix) == pytest.approx(-10.5, abs=2.54e-4)  # 5 decimals of an inch
     capsys.readouterr()
     assert main(["verify", str(p.with_suffix(".nc")), "--design", str(p), "--tol", str(TOL)]) == 0
+
+
+@pytest.mark.parametrize("machining", ["", "spindle_rpm = 4321.0\nfeed_mm_min = 500.0\nplunge_feed_mm_min = 200.0",
+                                       "max_spindle_rpm = 3000.0"])
+def test_each_header_key_is_stated_once(tmp_path, machining):
+    """The header is one table of `key: value` lines: the summary (spindle, feed, tool, material ...) and the
+    notes that say where each number came from use distinct keys, so a reader (or a script) never finds two
+    different `spindle:` lines.  Repeated keys are only continuation notes of the same item (stock, bore)."""
+    text = program(design(tmp_path, machining=machining))
+    head = text.split("(ROUGH", 1)[0]
+    keys = [m.group(1) for m in re.finditer(r"^\(([a-zA-Z /]+?):", head, re.M)]
+    repeated = {k for k in keys if keys.count(k) > 1} - {"stock", "bore"}
+    assert keys and not repeated, repeated
+    if "feed_mm_min" in machining:  # all three given: one line says so
+        assert "(cutting data: rpm, feed and plunge feed given)" in head
+    else:
+        assert "(spindle source:" in head and "(feed source:" in head and "(plunge source:" in head
