@@ -11,9 +11,12 @@ from __future__ import annotations
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from enum import StrEnum
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from .vibration_results import VibrationSummary
 
 __all__ = [
     "Severity",
@@ -92,6 +95,9 @@ class IssueCode(StrEnum):
     CONTACT_FORCE_BELOW_SAFETY = "CONTACT_FORCE_BELOW_SAFETY"
     SELF_LOCKING = "SELF_LOCKING"
     LOAD_REVERSAL = "LOAD_REVERSAL"
+    # follower vibration (the elastic follower train, [vibration])
+    FOLLOWER_SEPARATES_VIBRATION = "FOLLOWER_SEPARATES_VIBRATION"
+    VIBRATION_RESONANCE = "VIBRATION_RESONANCE"
     # G-code verification
     PARSE_WARNING = "PARSE_WARNING"
     NO_CUTTING_MOVES = "NO_CUTTING_MOVES"
@@ -476,6 +482,8 @@ class CheckReport:
         With a ``[dynamics]`` section.
     initial_arm_angle_deg : float or None
         Oscillating followers.
+    vibration : VibrationSummary or None
+        With a ``[vibration]`` section (:mod:`camfab.vibration_results`).
     """
 
     name: str
@@ -490,6 +498,7 @@ class CheckReport:
     area_mm2: float | None = None
     dynamics: DynamicsSummary | None = None
     initial_arm_angle_deg: float | None = None
+    vibration: VibrationSummary | None = None
 
     @property
     def verdict(self) -> Verdict:
@@ -518,4 +527,5 @@ class CheckReport:
                     "max_radius_mm": _plain(self.max_radius_mm), "area_mm2": _plain(self.area_mm2),
                     "dynamics": part(self.dynamics), "initial_arm_angle_deg": _plain(self.initial_arm_angle_deg),
                     "x_unit": self.x_unit, "findings": [f.to_dict() for f in self.findings]})
+        out["vibration"] = part(self.vibration)
         return out
