@@ -59,6 +59,8 @@ __all__ = ["Train", "VibrationSample", "FollowerTrain", "analyse_vibration", "dw
 
 #: samples per cycle (a power of two: the FFT)
 SAMPLES = 4096
+#: the motion is sampled this many times finer for its harmonics (aliasing from above n/2 falls by its square)
+OVERSAMPLE = 8
 #: the separation speed is searched up to this multiple of the design speed …
 SEARCH_FACTOR = 10.0
 #: … from 1 % of it, on a geometric ladder of this ratio (a separation band narrower is missed)
@@ -85,11 +87,12 @@ class VibrationSample:
     ``x``: the cam parameter (rad, or mm of travel); ``s``: the kinematic follower; ``w``: the elastic
     follower (from its static position on the base circle); ``force``: the generalised contact force F_c;
     ``contact_force``: N = F_c/D (newtons; NaN where the follower is wedged, D ≤ 0); ``kinematic_force``:
-    the rigid follower's G/D."""
+    the rigid follower's G/D; ``deflection_rate``: u̇ = ẇ − ṡ (per second); ``rate``: ω or v."""
 
     x: np.ndarray
     s: np.ndarray
     w: np.ndarray
+    deflection_rate: np.ndarray
     force: np.ndarray
     contact_force: np.ndarray
     kinematic_force: np.ndarray
@@ -123,14 +126,18 @@ class FollowerTrain:
         self.q_per_s = qs = dyn.q_per_s
         self.period = contact.period
         self.x = np.arange(self.n) * (self.period / self.n)
-        S = np.asarray(contact.motion.evaluate(self.x, (0, 1, 2)), dtype=float)
-        self.S = S
+        # the motion sampled OVERSAMPLE times finer: its first n/2 harmonics nearly free of aliasing
+        fine = np.arange(self.n * OVERSAMPLE) * (self.period / (self.n * OVERSAMPLE))
+        Sf = np.asarray(contact.motion.evaluate(fine, (0, 1, 2)), dtype=float)
+        S = self.S = Sf[:, ::OVERSAMPLE]
         self.s = qs * S[0]
         self.lever = dyn.evaluate(self.x).lever  # D does not depend on the speed
         m, ks, ca = loads.inertia, loads.spring_rate, loads.damping
-        # G̃ = r²·A₂ + r·A₁ + A₀ (per unit of x: S′ per rad or mm)
-        self._A = np.fft.rfft(np.stack([m * qs * S[2], ca * qs * S[1], ks * qs * S[0]]), axis=1)
-        self._S = np.fft.rfft(self.s)
+        # G̃ = r²·A₂ + r·A₁ + A₀ (per unit of x: S′ per rad or mm), as the DFT of n samples would give it
+        keep = self.n // 2 + 1
+        spec = np.fft.rfft(np.stack([m * qs * Sf[2], ca * qs * Sf[1], ks * qs * Sf[0]]), axis=1)[:, :keep]
+        self._A = spec / OVERSAMPLE
+        self._S = np.fft.rfft(qs * Sf[0])[:keep] / OVERSAMPLE
         self.constant = loads.preload + loads.external  # F₀ + F_ext: the contact load at rest on the base circle
         self.stiffness = k = train.stiffness
         self.total_stiffness = k + ks
@@ -176,8 +183,9 @@ class FollowerTrain:
         """The periodic steady state at the rate r (ω in rad/s, or v in mm/s)."""
         if not rate > 0:
             raise InputError(f"speed = {rate!r}: must be > 0")
-        _, U, F = self._spectra(np.array([float(rate)]))
+        wj, U, F = self._spectra(np.array([float(rate)]))
         u = np.fft.irfft(U[0], self.n)
+        du = np.fft.irfft(1j * wj[0] * U[0], self.n)
         force = np.fft.irfft(F[0], self.n) + self.constant
         D = self.lever
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -186,7 +194,7 @@ class FollowerTrain:
             G = (L.inertia * qs * S[2] * rate * rate + L.damping * qs * S[1] * rate + L.spring_rate * self.s
                  + self.constant)
             Nk = np.where(D > 0, G / D, np.nan)
-        return VibrationSample(self.x, self.s, self.s + u, force, N, Nk, float(rate))
+        return VibrationSample(self.x, self.s, self.s + u, du, force, N, Nk, float(rate))
 
     def min_force(self, rates) -> np.ndarray:
         """The smallest generalised contact force F_c over the cycle at each rate (vectorised)."""
