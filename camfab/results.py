@@ -11,12 +11,9 @@ from __future__ import annotations
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from enum import StrEnum
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 import numpy as np
-
-if TYPE_CHECKING:
-    from .vibration_results import VibrationSummary
 
 __all__ = [
     "Severity",
@@ -36,6 +33,7 @@ __all__ = [
     "DynamicsSummary",
     "DynamicsReport",
     "CheckReport",
+    "JsonPart",
     "CURVATURE_CODES",
     "JUMP_CODES",
     "FORCE_CODES",
@@ -459,6 +457,13 @@ class DynamicsReport:
 
 # ---------------------------------------------------------------------------
 # the check report
+class JsonPart(Protocol):
+    """A summary kept outside this module that writes its own part of ``check --json``."""
+
+    def to_dict(self) -> dict[str, Any]: ...
+
+
+
 @dataclass(frozen=True)
 class CheckReport:
     """The profile checks of a cam (the ``camfab check`` report): findings, verdict, conclusions.
@@ -482,8 +487,8 @@ class CheckReport:
         With a ``[dynamics]`` section.
     initial_arm_angle_deg : float or None
         Oscillating followers.
-    vibration : VibrationSummary or None
-        With a ``[vibration]`` section (:mod:`camfab.vibration_results`).
+    vibration : JsonPart or None
+        With a ``[vibration]`` section: a :class:`camfab.design.vibration_results.VibrationSummary`.
     """
 
     name: str
@@ -498,7 +503,7 @@ class CheckReport:
     area_mm2: float | None = None
     dynamics: DynamicsSummary | None = None
     initial_arm_angle_deg: float | None = None
-    vibration: VibrationSummary | None = None
+    vibration: JsonPart | None = None
 
     @property
     def verdict(self) -> Verdict:

@@ -10,13 +10,13 @@ import math
 
 from ..errors import InputError
 from ..results import CheckReport, DynamicsReport, Finding
-from ..vibration_results import VibrationReport
 from .checks import check
 from .dynamics import ContactDynamics, Loads, PairDynamics, analyse_dynamics, pair_of
 from .mechanisms import geometry_from_spec, mechanism_from_spec
 from .profile import CamGeometry
 from .spec import DesignSpec, DynamicsSpec
 from .vibration import analyse_vibration
+from .vibration_results import VibrationReport
 from .vibration_spec import train_of
 
 __all__ = ["mechanism_from_spec", "geometry_from_spec", "check_design", "knot_findings", "loads_from_spec",

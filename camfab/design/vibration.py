@@ -50,9 +50,9 @@ from .. import numeric
 from ..errors import InputError
 from ..results import Extreme, Finding, IssueCode, JumpSpeed, Maximum, Severity
 from ..units import RPM
-from ..vibration_results import Harmonic, VibrationReport, VibrationSummary
 from .dynamics import ContactDynamics, Loads
 from .profile import Contact
+from .vibration_results import Harmonic, VibrationReport, VibrationSummary
 
 __all__ = ["Train", "VibrationSample", "FollowerTrain", "analyse_vibration", "dwell_runs", "SEARCH_FACTOR",
            "SCAN_RATIO", "RESONANCE_BAND", "SIGNIFICANT_FRACTION", "SAMPLES"]

@@ -1,7 +1,7 @@
 """Typed results of the follower vibration (``[vibration]``): the ``vibration`` object of ``check --json``.
 
-Kept beside :mod:`camfab.results` (which holds the finding codes ``FOLLOWER_SEPARATES_VIBRATION`` and
-``VIBRATION_RESONANCE`` and the :class:`~camfab.results.CheckReport` that carries the summary).  Lengths are
+:mod:`camfab.results` holds the finding codes ``FOLLOWER_SEPARATES_VIBRATION`` and ``VIBRATION_RESONANCE`` and
+the :class:`~camfab.results.CheckReport` that carries the summary (as a :class:`~camfab.results.JsonPart`).  Lengths are
 in the lift unit (mm, or degrees of arm angle), forces in N, positions in user units (degrees of cam angle,
 or mm of travel for a translating cam; the JSON keys say ``_deg`` either way).
 """
@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from .results import Extreme, Finding, JumpSpeed, Maximum
+from ..results import Extreme, Finding, JumpSpeed, Maximum
 
 __all__ = ["Harmonic", "VibrationSummary", "VibrationReport"]
 
