@@ -13,7 +13,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from camfab.cli import main
-from camfab.design.assemble import loads_from_spec
+from camfab.design.assemble import check_design, loads_from_spec
 from camfab.design.dynamics import ContactDynamics, Loads, analyse_dynamics
 from camfab.design.mechanisms import geometry_from_spec
 from camfab.design.spec import design_from_dict
@@ -287,3 +287,46 @@ def test_loads_from_spec_units_match_the_train():
     spec = design_from_dict(_design(CYCLOIDAL, vibration=TOML_VIB))
     loads = loads_from_spec(spec.dynamics)
     assert loads.spring_rate == pytest.approx(KS) and spec.vibration.stiffness == 300.0
+
+
+def test_xlsx_design_keeps_the_vibration_table(tmp_path):
+    pytest.importorskip("openpyxl")
+    from camfab.formats import design_to_xlsx, load_design_xlsx
+
+    spec = design_from_dict(_design(CYCLOIDAL, vibration={**TOML_VIB, "harmonics": 7}))
+    path = tmp_path / "design.xlsx"
+    path.write_bytes(design_to_xlsx(spec))
+    assert load_design_xlsx(path).vibration == spec.vibration
+
+
+def test_oscillating_arm_and_translating_cam():
+    """An arm: k in N·m/degree, lengths in degrees, f_n = √((k + k_s)/I)/2π; a translating cam: speed in mm/s,
+    the cycle is the cam length over the speed."""
+    arm = design_from_dict({
+        "name": "arm", "cam": {"kind": "disc", "speed_rpm": 600.0},
+        "follower": {"type": "roller", "motion": "oscillating", "base_radius_mm": 40.0, "roller_radius_mm": 8.0,
+                     "pivot_distance_mm": 110.0, "arm_length_mm": 90.0},
+        "motion": [{"law": "cycloidal", "lift": 15.0, "angle_deg": 120.0}, {"law": "dwell", "angle_deg": 60.0},
+                   {"law": "cycloidal", "lift": -15.0, "angle_deg": 120.0}, {"law": "dwell", "angle_deg": 60.0}],
+        "dynamics": {"inertia_kg_m2": 0.002, "spring_rate_nm_per_deg": 0.05, "spring_preload_nm": 8.0},
+        "vibration": {"stiffness_nm_per_deg": 50.0, "damping_ratio": 0.1}})
+    v = check_vibration(arm)
+    per_rad = 180 / math.pi
+    assert v.lift_unit == "deg"
+    assert v.natural_frequency_hz == pytest.approx(math.sqrt((50.05 * per_rad) / 0.002) / (2 * math.pi))
+    assert v.cycle_frequency_hz == pytest.approx(10.0)
+    assert 0 < v.max_deviation.max < 1.0  # degrees
+    plate = design_from_dict({
+        "name": "plate", "cam": {"kind": "translating", "speed_mm_s": 500.0},
+        "follower": {"type": "roller", "motion": "translating", "roller_radius_mm": 5.0, "cam_length_mm": 200.0},
+        "motion": [{"law": "cycloidal", "lift": 8.0, "length_mm": 100.0},
+                   {"law": "cycloidal", "lift": -8.0, "length_mm": 100.0}],
+        "dynamics": {"mass_kg": 0.5, "spring_rate_n_per_mm": 5.0, "spring_preload_n": 50.0},
+        "vibration": {"stiffness_n_per_mm": 500.0}})
+    v = check_vibration(plate)
+    assert v.cycle_frequency_hz == pytest.approx(2.5) and v.separation_speed.unit == "mm/s"
+    assert v.residual_amplitude is None  # no dwell
+
+
+def check_vibration(spec):
+    return check_design(spec).vibration
