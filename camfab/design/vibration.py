@@ -321,19 +321,27 @@ def _separation(resp: VibrationSample, model: FollowerTrain, user, unit: str, sp
     neg = resp.force < 0
     if not neg.any():
         return []
-    x, n = resp.x, model.n
-    fix = f"the follower first leaves the cam at {sep.value:.6g} {sep.unit}" if sep.value is not None else ""
+    n, F = model.n, resp.force
+    h = model.period / n
+    fix = "raise the spring preload or rate, stiffen the train, or run slower"
+    if sep.value is not None:
+        fix = f"the follower first leaves the cam at {sep.value:.6g} {sep.unit}; " + fix
+    speed_txt = f"{speed / RPM:.6g} rpm" if model.contact.axis.rotating else f"{speed:.6g} mm/s"
     out = []
     for a, b in _runs(neg):
         idx = np.arange(a, b) % n
         worst = float(np.nanmin(resp.contact_force[idx])) if np.isfinite(resp.contact_force[idx]).any() else \
-            float(resp.force[idx].min())
-        lo, hi = float(user(x[idx[0]])), float(user(x[idx[-1]]))
-        speed_txt = f"{speed / RPM:.6g} rpm" if model.contact.axis.rotating else f"{speed:.6g} mm/s"
+            float(F[idx].min())
+        if b - a >= n:  # never in contact
+            lo, hi = 0.0, float(user(model.period))
+        else:  # the zero crossings, linear between the samples
+            f0, f1 = F[(a - 1) % n], F[a % n]
+            g0, g1 = F[(b - 1) % n], F[b % n]
+            lo = float(user(((a - 1) + f0 / (f0 - f1)) * h % model.period))
+            hi = float(user(((b - 1) + g0 / (g0 - g1)) * h % model.period))
         out.append(Finding(IssueCode.FOLLOWER_SEPARATES_VIBRATION, Severity.ERROR, lo, hi, worst, 0.0,
                            f"with the train's vibration the follower leaves the cam from {lo:.2f} to {hi:.2f} "
-                           f"{unit} at {speed_txt} (contact force down to {worst:.6g} N); {fix}: raise the spring "
-                           "preload or rate, stiffen the train, or run slower"))
+                           f"{unit} at {speed_txt} (contact force down to {worst:.6g} N); {fix}"))
     return out
 
 

@@ -330,3 +330,22 @@ def test_oscillating_arm_and_translating_cam():
 
 def check_vibration(spec):
     return check_design(spec).vibration
+
+
+def test_separation_ranges_end_where_the_force_crosses_zero(cycloidal_contact):
+    """Each FOLLOWER_SEPARATES_VIBRATION range starts and ends where the contact force with the vibration
+    crosses 0, checked on a 4x finer, independent solution 0.1° either side."""
+    loads, train = Loads(M, KS, F0), Train(3e5, 0.05)
+    rep = analyse_vibration(cycloidal_contact, loads, train, 2 * OMEGA)
+    seps = [f for f in rep.findings if f.code == IssueCode.FOLLOWER_SEPARATES_VIBRATION]
+    assert seps
+    fine = FollowerTrain(cycloidal_contact, loads, train, n=4 * 4096).response(2 * OMEGA)
+    deg = np.degrees(fine.x)
+
+    def force(at):
+        return np.interp(at % 360, deg, fine.force, period=360)
+
+    for f in seps:
+        assert force(f.from_deg - 0.1) > 0 > force(f.from_deg + 0.1)
+        assert force(f.to_deg - 0.1) < 0 < force(f.to_deg + 0.1)
+        assert f.value < 0 and f.limit == 0.0
