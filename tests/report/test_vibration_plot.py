@@ -50,3 +50,14 @@ def test_no_vibration_section_no_figure():
     report = check_design(spec)
     assert vibration_figures(spec, geometry_from_spec(spec), report) == {}
     assert report.vibration is None and "follower vibration" not in format_check(spec, report)
+
+
+def test_html_report_shows_the_vibration_plot():
+    from camfab.report.html import render_report
+
+    spec = design_from_dict(DESIGN)
+    files = render_report(spec, geometry_from_spec(spec), check_design(spec), frames=12)
+    assert files["plots/vibration.svg"].startswith(b"<?xml")
+    html = files["report.html"].decode("utf-8")
+    assert 'src="plots/vibration.svg"' in html and "Follower vibration" in html
+    assert "FOLLOWER_SEPARATES_VIBRATION" in html
