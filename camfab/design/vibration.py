@@ -33,9 +33,10 @@ Periodic steady state (harmonic balance)
 ----------------------------------------
 G̃ is periodic; the response of the linear system to its harmonic j (frequency jΩ, Ω = 2π/T) is
 that harmonic times H(jΩ) = 1/(k + k_s − m(jΩ)² + i·jΩ(c + c_a)) — no transient, no cycles to integrate.
-G̃ is sampled at ``n`` equal steps of one cycle and transformed (FFT): the solution is exact for the
-trigonometric interpolant of G̃ (error from the harmonics above n/2 only: 1/n² and faster for motions
-with a continuous acceleration); ``solve_ivp`` over many cycles agrees (tests).  G̃ = r²·A₂ + r·A₁ + A₀
+The response is computed at ``n`` equal steps of one cycle (FFT); G̃'s first n/2 harmonics come from
+a sample :data:`OVERSAMPLE` times finer, so little of the harmonics above folds onto them.  The error
+falls as 1/n² (3·10⁻⁸ of the deflection through a cycloidal rise at n = 4096); ``solve_ivp`` over many
+cycles agrees (tests).  G̃ = r²·A₂ + r·A₁ + A₀
 at the rate r (ω or v), so a new speed costs one inverse FFT: the separation speed is scanned on a
 geometric ladder of speeds and refined by root finding.
 """
