@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from enum import StrEnum
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -33,6 +33,7 @@ __all__ = [
     "DynamicsSummary",
     "DynamicsReport",
     "CheckReport",
+    "JsonPart",
     "CURVATURE_CODES",
     "JUMP_CODES",
     "FORCE_CODES",
@@ -92,6 +93,9 @@ class IssueCode(StrEnum):
     CONTACT_FORCE_BELOW_SAFETY = "CONTACT_FORCE_BELOW_SAFETY"
     SELF_LOCKING = "SELF_LOCKING"
     LOAD_REVERSAL = "LOAD_REVERSAL"
+    # follower vibration (the elastic follower train, [vibration])
+    FOLLOWER_SEPARATES_VIBRATION = "FOLLOWER_SEPARATES_VIBRATION"
+    VIBRATION_RESONANCE = "VIBRATION_RESONANCE"
     # G-code verification
     PARSE_WARNING = "PARSE_WARNING"
     NO_CUTTING_MOVES = "NO_CUTTING_MOVES"
@@ -453,6 +457,13 @@ class DynamicsReport:
 
 # ---------------------------------------------------------------------------
 # the check report
+class JsonPart(Protocol):
+    """A summary kept outside this module that writes its own part of ``check --json``."""
+
+    def to_dict(self) -> dict[str, Any]: ...
+
+
+
 @dataclass(frozen=True)
 class CheckReport:
     """The profile checks of a cam (the ``camfab check`` report): findings, verdict, conclusions.
@@ -476,6 +487,8 @@ class CheckReport:
         With a ``[dynamics]`` section.
     initial_arm_angle_deg : float or None
         Oscillating followers.
+    vibration : JsonPart or None
+        With a ``[vibration]`` section: a :class:`camfab.design.vibration_results.VibrationSummary`.
     """
 
     name: str
@@ -490,6 +503,7 @@ class CheckReport:
     area_mm2: float | None = None
     dynamics: DynamicsSummary | None = None
     initial_arm_angle_deg: float | None = None
+    vibration: JsonPart | None = None
 
     @property
     def verdict(self) -> Verdict:
@@ -518,4 +532,5 @@ class CheckReport:
                     "max_radius_mm": _plain(self.max_radius_mm), "area_mm2": _plain(self.area_mm2),
                     "dynamics": part(self.dynamics), "initial_arm_angle_deg": _plain(self.initial_arm_angle_deg),
                     "x_unit": self.x_unit, "findings": [f.to_dict() for f in self.findings]})
+        out["vibration"] = part(self.vibration)
         return out

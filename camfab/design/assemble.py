@@ -15,9 +15,12 @@ from .dynamics import ContactDynamics, Loads, PairDynamics, analyse_dynamics, pa
 from .mechanisms import geometry_from_spec, mechanism_from_spec
 from .profile import CamGeometry
 from .spec import DesignSpec, DynamicsSpec
+from .vibration import analyse_vibration
+from .vibration_results import VibrationReport
+from .vibration_spec import train_of
 
 __all__ = ["mechanism_from_spec", "geometry_from_spec", "check_design", "knot_findings", "loads_from_spec",
-           "dynamics_of", "dynamics_model", "is_form_closed"]
+           "dynamics_of", "dynamics_model", "is_form_closed", "vibration_of"]
 
 
 def check_design(spec: DesignSpec, *, tool_radius_mm: float | None = None) -> CheckReport:
@@ -33,6 +36,10 @@ def check_design(spec: DesignSpec, *, tool_radius_mm: float | None = None) -> Ch
         dyn = dynamics_of(spec, geom)
         report = dataclasses.replace(report, dynamics=dyn.summary)
         extra = list(dyn.findings) + extra
+    if spec.vibration is not None and spec.dynamics is not None:
+        vib = vibration_of(spec, geom)
+        report = dataclasses.replace(report, vibration=vib.summary)
+        extra = extra + list(vib.findings)
     if extra:
         report = dataclasses.replace(report, findings=report.findings + tuple(extra))
     return report
@@ -81,3 +88,13 @@ def knot_findings(spec: DesignSpec) -> list[Finding]:
     if spec.knot_table is None:
         return []
     return list(spec.knot_table.warnings())
+
+
+def vibration_of(spec: DesignSpec, geometry: CamGeometry | None = None) -> VibrationReport:
+    """The follower vibration of a design with ``[dynamics]`` and ``[vibration]`` sections."""
+    if spec.vibration is None or spec.dynamics is None:
+        raise InputError(f"{spec.name} has no [vibration] (and [dynamics]) section: add one (the train's stiffness "
+                         "and damping ratio) to analyse the follower's vibration")
+    geom = geometry if geometry is not None else geometry_from_spec(spec)
+    return analyse_vibration(geom.profiles[0], loads_from_spec(spec.dynamics), train_of(spec.vibration), spec.speed,
+                             harmonics=spec.vibration.harmonics)

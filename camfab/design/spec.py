@@ -38,6 +38,7 @@ from .shop import (
     outputs_section,
 )
 from .validator import Validator
+from .vibration_spec import VibrationSpec, vibration_section
 
 __all__ = [
     "CamSpec",
@@ -57,7 +58,8 @@ __all__ = [
 
 
 _TOP_KEYS = ("name", "description", "cam", "follower", "motion", "motion_table", "manufacturing", "machining",
-             "outputs", "checks", "dynamics", "assembly", "drawing")
+             "outputs", "checks", "dynamics", "assembly", "drawing",
+             "vibration")
 _CAM_KEYS = ("kind", "rotation", "direction", "speed_rpm", "omega_rad_s", "speed_mm_s")
 _FOLLOWER_FLOATS = ("base_radius_mm", "roller_radius_mm", "offset_mm", "pivot_distance_mm",
                     "arm_length_mm", "face_offset_mm", "follower_distance_mm",
@@ -184,6 +186,7 @@ class DesignSpec:
     machining: MachiningSpec = field(default_factory=MachiningSpec)
     assembly: AssemblySpec = field(default_factory=AssemblySpec)
     drawing: DrawingSpec = field(default_factory=DrawingSpec)
+    vibration: VibrationSpec | None = None
 
     @property
     def is_translating_cam(self) -> bool:
@@ -317,7 +320,8 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
     dyn = _dynamics(v, data, cam, fol)
     return DesignSpec(name.strip(), cam, fol, motion, table, mfg, out, pressure_angle_limit_deg=pa,
                       description=str(data.get("description", "")), source=source, face_margin_mm=margin,
-                      dynamics=dyn, machining=machining, assembly=assembly, drawing=drawing)
+                      dynamics=dyn, machining=machining, assembly=assembly, drawing=drawing,
+                      vibration=vibration_section(v, data, cam.kind, fol.motion))
 
 
 def _depth_levels(v: Validator, mfg: ManufacturingSpec, machining: MachiningSpec) -> None:

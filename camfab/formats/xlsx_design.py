@@ -369,6 +369,10 @@ def design_rows(spec: DesignSpec) -> tuple[list[tuple[str, Any]], list[dict[str,
     kv.append(("checks.face_margin_mm", _num(spec.face_margin_mm)))
     if spec.dynamics is not None:
         kv += [(f"dynamics.{k}", _num(v)) for k, v in dynamics_items(spec.dynamics)]
+    if spec.vibration is not None:
+        vib = spec.vibration
+        kv += [(f"vibration.{vib.stiffness_key}", _num(vib.stiffness)), ("vibration.damping_ratio",
+               _num(vib.damping_ratio)), ("vibration.harmonics", vib.harmonics)]
     segs = None if spec.motion is None else _segment_rows(spec)
     knots = None
     if spec.motion_table is not None:

@@ -11,6 +11,7 @@ import numpy as np
 
 from ..results import FORCE_CODES, IssueCode, Verdict
 from ..textsafe import plain
+from .vibration_plot import vibration_lines
 
 __all__ = ["motion_csv", "segment_rows", "format_motion", "format_check", "VERDICT_TEXT"]
 
@@ -82,6 +83,7 @@ def format_check(spec, report) -> str:
         out.append(f"spring preload for the safety force: {pre.value:.6g} {pre.unit} (worst at {pre.at:.2f})")
         out.append("jump speed: " + ("none (the follower never leaves the cam)" if jump.value is None else
                                      f"{jump.value:.6g} {jump.unit} (first at {jump.at:.2f})"))
+    out += vibration_lines(report)
     if report.findings:
         out += ["", "Findings:"]
         out += [f"  [{f.severity}] {f.code}: {f.message}" for f in report.findings]
