@@ -92,6 +92,8 @@ class IssueCode(StrEnum):
     CONTACT_FORCE_BELOW_SAFETY = "CONTACT_FORCE_BELOW_SAFETY"
     SELF_LOCKING = "SELF_LOCKING"
     LOAD_REVERSAL = "LOAD_REVERSAL"
+    # contact stress (Hertz)
+    CONTACT_STRESS_ABOVE_LIMIT = "CONTACT_STRESS_ABOVE_LIMIT"
     # G-code verification
     PARSE_WARNING = "PARSE_WARNING"
     NO_CUTTING_MOVES = "NO_CUTTING_MOVES"
@@ -476,6 +478,8 @@ class CheckReport:
         With a ``[dynamics]`` section.
     initial_arm_angle_deg : float or None
         Oscillating followers.
+    contact_stress : camfab.design.strength.ContactStressSummary or None
+        With a ``[dynamics]`` or ``[strength]`` section (its ``to_dict`` is the ``contact_stress`` object).
     """
 
     name: str
@@ -490,6 +494,7 @@ class CheckReport:
     area_mm2: float | None = None
     dynamics: DynamicsSummary | None = None
     initial_arm_angle_deg: float | None = None
+    contact_stress: Any = None
 
     @property
     def verdict(self) -> Verdict:
@@ -518,4 +523,5 @@ class CheckReport:
                     "max_radius_mm": _plain(self.max_radius_mm), "area_mm2": _plain(self.area_mm2),
                     "dynamics": part(self.dynamics), "initial_arm_angle_deg": _plain(self.initial_arm_angle_deg),
                     "x_unit": self.x_unit, "findings": [f.to_dict() for f in self.findings]})
+        out["contact_stress"] = part(self.contact_stress)
         return out

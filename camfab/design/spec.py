@@ -37,6 +37,7 @@ from .shop import (
     manufacturing_section,
     outputs_section,
 )
+from .strength_spec import StrengthSpec, strength_section
 from .validator import Validator
 
 __all__ = [
@@ -57,7 +58,7 @@ __all__ = [
 
 
 _TOP_KEYS = ("name", "description", "cam", "follower", "motion", "motion_table", "manufacturing", "machining",
-             "outputs", "checks", "dynamics", "assembly", "drawing")
+             "outputs", "checks", "dynamics", "assembly", "drawing", "strength", "materials")
 _CAM_KEYS = ("kind", "rotation", "direction", "speed_rpm", "omega_rad_s", "speed_mm_s")
 _FOLLOWER_FLOATS = ("base_radius_mm", "roller_radius_mm", "offset_mm", "pivot_distance_mm",
                     "arm_length_mm", "face_offset_mm", "follower_distance_mm",
@@ -184,6 +185,9 @@ class DesignSpec:
     machining: MachiningSpec = field(default_factory=MachiningSpec)
     assembly: AssemblySpec = field(default_factory=AssemblySpec)
     drawing: DrawingSpec = field(default_factory=DrawingSpec)
+    #: ``[strength]`` / ``[materials.*]`` resolved (``camfab.design.strength_spec``); None when the contact-stress
+    #: check does not apply (no ``[dynamics]``, no ``[strength]``)
+    strength: StrengthSpec | None = None
 
     @property
     def is_translating_cam(self) -> bool:
@@ -315,9 +319,11 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
     pa = v.number(checks, "pressure_angle_limit_deg", "checks", None, lo=0.0, hi=90.0, lo_open=True, hi_open=True)
     margin = v.number(checks, "face_margin_mm", "checks", 0.0, lo=0.0, hi=1e4)
     dyn = _dynamics(v, data, cam, fol)
+    strength = strength_section(v, data, thickness_mm=mfg.thickness_mm, manufacturing_material=mfg.material,
+                                assembly_roller_width_mm=assembly.roller_width_mm, applies="dynamics" in data)
     return DesignSpec(name.strip(), cam, fol, motion, table, mfg, out, pressure_angle_limit_deg=pa,
                       description=str(data.get("description", "")), source=source, face_margin_mm=margin,
-                      dynamics=dyn, machining=machining, assembly=assembly, drawing=drawing)
+                      dynamics=dyn, machining=machining, assembly=assembly, drawing=drawing, strength=strength)
 
 
 def _depth_levels(v: Validator, mfg: ManufacturingSpec, machining: MachiningSpec) -> None:
