@@ -36,7 +36,8 @@ def main() -> None:
     e = effective_modulus(cam.e_mpa, cam.poisson, roller.e_mpa, roller.poisson)
     cams = (("translating roller", CamGeometry(TranslatingRoller(40.0, 8.0, 5.0), prog),
              Loads(0.3, 20000.0, 400.0, damping=20.0)),
-            ("oscillating roller", CamGeometry(OscillatingRoller(50.0, 8.0, 120.0, 90.0), osc), Loads(0.02, 30.0, 20.0)),
+            ("oscillating roller", CamGeometry(OscillatingRoller(50.0, 8.0, 120.0, 90.0), osc),
+             Loads(0.02, 30.0, 20.0)),
             ("translating flat", CamGeometry(TranslatingFlat(80.0), prog), Loads(0.3, 20000.0, 400.0, damping=20.0)),
             ("conjugate roller pair", ConjugateTranslatingRoller(40.0, 8.0, 110.0).geometry(prog),
              Loads(0.3, damping=20.0)))

@@ -50,7 +50,7 @@ import numpy as np
 from .. import numeric
 from ..errors import InputError
 from ..results import Finding, IssueCode, Severity
-from .dynamics import ContactDynamics, PairDynamics
+from .dynamics import ContactDynamics, DynamicsSample, PairDynamics
 from .kinds import ContactKind
 from .materials import Material
 from .profile import CamGeometry, Contact
@@ -160,7 +160,11 @@ class StressModel:
         self.radius_2 = follower_radius(dynamics.second.contact) if isinstance(dynamics, PairDynamics) else None
 
     def evaluate(self, x) -> StressSample:
-        sm = self.dynamics.evaluate(x)
+        """The stress at parameters x (radians, or mm of travel)."""
+        return self.of_sample(self.dynamics.evaluate(x))
+
+    def of_sample(self, sm: DynamicsSample) -> StressSample:
+        """The stress from a force sample of :attr:`dynamics` (no second evaluation)."""
         p, _ = hertz_line(sm.contact_force, self.e_star, self.width, relative_curvature(sm.curvature, self.radius))
         if not self.pair:
             return StressSample(sm.phi, p, sm.contact_force)

@@ -288,3 +288,36 @@ def test_form_closed_roller_life_covers_both_rollers():
     top = max(dyn.contact_force.max, dyn.second_contact_force.max)
     assert 0 < r.equivalent_load_n < top
     assert r.l10_million_revolutions == pytest.approx((5000.0 / r.equivalent_load_n) ** (10 / 3), rel=1e-12)
+
+
+def test_stress_in_the_workbook_and_the_report_figure():
+    """The xlsx (read back with openpyxl): the Dynamics sheet's stress column is the stress at its angles, and the
+    Checks summary carries the exact peak; the report figure draws the allowable line and the curve below the peak."""
+    import io
+
+    import openpyxl
+
+    from camfab.formats.camdas_workbook import camdas_workbook
+    from camfab.report.plots import report_figures
+
+    spec = design_from_dict(_design("press_feed_oscillating", strength={"roller_dynamic_rating_n": 8000.0}))
+    geom = geometry_from_spec(spec)
+    rep = check_design(spec)
+    wb = openpyxl.load_workbook(io.BytesIO(camdas_workbook(spec, geom, rep)))
+    ws = wb["Dynamics"]
+    head = [c.value for c in ws[1]]
+    col = head.index("Contact stress (MPa)")
+    rows = [[c.value for c in r] for r in ws.iter_rows(min_row=2)]
+    angle = np.radians([r[0] for r in rows])
+    inp = strength_input(spec, geom)
+    e = effective_modulus(inp.cam.e_mpa, inp.cam.poisson, inp.follower.e_mpa, inp.follower.poisson)
+    np.testing.assert_allclose([r[col] for r in rows], StressModel(inp.dynamics, e, 14.0).evaluate(angle).stress,
+                               rtol=1e-12)
+    summary = {r[0].value: r[1].value for r in wb["Checks"].iter_rows() if r[0].value}
+    assert summary["Maximum contact stress"] == pytest.approx(rep.contact_stress.max_mpa, rel=1e-12)
+    assert summary["Roller life L10"] == pytest.approx(rep.contact_stress.roller_life.hours, rel=1e-12)
+    fig = report_figures(spec, geom, rep)["contact_stress"]
+    ax = fig.axes[0]
+    curve, allow = ax.lines[0], ax.lines[1]
+    assert set(allow.get_ydata()) == {1150.0}
+    assert max(curve.get_ydata()) <= rep.contact_stress.max_mpa * (1 + 1e-12)
