@@ -197,6 +197,10 @@ def _highlights(spec, report) -> list[str]:
         cf = dyn.contact_force
         out.append(f"Smallest contact force {fmt(cf.min)} N at {fmt_at(cf.at_min, xu.strip())} "
                    f"(safety force {dyn.safety_force_n:g} N)")
+    cs = report.contact_stress
+    if cs is not None and cs.max_mpa is not None:
+        out.append(f"Largest contact stress {fmt(cs.max_mpa)} MPa at {fmt_at(cs.at, xu.strip())} (allowable "
+                   f"{cs.allowable_mpa:g} MPa, safety factor {cs.safety_factor:.3g})")
     return out
 
 

@@ -213,10 +213,11 @@ def test_check_json_contact_stress(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["contact_stress"] is None
 
 
-def test_form_closed_cams_on_both_followers():
-    """A constant-width cam with [dynamics]: each follower's stress, follower 2 half a turn on; the peak is the
-    larger of the two."""
-    data = _design("constant_width", dynamics={"mass_kg": 0.4})
+@pytest.mark.parametrize("name, cam", [("constant_width", {}), ("ejemplo8da_conjugate", {"omega_rad_s": 30.0})])
+def test_form_closed_cams_on_both_followers(name, cam):
+    """Form-closed cams with [dynamics] — a constant-width cam (one profile, follower 2 half a turn on) and a
+    conjugate pair (two profiles): each follower's stress; the peak is the larger of the two, both exact."""
+    data = _design(name, dynamics={"mass_kg": 0.4}, cam=cam)
     spec = design_from_dict(data)
     cs = check_design(spec).contact_stress
     assert cs.second is not None and cs.max_mpa == pytest.approx(max(cs.max_mpa, cs.second[0]))
@@ -236,6 +237,13 @@ def test_knife_edge_is_refused_with_its_reason():
     inp = StrengthInput(ContactDynamics(g.profiles[0], Loads(0.5, 5000.0, 50.0), W), STEEL, STEEL, 10.0, 1150.0)
     with pytest.raises(InputError, match="knife-edge"):
         analyse_strength(g, inp)
+    # in `check` a knife edge is stated, not checked: no number, no finding, the reason in the notes
+    data = _design("ejemplo9rt", dynamics={"mass_kg": 0.5, "spring_rate_n_per_mm": 5.0, "spring_preload_n": 100.0})
+    data["follower"] = {k: v for k, v in data["follower"].items() if k != "roller_radius_mm"} | {"type": "knife"}
+    rep = check_design(design_from_dict(data))
+    cs = rep.contact_stress
+    assert cs.max_mpa is None and cs.safety_factor is None and not rep.by_code("CONTACT_STRESS_ABOVE_LIMIT")
+    assert any("knife-edge" in n and "infinite" in n for n in cs.notes)
 
 
 def test_unknown_material_is_exit_2(tmp_path, capsys):
