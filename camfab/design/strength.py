@@ -294,8 +294,8 @@ def analyse_strength(geometry: CamGeometry, inp: StrengthInput) -> tuple[Contact
                      for j, rs in enumerate(ranges) for lo, hi, xw, gw in rs)
     second = peaks[1] if pair is not None else None
     if infinite_at is not None:
-        notes.append(f"the contact stress is infinite at {infinite_at:.6g} {c.axis.x_unit} (a cusp, or a flat face on "
-                     "a concave stretch): see the curvature findings")
+        notes.append(f"the contact stress is infinite at {infinite_at:.6g} {c.axis.x_unit} (a cusp or a flat face on "
+                     "a concave stretch: see the curvature findings; or an infinite force: a self-locking follower)")
         return ContactStressSummary(None, infinite_at, lim, 0.0, inp.cam.name, inp.follower.name, inp.width_mm,
                                     follower, second, None, None, tuple(notes)), findings
     cycle_s = (2 * math.pi if c.closed else c.period) / inp.dynamics.speed
