@@ -33,7 +33,7 @@ from .materials import (
 )
 from .validator import Validator
 
-__all__ = ["StrengthSpec", "strength_section", "STRENGTH_KEYS", "MATERIAL_KEYS"]
+__all__ = ["StrengthSpec", "strength_section", "strength_rows", "STRENGTH_KEYS", "MATERIAL_KEYS"]
 
 STRENGTH_KEYS = ("cam_material", "follower_material", "roller_width_mm", "allowable_contact_stress_mpa",
                  "roller_dynamic_rating_n", "roller_bearing")
@@ -56,9 +56,20 @@ class StrengthSpec:
     ball_bearing: bool = False
     notes: tuple[str, ...] = ()
     materials: Mapping[str, Material] = field(default_factory=dict)
+    #: the ``[strength]`` keys as written (valid ones), and each ``[materials.NAME]`` table's: what
+    #: :func:`strength_rows` writes back
+    given: tuple[tuple[str, Any], ...] = ()
+    own_tables: tuple[tuple[str, tuple[tuple[str, float], ...]], ...] = ()
 
 
-def _own_materials(v: Validator, data: Mapping[str, Any]) -> dict[str, Material]:
+def strength_rows(st: StrengthSpec) -> list[tuple[str, Any]]:
+    """``strength.*`` and ``materials.NAME.*`` key/value rows of the tables as written (a design file writer's)."""
+    rows = [(f"strength.{k}", v) for k, v in st.given]
+    return rows + [(f"materials.{name}.{k}", v) for name, values in st.own_tables for k, v in values]
+
+
+def _own_materials(v: Validator, data: Mapping[str, Any],
+                   tables: list[tuple[str, tuple[tuple[str, float], ...]]]) -> dict[str, Material]:
     out: dict[str, Material] = {}
     t = v.table(data, "materials")
     for name, row in t.items():
@@ -76,6 +87,7 @@ def _own_materials(v: Validator, data: Mapping[str, Any]) -> dict[str, Material]
                 vals[key] = x
         if all(k in vals for k, (req, *_) in MATERIAL_KEYS.items() if req):
             out[str(name)] = material_from_table(str(name), vals)
+            tables.append((str(name), tuple(vals.items())))
     return out
 
 
@@ -96,7 +108,8 @@ def strength_section(v: Validator, data: Mapping[str, Any], *, thickness_mm: flo
                      assembly_roller_width_mm: float | None, applies: bool) -> StrengthSpec | None:
     """``[strength]`` and ``[materials.*]`` read into a :class:`StrengthSpec`; None when the check does not
     apply (no ``[dynamics]`` and no ``[strength]``).  Problems go to ``v``."""
-    own = _own_materials(v, data)
+    tables: list[tuple[str, tuple[tuple[str, float], ...]]] = []
+    own = _own_materials(v, data, tables)
     t = v.table(data, "strength")
     v.keys(t, STRENGTH_KEYS, "strength")
     if not (applies or "strength" in data):
@@ -132,4 +145,5 @@ def strength_section(v: Validator, data: Mapping[str, Any], *, thickness_mm: flo
         return None
     if allow is None:
         allow = min(cam.allowable_mpa, fol.allowable_mpa)
-    return StrengthSpec(cam, fol, width, allow, rating, bearing == "ball", tuple(notes), own)
+    given = tuple((k, t[k]) for k in STRENGTH_KEYS if k in t)
+    return StrengthSpec(cam, fol, width, allow, rating, bearing == "ball", tuple(notes), own, given, tuple(tables))

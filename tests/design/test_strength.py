@@ -329,3 +329,19 @@ def test_stress_in_the_workbook_and_the_report_figure():
     curve, allow = ax.lines[0], ax.lines[1]
     assert set(allow.get_ydata()) == {1150.0}
     assert max(curve.get_ydata()) <= rep.contact_stress.max_mpa * (1 + 1e-12)
+
+
+def test_strength_tables_survive_the_xlsx_design_round_trip(tmp_path):
+    """[strength] and [materials.NAME] written to an xlsx design and read back give the same strength inputs."""
+    from camfab.formats.xlsx_design import design_to_xlsx, load_design_xlsx
+
+    data = _design("press_feed_oscillating", manufacturing={"material": "MyIron"},
+                   strength={"follower_material": "42CrMo4", "roller_width_mm": 12, "roller_dynamic_rating_n": 8000.0,
+                             "roller_bearing": "ball"},
+                   materials={"MyIron": {"youngs_modulus_mpa": 120e3, "poisson_ratio": 0.26,
+                                         "allowable_contact_stress_mpa": 420.0, "contact_fatigue_limit_mpa": 400.0}})
+    spec = design_from_dict(data)
+    assert spec.strength.cam.name == "MyIron" and spec.strength.width_mm == 12 and spec.strength.ball_bearing
+    p = tmp_path / "d.xlsx"
+    p.write_bytes(design_to_xlsx(spec))
+    assert load_design_xlsx(p).strength == spec.strength
