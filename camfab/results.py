@@ -96,6 +96,8 @@ class IssueCode(StrEnum):
     # follower vibration (the elastic follower train, [vibration])
     FOLLOWER_SEPARATES_VIBRATION = "FOLLOWER_SEPARATES_VIBRATION"
     VIBRATION_RESONANCE = "VIBRATION_RESONANCE"
+    # contact stress (Hertz)
+    CONTACT_STRESS_ABOVE_LIMIT = "CONTACT_STRESS_ABOVE_LIMIT"
     # G-code verification
     PARSE_WARNING = "PARSE_WARNING"
     NO_CUTTING_MOVES = "NO_CUTTING_MOVES"
@@ -489,6 +491,8 @@ class CheckReport:
         Oscillating followers.
     vibration : JsonPart or None
         With a ``[vibration]`` section: a :class:`camfab.design.vibration_results.VibrationSummary`.
+    contact_stress : camfab.design.strength.ContactStressSummary or None
+        With a ``[dynamics]`` or ``[strength]`` section (its ``to_dict`` is the ``contact_stress`` object).
     """
 
     name: str
@@ -504,6 +508,7 @@ class CheckReport:
     dynamics: DynamicsSummary | None = None
     initial_arm_angle_deg: float | None = None
     vibration: JsonPart | None = None
+    contact_stress: JsonPart | None = None
 
     @property
     def verdict(self) -> Verdict:
@@ -533,4 +538,5 @@ class CheckReport:
                     "dynamics": part(self.dynamics), "initial_arm_angle_deg": _plain(self.initial_arm_angle_deg),
                     "x_unit": self.x_unit, "findings": [f.to_dict() for f in self.findings]})
         out["vibration"] = part(self.vibration)
+        out["contact_stress"] = part(self.contact_stress)
         return out

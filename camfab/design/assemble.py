@@ -15,12 +15,13 @@ from .dynamics import ContactDynamics, Loads, PairDynamics, analyse_dynamics, pa
 from .mechanisms import geometry_from_spec, mechanism_from_spec
 from .profile import CamGeometry
 from .spec import DesignSpec, DynamicsSpec
+from .strength import BALL, ROLLER, StrengthInput
 from .vibration import analyse_vibration
 from .vibration_results import VibrationReport
 from .vibration_spec import train_of
 
 __all__ = ["mechanism_from_spec", "geometry_from_spec", "check_design", "knot_findings", "loads_from_spec",
-           "dynamics_of", "dynamics_model", "is_form_closed", "vibration_of"]
+           "dynamics_of", "dynamics_model", "is_form_closed", "vibration_of", "strength_input"]
 
 
 def check_design(spec: DesignSpec, *, tool_radius_mm: float | None = None) -> CheckReport:
@@ -30,7 +31,7 @@ def check_design(spec: DesignSpec, *, tool_radius_mm: float | None = None) -> Ch
     report = check(geom, pressure_angle_limit_deg=spec.pressure_angle_limit_deg,
                    allow_acceleration_jump=spec.cam.kind in ("constant_width", "constant_diameter"),
                    tool_radius_mm=tool_radius_mm, face_margin_mm=spec.face_margin_mm,
-                   name=spec.name, speed=spec.speed)
+                   name=spec.name, speed=spec.speed, strength=strength_input(spec, geom))
     extra = knot_findings(spec)
     if spec.dynamics is not None:
         dyn = dynamics_of(spec, geom)
@@ -81,6 +82,17 @@ def dynamics_of(spec: DesignSpec, geometry: CamGeometry | None = None) -> Dynami
     return analyse_dynamics(geom, loads_from_spec(spec.dynamics), spec.speed,
                             preload_unit=spec.dynamics.preload_unit,
                             form_closed=is_form_closed(spec))
+
+
+def strength_input(spec: DesignSpec, geometry: CamGeometry) -> StrengthInput | None:
+    """The contact-stress inputs of a design (None when the check does not apply: no ``[dynamics]``, no
+    ``[strength]``); the force model None without ``[dynamics]``."""
+    st = spec.strength
+    if st is None:
+        return None
+    dyn = dynamics_model(spec, geometry) if spec.dynamics is not None else None
+    return StrengthInput(dyn, st.cam, st.follower, st.width_mm, st.allowable_mpa, st.dynamic_rating_n,
+                         BALL if st.ball_bearing else ROLLER, st.notes)
 
 
 def knot_findings(spec: DesignSpec) -> list[Finding]:

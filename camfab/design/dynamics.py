@@ -112,6 +112,8 @@ class DynamicsSample:
     power: np.ndarray           # drive power (W)
     motion: np.ndarray | None = None           # S, S′, S″ at phi (3, n): lift unit per unit of phi
     contact_force_2: np.ndarray | None = None  # form-closed followers: follower 2's contact force (N)
+    curvature: np.ndarray | None = None        # the profile's signed curvature at the contact (1/mm)
+    curvature_2: np.ndarray | None = None      # form-closed followers: at follower 2's contact (1/mm)
 
 
 class ContactDynamics:
@@ -209,7 +211,7 @@ class ContactDynamics:
         G = self.required(S)
         with np.errstate(divide="ignore", invalid="ignore"):  # D = 0: wedged (N infinite), see SELF_LOCKING
             N = G / D
-        return DynamicsSample(x, G, D, N, *self._transmit(N, s, vhat, u), S)
+        return DynamicsSample(x, G, D, N, *self._transmit(N, s, vhat, u), S, curvature=s.curvature)
 
     # ---- design helpers (from a sample: no second evaluation) --------------------------
     def jump_speed(self, s: DynamicsSample) -> np.ndarray:
@@ -271,7 +273,8 @@ class PairDynamics:
         f1, b1, d1, p1 = self.first._transmit(N1, s1, v1, u1)
         f2, b2, d2, p2 = self.second._transmit(N2, s2, v2, u2)
         # one of N₁, N₂ is 0 at every angle: the bearing carries the other's force
-        return DynamicsSample(x, G, np.where(G < 0, D2, D1), N1, f1 + f2, b1 + b2, d1 + d2, p1 + p2, S, N2)
+        return DynamicsSample(x, G, np.where(G < 0, D2, D1), N1, f1 + f2, b1 + b2, d1 + d2, p1 + p2, S, N2,
+                              s1.curvature, s2.curvature)
 
 
 def pair_of(geometry: CamGeometry, loads: Loads, speed: float) -> PairDynamics:

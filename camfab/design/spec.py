@@ -37,6 +37,7 @@ from .shop import (
     manufacturing_section,
     outputs_section,
 )
+from .strength_spec import StrengthSpec, strength_section
 from .validator import Validator
 from .vibration_spec import VibrationSpec, vibration_section
 
@@ -59,7 +60,7 @@ __all__ = [
 
 _TOP_KEYS = ("name", "description", "cam", "follower", "motion", "motion_table", "manufacturing", "machining",
              "outputs", "checks", "dynamics", "assembly", "drawing",
-             "vibration")
+             "vibration", "strength", "materials")
 _CAM_KEYS = ("kind", "rotation", "direction", "speed_rpm", "omega_rad_s", "speed_mm_s")
 _FOLLOWER_FLOATS = ("base_radius_mm", "roller_radius_mm", "offset_mm", "pivot_distance_mm",
                     "arm_length_mm", "face_offset_mm", "follower_distance_mm",
@@ -187,6 +188,9 @@ class DesignSpec:
     assembly: AssemblySpec = field(default_factory=AssemblySpec)
     drawing: DrawingSpec = field(default_factory=DrawingSpec)
     vibration: VibrationSpec | None = None
+    #: ``[strength]`` / ``[materials.*]`` resolved (``camfab.design.strength_spec``); None when the contact-stress
+    #: check does not apply (no ``[dynamics]``, no ``[strength]``)
+    strength: StrengthSpec | None = None
 
     @property
     def is_translating_cam(self) -> bool:
@@ -318,9 +322,11 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
     pa = v.number(checks, "pressure_angle_limit_deg", "checks", None, lo=0.0, hi=90.0, lo_open=True, hi_open=True)
     margin = v.number(checks, "face_margin_mm", "checks", 0.0, lo=0.0, hi=1e4)
     dyn = _dynamics(v, data, cam, fol)
+    strength = strength_section(v, data, thickness_mm=mfg.thickness_mm, manufacturing_material=mfg.material,
+                                assembly_roller_width_mm=assembly.roller_width_mm, applies="dynamics" in data)
     return DesignSpec(name.strip(), cam, fol, motion, table, mfg, out, pressure_angle_limit_deg=pa,
                       description=str(data.get("description", "")), source=source, face_margin_mm=margin,
-                      dynamics=dyn, machining=machining, assembly=assembly, drawing=drawing,
+                      dynamics=dyn, machining=machining, assembly=assembly, drawing=drawing, strength=strength,
                       vibration=vibration_section(v, data, cam.kind, fol.motion))
 
 

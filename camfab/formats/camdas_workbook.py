@@ -61,7 +61,8 @@ headings, then one row per angle of the CAM-DAS grid (0 … 360° inclusive at
 angle, contact force (N), friction force (N), bearing force (N), drive torque
 (N·m; drive force in N along the travel for a translating cam) and drive
 power (W) at the design speed (empty where infinite: a self-locking
-follower).  The dynamics summary (extremes, work per cycle, mean power,
+follower), then the Hertz contact stress (MPa) of each follower (not for a
+knife edge; ``camfab.design.strength``).  The dynamics summary (extremes, work per cycle, mean power,
 preload needed, jump speed) is in the ``Summary`` block of ``Checks``.
 
 The bytes are deterministic: the workbook properties carry a fixed date and
@@ -85,7 +86,8 @@ from ..results import JUMP_CODES, IssueCode, Severity, Verdict
 from ..textsafe import xlsx_no_formulas, xlsx_put, xlsx_text
 
 __all__ = ["CAMDAS_COLUMNS", "FIXED_DATE", "LiftTable", "camdas_workbook", "camdas_columns", "conclusions",
-           "dynamics_columns", "dynamics_summary_rows", "fixed_zip", "geometry_rows", "lift_table", "sample_params",
+           "dynamics_columns", "dynamics_summary_rows", "strength_summary_rows",
+           "fixed_zip", "geometry_rows", "lift_table", "sample_params",
            "type_text", "verdict_sentence"]
 
 #: the date written into the workbook properties (deterministic output)
@@ -255,7 +257,29 @@ def dynamics_columns(spec, geometry, *, step_deg: float = 1.0) -> tuple[list[str
             "Bearing force (N)", "Drive torque (N·m)" if geometry.closed else "Drive force (N)", "Power (W)"]
     cols = [geometry.to_user(x), sm.contact_force, *([sm.contact_force_2] if pair else []), sm.friction_force,
             sm.bearing_force, sm.drive, sm.power]
+    stress = _stress_columns(spec, geometry, sm)
+    head += [h for h, _ in stress]
+    cols += [c for _, c in stress]
     return head, [np.where(np.isfinite(c), c, np.nan) for c in cols]
+
+
+def _stress_columns(spec, geometry, sm) -> list[tuple[str, np.ndarray]]:
+    """The Hertz contact stress (MPa) of each follower from the force sample ``sm`` (none for a knife edge)."""
+    from ..design.assemble import strength_input
+    from ..design.strength import StressModel, effective_modulus
+
+    inp = strength_input(spec, geometry)
+    if inp is None or inp.dynamics is None:
+        return []
+    try:
+        model = StressModel(inp.dynamics, effective_modulus(inp.cam.e_mpa, inp.cam.poisson, inp.follower.e_mpa,
+                                                            inp.follower.poisson), inp.width_mm)
+    except InputError:  # a knife edge: no finite contact stress
+        return []
+    st = model.of_sample(sm)
+    if st.stress_2 is None:
+        return [("Contact stress (MPa)", st.stress)]
+    return [("Contact stress, follower 1 (MPa)", st.stress), ("Contact stress, follower 2 (MPa)", st.stress_2)]
 
 
 def dynamics_summary_rows(report) -> list[tuple[str, Any, str, float | None]]:
@@ -284,6 +308,25 @@ def dynamics_summary_rows(report) -> list[tuple[str, Any, str, float | None]]:
             ("Work per cycle", d.work_per_cycle_j, "J", None), ("Mean power", d.mean_power_w, "W", None),
             ("Preload needed", pre.value, pre.unit, pre.at),
             ("Jump speed", js.value if js.value is not None else "never", js.unit, js.at)]
+
+
+def strength_summary_rows(report) -> list[tuple[str, Any, str, float | None]]:
+    """The contact-stress summary of ``report`` as ``(label, value, unit, at)`` rows ([] when not computed)."""
+    cs = report.contact_stress
+    if cs is None or cs.max_mpa is None:
+        return []
+    rows: list[tuple[str, Any, str, float | None]] = [
+        ("Maximum contact stress", cs.max_mpa, "MPa", cs.at),
+        ("Allowable contact stress", cs.allowable_mpa, "MPa", None),
+        ("Contact-stress safety factor", cs.safety_factor, "", None), ("Face width", cs.width_mm, "mm", None)]
+    if cs.roller_life is not None:
+        r = cs.roller_life
+        rows += [("Roller equivalent load (ISO 281)", r.equivalent_load_n, "N", None),
+                 ("Roller life L10", r.hours if r.hours is not None else "unlimited", "h", None)]
+    if cs.cam_life is not None:
+        rows.append(("Cam track life (estimate)", cs.cam_life.hours if cs.cam_life.hours is not None else "unlimited",
+                     "h", None))
+    return rows
 
 
 # ---------------------------------------------------------------------------
@@ -455,7 +498,7 @@ def _checks_sheet(ws, spec, report) -> None:
         if value is not None:
             row += 1
             ws.cell(row, 1, label), ws.cell(row, 2, _fmt(value)), ws.cell(row, 3, unit)
-    dyn = dynamics_summary_rows(report)
+    dyn = dynamics_summary_rows(report) + strength_summary_rows(report)
     if dyn:
         row += 2
         ws.cell(row, 1, "Dynamics").font = bold

@@ -62,7 +62,8 @@ __all__ = ["load_design_xlsx", "design_to_xlsx", "design_rows", "SEGMENT_COLUMNS
 
 SEGMENT_COLUMNS = ("law", "lift", "angle_deg", "length_mm", "shape")
 KNOT_COLUMNS = ("angle", "s", "v", "a", "j")
-_TEXT_KEYS = {"name", "description", "manufacturing.material", "motion_table.file"}
+_TEXT_KEYS = {"name", "description", "manufacturing.material", "motion_table.file", "strength.cam_material",
+              "strength.follower_material"}
 _FIX_FORMAT = ("save it as an .xlsx workbook with a 'design' sheet of key/value rows "
                "(see camfab.formats.xlsx_design), or use a TOML design file")
 
@@ -373,6 +374,9 @@ def design_rows(spec: DesignSpec) -> tuple[list[tuple[str, Any]], list[dict[str,
         vib = spec.vibration
         kv += [(f"vibration.{vib.stiffness_key}", _num(vib.stiffness)), ("vibration.damping_ratio",
                _num(vib.damping_ratio)), ("vibration.harmonics", vib.harmonics)]
+    if spec.strength is not None:
+        from ..design.strength_spec import strength_rows
+        kv += [(k, _num(v)) for k, v in strength_rows(spec.strength)]
     segs = None if spec.motion is None else _segment_rows(spec)
     knots = None
     if spec.motion_table is not None:

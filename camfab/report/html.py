@@ -60,6 +60,10 @@ PLOT_TEXT = {
                  "speed) against the safety force; red bands: the follower leaves the cam, orange: below the "
                  "safety force, purple: self-locking. Below: the drive torque (drive force of a translating "
                  "cam) that keeps the speed constant."),
+    "contact_stress": ("Contact stress",
+                       "Hertz line-contact stress between cam and follower from the contact force, the radii of "
+                       "curvature and the face width; the dashed line is the allowable contact stress of the "
+                       "materials, red bands the stretches above it."),
 }
 #: what changes in :data:`PLOT_TEXT` for a curved-face follower (its pitch curve is the path of the face's
 #: centre of curvature; its contact runs along the face)
@@ -193,6 +197,10 @@ def _highlights(spec, report) -> list[str]:
         cf = dyn.contact_force
         out.append(f"Smallest contact force {fmt(cf.min)} N at {fmt_at(cf.at_min, xu.strip())} "
                    f"(safety force {dyn.safety_force_n:g} N)")
+    cs = report.contact_stress
+    if cs is not None and cs.max_mpa is not None:
+        out.append(f"Largest contact stress {fmt(cs.max_mpa)} MPa at {fmt_at(cs.at, xu.strip())} (allowable "
+                   f"{cs.allowable_mpa:g} MPa, safety factor {cs.safety_factor:.3g})")
     return out
 
 

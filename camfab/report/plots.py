@@ -544,4 +544,8 @@ def report_figures(spec, geometry, report) -> dict[str, Any]:
         figs["face_position"] = face_position_figure(spec, geometry, report)
     if spec.dynamics is not None:
         figs["dynamics"] = dynamics_figure(spec, geometry, report)
+    cs = getattr(report, "contact_stress", None)
+    if spec.dynamics is not None and cs is not None and cs.max_mpa is not None:
+        from .strength_plot import contact_stress_figure
+        figs["contact_stress"] = contact_stress_figure(spec, geometry, report)
     return figs

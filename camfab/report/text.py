@@ -70,6 +70,11 @@ def format_check(spec, report) -> str:
     rows = _motion_rows(spec, report, codes) + _geometry_rows(report, codes)
     if report.dynamics is not None:
         rows += _dynamics_rows(report.dynamics, codes)
+    cs = report.contact_stress
+    if cs is not None and cs.max_mpa is not None:
+        rows.append(("Contact stress (MPa)", _num(cs.max_mpa), "--",
+                     ("above the allowable: see findings" if IssueCode.CONTACT_STRESS_ABOVE_LIMIT in codes else
+                      "within the allowable") + f" {cs.allowable_mpa:g} MPa, safety factor {cs.safety_factor:.3g}"))
     width = max(len(r[0]) for r in rows) + 2
     out = [f"{plain(spec.name)}: {VERDICT_TEXT[report.verdict]}", ""]  # no control characters to a terminal
     out.append(f"{'Concept':<{width}}{'Maximum':>13}{'Minimum':>13}  Comments")
@@ -84,10 +89,29 @@ def format_check(spec, report) -> str:
         out.append("jump speed: " + ("none (the follower never leaves the cam)" if jump.value is None else
                                      f"{jump.value:.6g} {jump.unit} (first at {jump.at:.2f})"))
     out += vibration_lines(report)
+    out += _strength_lines(cs)
     if report.findings:
         out += ["", "Findings:"]
         out += [f"  [{f.severity}] {f.code}: {f.message}" for f in report.findings]
     return "\n".join(out)
+
+
+def _strength_lines(cs) -> list[str]:
+    """Materials, roller life and cam-life estimate, and the notes of a ``contact_stress`` summary."""
+    if cs is None:
+        return []
+    out = []
+    if cs.cam_material is not None:
+        out.append(f"contact stress: {plain(cs.cam_material)} cam, {plain(str(cs.follower_material))} follower, "
+                   f"face width {cs.width_mm:g} mm")
+    life = cs.roller_life
+    if life is not None:
+        out.append("roller life L10 (ISO 281): " + ("unlimited" if life.hours is None else
+                   f"{life.hours:.4g} h, {life.cam_cycles:.4g} cam revolutions (equivalent load "
+                   f"{life.equivalent_load_n:.4g} N)"))
+    if cs.cam_life is not None and cs.cam_life.hours is not None:
+        out.append(f"cam track life (estimate): {cs.cam_life.hours:.4g} h, {cs.cam_life.cam_cycles:.4g} revolutions")
+    return out + [f"  note: {plain(n)}" for n in cs.notes]
 
 
 def _motion_rows(spec, report, codes) -> list[tuple[str, str, str, str]]:

@@ -228,7 +228,7 @@ def test_rules_run_in_registry_order_and_a_new_rule_is_one_entry(monkeypatch):
     from camfab.design.checks import RULES, Rule, RuleResult, Scope
     from camfab.results import Finding, Severity
 
-    assert [r.name for r in RULES] == ["continuity", "curvature", "pressure_angle", "face", "extent"]
+    assert [r.name for r in RULES] == ["continuity", "curvature", "pressure_angle", "face", "extent", "contact_stress"]
     seen = []
 
     def lift_rule(contact, limits, sample):

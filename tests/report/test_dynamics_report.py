@@ -80,7 +80,7 @@ def test_dynamics_figure_only_for_designs_with_dynamics(valve, e9):
 
     assert e9[0].dynamics is None and "dynamics" not in report_figures(*e9)
     figs = report_figures(*valve)
-    assert list(figs)[-1] == "dynamics"
+    assert list(figs)[-2:] == ["dynamics", "contact_stress"]  # the Hertz stress follows the forces
     spec, geom, rep = valve
     top, bottom = figs["dynamics"].axes
     # the contact-force curve is N of an independent evaluation on the plot grid
@@ -223,8 +223,8 @@ def test_xlsx_dynamics_sheet_values(valve):
     assert wb.sheetnames == ["CAM-DAS", "Checks", "Lift table", "Dynamics"]
     head, data = _sheet_columns(wb["Dynamics"])
     assert head == ("Cam angle (deg)", "Contact force (N)", "Friction force (N)", "Bearing force (N)",
-                    "Drive torque (N·m)", "Power (W)")
-    assert data.shape == (361, 6) and wb["Dynamics"].max_row == 362
+                    "Drive torque (N·m)", "Power (W)", "Contact stress (MPa)")
+    assert data.shape == (361, 7) and wb["Dynamics"].max_row == 362
     np.testing.assert_allclose(data[:, 0], np.arange(361.0), rtol=0, atol=1e-12)
     # the same grid as the CAM-DAS sheet
     camdas = [wb["CAM-DAS"][f"A{10 + i}"].value for i in range(361)]
@@ -261,7 +261,7 @@ def test_xlsx_dynamics_summary_in_the_checks_sheet(press_fast):
 def test_xlsx_oscillating_step_and_translating_cam(press, wedge):
     spec, geom, rep = press
     head, data = _sheet_columns(_book(spec, geom, rep, step_deg=2.0)["Dynamics"])
-    assert data.shape == (181, 6)
+    assert data.shape == (181, 7)
     np.testing.assert_allclose(data[:, 0], np.arange(0.0, 361.0, 2.0), rtol=0, atol=1e-12)
     ref = _dynamics(spec, geom).evaluate(np.radians(data[:, 0]))
     np.testing.assert_allclose(data[:, 1], ref.contact_force, rtol=1e-12)
@@ -271,7 +271,7 @@ def test_xlsx_oscillating_step_and_translating_cam(press, wedge):
     wb = _book(spec, geom, rep)
     head, data = _sheet_columns(wb["Dynamics"])
     assert head[0] == "Cam travel (mm)" and head[4] == "Drive force (N)"
-    assert data.shape == (361, 6)
+    assert data.shape == (361, 7)
     np.testing.assert_allclose(data[:, 0], np.arange(361) * 200.0 / 360, rtol=1e-15)
     idx = np.array([0, 45, 90, 180, 270, 360])
     ref = _dynamics(spec, geom).evaluate(data[idx, 0])

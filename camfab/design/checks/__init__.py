@@ -6,7 +6,8 @@ The checks are flat rules, registered in :data:`RULES` and run in that order by 
 * :func:`curvature_rule` — undercut, cusp, concave stretches tighter than the cutter;
 * :func:`pressure_angle_rule` — |δ| above its limit (rollers and knife edges);
 * :func:`face_rule` — the flat-face length needed;
-* :func:`extent_rule` — base and largest radius, area.
+* :func:`extent_rule` — base and largest radius, area;
+* :func:`contact_stress_rule` — Hertz contact stress above the allowable, roller and cam life (with forces).
 
 A rule of the whole cam is a function ``(geometry, limits, samples) -> RuleResult``; a rule of one
 contact is ``(contact, limits, sample) -> RuleResult`` and runs for every profile (consecutive
@@ -37,10 +38,11 @@ from .curvature import curvature_rule
 from .extent import extent_rule
 from .face import face_rule
 from .pressure import pressure_angle_rule
+from .strength import contact_stress_rule
 
 __all__ = ["check", "Limits", "RuleResult", "ContactSample", "Rule", "Scope", "RULES", "CUSP_TOL_MM",
            "DEFAULT_PRESSURE_LIMIT_DEG", "continuity_rule", "curvature_rule", "pressure_angle_rule", "face_rule",
-           "extent_rule"]
+           "extent_rule", "contact_stress_rule"]
 
 
 class Scope(StrEnum):
@@ -68,12 +70,13 @@ RULES: tuple[Rule, ...] = (
     Rule("pressure_angle", Scope.CONTACT, pressure_angle_rule),
     Rule("face", Scope.CONTACT, face_rule),
     Rule("extent", Scope.CAM, extent_rule),
+    Rule("contact_stress", Scope.CAM, contact_stress_rule),
 )
 
 
 def check(geometry: CamGeometry, *, pressure_angle_limit_deg: float | None = None,
           allow_acceleration_jump: bool = False, tool_radius_mm: float | None = None,
-          face_margin_mm: float = 0.0, name: str = "cam", speed: float = 1.0) -> CheckReport:
+          face_margin_mm: float = 0.0, name: str = "cam", speed: float = 1.0, strength: Any = None) -> CheckReport:
     """Verify a cam geometry: run every rule of :data:`RULES`.
 
     Parameters
@@ -91,12 +94,14 @@ def check(geometry: CamGeometry, *, pressure_angle_limit_deg: float | None = Non
         Cam name for the report.
     speed : float
         ω in rad/s (mm/s for a translating cam), for the motion peaks.
+    strength : camfab.design.strength.StrengthInput, optional
+        Contact-stress inputs: the ``contact_stress`` rule runs with them.
 
     Returns
     -------
     CheckReport
     """
-    limits = Limits(pressure_angle_limit_deg, tool_radius_mm, face_margin_mm, allow_acceleration_jump, speed)
+    limits = Limits(pressure_angle_limit_deg, tool_radius_mm, face_margin_mm, allow_acceleration_jump, speed, strength)
     samples = [ContactSample(c) for c in geometry.profiles]
     multi = len(samples) > 1
     findings: list = []

@@ -48,6 +48,8 @@ class Limits:
         Accept acceleration jumps (constant-width / constant-diameter cams).
     speed : float
         ω in rad/s (mm/s for a translating cam): the motion peaks are given in time units.
+    strength : camfab.design.strength.StrengthInput, optional
+        The contact-stress inputs (force model, materials, width); None: no contact-stress check.
     """
 
     pressure_angle_deg: float | None = None
@@ -55,6 +57,7 @@ class Limits:
     face_margin_mm: float = 0.0
     allow_acceleration_jump: bool = False
     speed: float = 1.0
+    strength: Any = None
 
 
 @dataclass(frozen=True)
