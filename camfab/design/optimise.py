@@ -442,7 +442,8 @@ def solve(prob: OptimisationProblem, weights: Mapping[str, float] | None = None)
         if opt.method == Method.DIFFERENTIAL_EVOLUTION:
             cons = NonlinearConstraint(g, 0.0, np.inf) if len(g(z0)) else ()
             res = differential_evolution(f, [(0.0, 1.0)] * n, seed=opt.seed, maxiter=opt.max_iterations,
-                                         constraints=cons, polish=False, init="sobol", x0=z0, tol=1e-6)
+                                         constraints=cons, polish=False, init="sobol", x0=z0, tol=1e-6,
+                                         popsize=6)
         else:
             cons = [{"type": "ineq", "fun": g}] if len(g(z0)) else []
             res = minimize(f, z0, method="SLSQP", bounds=[(0.0, 1.0)] * n, constraints=cons,
