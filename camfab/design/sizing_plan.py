@@ -258,7 +258,8 @@ def _size_rows(mech: Any, program: MotionLike, wanted: tuple[str, ...],
             rows.append(SizingRow(name, s.title, None, f"does not apply: {why}"))
             continue
         r = float(s.smallest(mech, program, limits))
-        rows.append(SizingRow(name, s.title, r, "never binds (any valid base radius)" if r < 1e-6 else ""))
+        rows.append(SizingRow(name, s.title, r, "never binds (the smallest radius the follower allows)"
+                              if r <= _least(mech) * (1 + 1e-6) + 1e-6 else ""))
     sized = [r for r in rows if r.radius_mm is not None]
     if not sized:
         raise InputError("no sizing constraint applies to this follower; name one in [sizing] constraints "
@@ -266,6 +267,17 @@ def _size_rows(mech: Any, program: MotionLike, wanted: tuple[str, ...],
     top = max(sized, key=lambda r: r.radius_mm or 0.0)
     rows = [dataclasses.replace(r, governing=True) if r is top else r for r in rows]
     return rows, top.constraint, float(top.radius_mm or 0.0)
+
+
+def _least(mech: Any) -> float:
+    """The smallest base radius the follower's geometry allows (an offset or an arm must reach the prime circle)."""
+    if isinstance(mech, OscillatingRoller):
+        return max(abs(mech.arm_length_mm - mech.pivot_distance_mm) - mech.roller_radius_mm, 0.0)
+    if isinstance(mech, TranslatingRoller):
+        return max(abs(mech.offset_mm) - mech.roller_radius_mm, 0.0)
+    if isinstance(mech, OscillatingFlat):
+        return max(mech.face_offset_mm - mech.pivot_distance_mm, 0.0)
+    return 0.0
 
 
 def _round(x: float, step: float) -> float:

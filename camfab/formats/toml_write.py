@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from ..design.spec import DesignSpec
-from ..errors import Problem, SpecError
+from ..errors import ApiError, Problem, SpecError
 from .design_files import load_design, resolve_design_path
 from .input_limits import read_text_limited
 from .knot_files import resolve_knot_file
@@ -69,7 +69,7 @@ def _value(v: Any) -> str:
         return "{ " + ", ".join(f"{_key(k)} = {_value(x)}" for k, x in v.items()) + " }" if v else "{}"
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_value(x) for x in v) + "]"
-    raise TypeError(f"cannot write a {type(v).__name__} to TOML")
+    raise ApiError(f"cannot write a {type(v).__name__} to TOML")
 
 
 def _is_table_array(v: Any) -> bool:
