@@ -41,6 +41,14 @@ def test_size_json_and_written_design_meets_the_constraints(tmp_path, capsys):
     assert not {f["code"] for f in chk["findings"]} & {"PRESSURE_ANGLE_EXCEEDED", "UNDERCUT", "CUSP"}
 
 
+def test_size_writes_the_same_bytes_twice(tmp_path, capsys):
+    src = _design(tmp_path, sizing={"set_offset": True})
+    a, b = tmp_path / "a.toml", tmp_path / "b.toml"
+    assert main(["size", str(src), "-o", str(a)]) == 0 and main(["size", str(src), "-o", str(b)]) == 0
+    assert a.read_bytes() == b.read_bytes()
+    assert tomllib.loads(a.read_text(encoding="utf-8"))["follower"]["offset_mm"] != 0.0
+
+
 def test_size_table_text(capsys):
     assert main(["size", "valve_exhaust_ej1"]) == 0
     out = capsys.readouterr().out

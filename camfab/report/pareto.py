@@ -22,7 +22,8 @@ def pareto_figure(rows: Sequence[tuple[float, float, float]], labels: tuple[str,
         ax = fig.add_subplot()
         xs = [r[1] for r in rows]
         ys = [r[2] for r in rows]
-        ax.plot(xs, ys, "-o", color="#1f77b4", label="optimum for weights (1 − t, t)")
+        second = labels[1].split(" (", 1)[0]
+        ax.plot(xs, ys, "-o", color="#1f77b4", label=f"optimum with weight t on the {second}, 1 − t on the other")
         for t, x, y in rows:
             ax.annotate(f"t = {t:.2g}", (x, y), textcoords="offset points", xytext=(5, 4), fontsize=7)
         if start is not None:
