@@ -359,6 +359,8 @@ def build_problem(data: Mapping[str, Any], spec: DesignSpec) -> OptimisationProb
         for k in weights:
             _applies(f"optimise.objectives.{k}", OBJECTIVES[k].measure, start)
         limits = _limits(opt, spec, start)
+        for i, k in enumerate(opt.pareto or ()):
+            _applies(f"optimise.pareto[{i}]", OBJECTIVES[k].measure, start)
     except SpecError as exc:
         raise SpecError(exc.problems, spec.source) from None
     base = spec
@@ -475,8 +477,8 @@ def pareto_sweep(prob: OptimisationProblem, pair: Sequence[str], points: int) ->
     """The trade-off of two objectives: for weights (1 − t, t), t from 0 to 1, the optimum's two measures;
     rows (t, measure 1, measure 2)."""
     a, b = pair
-    for k in pair:
-        _applies(f"optimise.pareto[{list(pair).index(k)}]", OBJECTIVES[k].measure, prob.start)
+    for i, k in enumerate(pair):
+        _applies(f"optimise.pareto[{i}]", OBJECTIVES[k].measure, prob.start)
     out = []
     for t in np.linspace(0.0, 1.0, points):
         r = solve(prob, {a: 1.0 - float(t) or 1e-9, b: float(t) or 1e-9})

@@ -78,6 +78,8 @@ def test_differential_evolution_is_seeded():
     ({"variables": ANGLES, "objectives": {"peak_contact_force_n": 1.0}}, "optimise.objectives.peak_contact_force_n",
      "[dynamics]"),
     ({"variables": ANGLES, "objectives": {"min_radius_mm": 0.0}}, "optimise.objectives", "weight > 0"),
+    ({"variables": ANGLES, "pareto": ["min_radius_mm", "peak_contact_force_n"]}, "optimise.pareto[1]", "[dynamics]"),
+    ({"variables": ANGLES, "pareto": ["min_radius_mm", "min_radius_mm"]}, "optimise.pareto", "two different"),
     ({"variables": [{"name": "motion[0].angle_deg", "lo": 60, "hi": 10}]}, "optimise.variables[0].hi", "greater"),
     ({"variables": ANGLES, "method": "newton"}, "optimise.method", "valid option"),
 ])
