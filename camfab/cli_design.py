@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import copy
+import dataclasses
 import json
 import sys
 from pathlib import Path
@@ -117,6 +118,7 @@ def cmd_optimise(args: argparse.Namespace) -> int:
         assert opt is not None  # build_problem refused a design without [optimise]
         sweep = pareto_sweep(prob, opt.pareto, opt.pareto_points) if opt.pareto else None
         new_spec = design_from_dict(res.data, source=f"{stem}_optimised.toml")
+        new_spec = dataclasses.replace(new_spec, name=f"{spec.name} (optimised)")  # the report's label only
         items = [(s, geometry_from_spec(s), check_design(s, tool_radius_mm=_tool_radius(s))) for s in (spec, new_spec)]
         files = render_comparison(items, standalone=args.standalone)
         summary: dict[str, Any] = {"name": spec.name, **res.to_dict(), "verdict_start": str(items[0][2].verdict),
