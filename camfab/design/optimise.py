@@ -349,11 +349,7 @@ def build_problem(data: Mapping[str, Any], spec: DesignSpec) -> OptimisationProb
                                 "objectives = { min_radius_mm = 1.0 }"), spec.source)
     try:
         variables = [_variable(v, data, spec) for v in opt.variables]
-        if sum(v.angle for v in variables) == 1:
-            p = next(v.path for v, var in zip(opt.variables, variables, strict=True) if var.angle)
-            raise _problem(f"{p}.name", variables[[v.angle for v in variables].index(True)].name,
-                           "a single segment span cannot change: the spans keep their sum (360°, or the cam length)",
-                           "free at least two segment spans")
+        _single_span(opt, variables)
         start = measure(spec)
         weights = {k: w for k, w in opt.objectives.items() if w > 0}
         for k in weights:
@@ -367,16 +363,28 @@ def build_problem(data: Mapping[str, Any], spec: DesignSpec) -> OptimisationProb
     if spec.motion_table is not None and isinstance(data.get("motion_table"), Mapping):
         base = dataclasses.replace(spec, motion_table=dict(data["motion_table"]))
     prob = OptimisationProblem(dict(data), spec, variables, weights, limits, start, opt, base=base)
-    bad = [(n, lim, lower) for (n, key, lim, lower), s in zip(limits, prob.slack(prob.z0()), strict=False) if s < 0]
-    if bad:
-        n, lim, lower = bad[0]
-        key = CONSTRAINTS[n].measure if n in CONSTRAINTS else n
-        raise SpecError(Problem(f"optimise.constraints.{n}", lim,
-                                f"the start design does not meet it ({CONSTRAINTS[n].title if n in CONSTRAINTS else n} "
-                                f"= {start[key]:.6g}, must be {'≥' if lower else '≤'} {lim:.6g})",
-                                "relax the limit, or start from a design that meets it (camfab check, camfab size)"),
-                        spec.source)
+    _feasible_start(prob, spec.source)
     return prob
+
+
+def _single_span(opt: OptimiseSpec, variables: Sequence[Variable]) -> None:
+    """A single free span cannot change (the spans keep their sum)."""
+    spans = [(vs, var) for vs, var in zip(opt.variables, variables, strict=True) if var.angle]
+    if len(spans) == 1:
+        raise _problem(f"{spans[0][0].path}.name", spans[0][1].name, "a single segment span cannot change: the "
+                       "spans keep their sum (360°, or the cam length)", "free at least two segment spans")
+
+
+def _feasible_start(prob: OptimisationProblem, source: str | None) -> None:
+    """The start must meet every constraint (the result is never worse than the start)."""
+    for (n, key, lim, lower), s in zip(prob.limits, prob.slack(prob.z0()), strict=False):
+        if s < 0:
+            title = CONSTRAINTS[n].title if n in CONSTRAINTS else n
+            raise SpecError(Problem(f"optimise.constraints.{n}", lim,
+                                    f"the start design does not meet it ({title} = {prob.start[key]:.6g}, must be "
+                                    f"{'≥' if lower else '≤'} {lim:.6g})",
+                                    "relax the limit, or start from a design that meets it (camfab check, camfab "
+                                    "size)"), source)
 
 
 def _applies(path: str, key: str, start: Mapping[str, float]) -> None:
