@@ -555,3 +555,4 @@ def _guarded(args: argparse.Namespace) -> int:
         return EXIT_IO
     finally:
         _ALLOW_OUTSIDE.reset(token)
+from . import cli_design  # noqa: E402,F401  (registers the size and optimise commands)

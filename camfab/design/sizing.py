@@ -12,6 +12,10 @@ below), or the geometric lower bound when the constraint never binds.
   ``R_b,min = −min(S + S″)`` (ρ = R_b + S + S″ must stay ≥ 0), oscillating numerical.
 * :func:`optimal_offset` — the offset of a translating roller that minimises
   the peak |pressure angle|.
+* :func:`min_base_radius_for_cutter` — rollers: the smallest concave profile radius
+  (|ρ_p| + R_r) reaches the cutter radius (an outside contour's convex stretches never limit it).
+* :func:`best_pivot_and_arm` — oscillating roller: the pivot distance and arm length within bounds
+  that minimise the peak |pressure angle|.
 
 The searches are :mod:`camfab.numeric`'s: bracketing root refinement for the radius at which a
 constraint becomes active, the global extremum search for the best offset.
@@ -36,6 +40,8 @@ __all__ = [
     "min_base_radius_no_undercut",
     "min_base_radius_no_cusp",
     "optimal_offset",
+    "min_base_radius_for_cutter",
+    "best_pivot_and_arm",
 ]
 
 _TINY = 1e-9
@@ -210,3 +216,63 @@ def optimal_offset(mechanism: TranslatingRoller, program: MotionLike) -> float:
 
     span = 0.99 * rp
     return extremum(_each(peak), [-span, span], step=span / 4).at
+
+
+def min_base_radius_for_cutter(mechanism: Mechanism, program: MotionLike, tool_radius_mm: float) -> float:
+    """Smallest R_b (mm) at which every concave stretch of a roller follower's profile is at least as wide
+    as the cutter: min over concave stretches of (1/|κ_p| + R_r) >= ``tool_radius_mm``.
+
+    A flat face's profile has no concave stretch (ρ = R_b + S + S″ > 0 where it is valid), so only roller
+    followers (translating or oscillating) are sized; a profile with no concave stretch needs no sizing
+    (its geometric lower bound is returned).
+    """
+    if not isinstance(mechanism, (TranslatingRoller, OscillatingRoller)):
+        raise ApiError(f"cutter sizing applies to roller followers, not a {type(mechanism).__name__}")
+    rr, rt = mechanism.roller_radius_mm, float(tool_radius_mm)
+    if not (math.isfinite(rt) and rt > 0):
+        raise InputError(f"tool radius {rt!r}: must be a positive length in mm")
+
+    def f(rb):
+        def tight(c):
+            kmin = extremum(lambda x: c.evaluate(x).curvature_pitch, c.breakpoints)[1]
+            # concave radius 1/|κ| + R_r >= R_t  ⟺  (R_t − R_r)·|κ| − 1 <= 0
+            return (rt - rr) * max(-kmin, 0.0) - 1.0
+        return _measure(mechanism, program, rb, tight)
+
+    if isinstance(mechanism, TranslatingRoller):
+        lo = max(abs(mechanism.offset_mm) - rr, 0.0) * (1 + _TINY) + _TINY
+        if rt <= rr:  # the concave radius is always > R_r
+            return lo
+        return _smallest(f, lo, _upper(mechanism, program, f, 4 * max(rt, _lift(program))))
+    if rt <= rr:
+        return _osc_bounds(mechanism)[0]
+    return _smallest(f, *_osc_bounds(mechanism))
+
+
+def best_pivot_and_arm(mechanism: OscillatingRoller, program: MotionLike,
+                       pivot_bounds: tuple[float, float], arm_bounds: tuple[float, float]) -> tuple[float, float]:
+    """Pivot distance m and arm length A (mm) within their bounds that minimise the peak |pressure angle| of an
+    oscillating roller at its base radius (scipy's bounded Powell search from the mechanism's own m and A,
+    deterministic).  A pair whose arm cannot reach the prime circle, or swings past the line of centres,
+    counts as infinitely bad."""
+    from scipy.optimize import minimize
+
+    if not isinstance(mechanism, OscillatingRoller):
+        raise ApiError(f"best_pivot_and_arm applies to oscillating roller followers, not a {type(mechanism).__name__}")
+
+    def peak(z) -> float:
+        m, a = float(z[0]), float(z[1])
+        mech = dataclasses.replace(mechanism, pivot_distance_mm=m, arm_length_mm=a)
+        if mech.validate() or mech.validate_motion(program):
+            return 180.0
+        try:
+            return peak_pressure_angle_deg(mech, program)
+        except (SpecError, InputError):
+            return 180.0
+
+    x0 = [min(max(mechanism.pivot_distance_mm, pivot_bounds[0]), pivot_bounds[1]),
+          min(max(mechanism.arm_length_mm, arm_bounds[0]), arm_bounds[1])]
+    res = minimize(peak, x0, method="Powell", bounds=[pivot_bounds, arm_bounds],
+                   options={"xtol": 1e-4, "ftol": 1e-8, "maxfev": 200})
+    best = (float(res.x[0]), float(res.x[1]))
+    return best if peak(best) <= peak(x0) else (float(x0[0]), float(x0[1]))

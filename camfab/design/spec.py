@@ -25,6 +25,7 @@ from .kinds import CamKind, Direction, FollowerMotion, FollowerType, LiftUnit, R
 from .knots import KnotFile, KnotTable, build_knot_table
 from .laws import law_names
 from .mechanisms import MECHANISMS, mechanism_class, mechanism_from_spec
+from .optimise_spec import OptimiseSpec, optimise_section
 from .program import TWO_PI, MotionProgram, SegmentInput, build_program
 from .shop import (
     POSTS,
@@ -37,6 +38,7 @@ from .shop import (
     manufacturing_section,
     outputs_section,
 )
+from .sizing_plan import SizingSpec, sizing_section
 from .strength_spec import StrengthSpec, strength_section
 from .validator import Validator
 from .vibration_spec import VibrationSpec, vibration_section
@@ -60,7 +62,8 @@ __all__ = [
 
 _TOP_KEYS = ("name", "description", "cam", "follower", "motion", "motion_table", "manufacturing", "machining",
              "outputs", "checks", "dynamics", "assembly", "drawing",
-             "vibration", "strength", "materials")
+             "vibration", "strength", "materials",
+             "sizing", "optimise")  # camfab size / camfab optimise: design/sizing_plan.py, design/optimise_spec.py
 _CAM_KEYS = ("kind", "rotation", "direction", "speed_rpm", "omega_rad_s", "speed_mm_s")
 _FOLLOWER_FLOATS = ("base_radius_mm", "roller_radius_mm", "offset_mm", "pivot_distance_mm",
                     "arm_length_mm", "face_offset_mm", "follower_distance_mm",
@@ -191,6 +194,8 @@ class DesignSpec:
     #: ``[strength]`` / ``[materials.*]`` resolved (``camfab.design.strength_spec``); None when the contact-stress
     #: check does not apply (no ``[dynamics]``, no ``[strength]``)
     strength: StrengthSpec | None = None
+    sizing: SizingSpec = field(default_factory=SizingSpec)
+    optimise: OptimiseSpec | None = None
 
     @property
     def is_translating_cam(self) -> bool:
@@ -327,7 +332,9 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
     return DesignSpec(name.strip(), cam, fol, motion, table, mfg, out, pressure_angle_limit_deg=pa,
                       description=str(data.get("description", "")), source=source, face_margin_mm=margin,
                       dynamics=dyn, machining=machining, assembly=assembly, drawing=drawing, strength=strength,
-                      vibration=vibration_section(v, data, cam.kind, fol.motion))
+                      vibration=vibration_section(v, data, cam.kind, fol.motion),
+                      sizing=sizing_section(v, v.table(data, "sizing")),
+                      optimise=optimise_section(v, v.table(data, "optimise")) if "optimise" in data else None)
 
 
 def _depth_levels(v: Validator, mfg: ManufacturingSpec, machining: MachiningSpec) -> None:
