@@ -52,7 +52,8 @@ def test_size_writes_the_same_bytes_twice(tmp_path, capsys):
 def test_size_table_text(capsys):
     assert main(["size", "valve_exhaust_ej1"]) == 0
     out = capsys.readouterr().out
-    assert "governing: cusp" in out and "← governs" in out
+    # the cusp radius leaves a point of infinite Hertz stress: the contact stress governs, just above it
+    assert "governing: contact_stress" in out and "← governs" in out and "cusp" in out
 
 
 @pytest.mark.parametrize("over,path", [

@@ -41,6 +41,7 @@ __all__ = [
     "min_base_radius_no_cusp",
     "optimal_offset",
     "min_base_radius_for_cutter",
+    "min_base_radius_for_stress",
     "best_pivot_and_arm",
 ]
 
@@ -276,3 +277,43 @@ def best_pivot_and_arm(mechanism: OscillatingRoller, program: MotionLike,
                    options={"xtol": 1e-4, "ftol": 1e-8, "maxfev": 200})
     best = (float(res.x[0]), float(res.x[1]))
     return best if peak(best) <= peak(x0) else (float(x0[0]), float(x0[1]))
+
+
+def min_base_radius_for_stress(mechanism: Mechanism, program: MotionLike,
+                               peak_stress_mpa: Callable[[Mechanism], float], allowable_mpa: float) -> float:
+    """Smallest R_b (mm) at which the peak Hertz contact stress ``peak_stress_mpa(mechanism at R_b)`` (MPa; +inf
+    where it is infinite or the geometry cannot be built) is at most ``allowable_mpa``.
+
+    The stress falls as the base circle grows (the profile's curvature flattens and the pressure angle drops),
+    so the first feasible radius of a scan from the follower's geometric lower bound (a flat face: from its
+    cusp radius, where the stress is infinite) is refined to the root of p_max/allowable − 1.
+    """
+    if not (math.isfinite(allowable_mpa) and allowable_mpa > 0):
+        raise InputError(f"allowable contact stress {allowable_mpa!r}: must be a positive stress in MPa")
+
+    def f(rb):
+        try:
+            p = float(peak_stress_mpa(_with_rb(mechanism, rb)))
+        except SpecError:
+            return math.inf
+        return p / allowable_mpa - 1.0 if math.isfinite(p) else math.inf
+
+    if isinstance(mechanism, (OscillatingRoller, OscillatingFlat)):
+        return _smallest(f, *_osc_bounds(mechanism), n=24)
+    if isinstance(mechanism, TranslatingRoller):
+        lo = max(abs(mechanism.offset_mm) - mechanism.roller_radius_mm, 0.0) * (1 + _TINY) + _TINY
+        start = 4 * max(mechanism.roller_radius_mm, _lift(program))
+    elif isinstance(mechanism, TranslatingFlat):
+        lo = min_base_radius_no_cusp(mechanism, program) * (1 + _TINY) + _TINY
+        start = 2 * max(lo, _lift(program))
+    else:
+        raise ApiError(f"contact-stress sizing applies to disc cams with roller or flat-face followers, not a "
+                       f"{type(mechanism).__name__}")
+    start = max(start, lo)
+    far = 1000.0 * start  # a cam this large is flat to the follower: the stress is then the follower's alone
+    if f(far) > 0:
+        raise InputError(f"no base radius brings the contact stress to the allowable {allowable_mpa:g} MPa: even "
+                         f"at {far:.6g} mm it is {(f(far) + 1) * allowable_mpa:.6g} MPa (set by the follower's "
+                         "radius and the force, not by the cam): widen the face, use a larger roller or a stronger "
+                         "material, or lower the force")
+    return _smallest(f, lo, _upper(mechanism, program, f, start), n=24)

@@ -6,7 +6,8 @@ design passes the checks rather than sitting on their limit.  A translating roll
 oscillating roller's best pivot distance and arm length (least peak pressure angle) are reported and, on
 request (``set_offset`` / ``set_pivot``), written into the design before its radius is sized.
 
-A new constraint (e.g. the contact-stress limit) is one more :class:`Sizer` in :data:`SIZERS`.
+A new constraint is one more :class:`Sizer` in :data:`SIZERS` (the contact-stress limit is one: it reads the
+design's force model and materials through the ``peak_stress`` function of the limits).
 """
 from __future__ import annotations
 
@@ -25,6 +26,7 @@ from .sizing import (
     best_pivot_and_arm,
     min_base_radius_for_cutter,
     min_base_radius_for_pressure_angle,
+    min_base_radius_for_stress,
     min_base_radius_no_cusp,
     min_base_radius_no_undercut,
     optimal_offset,
@@ -63,28 +65,36 @@ class Sizer:
     base radius (mm) meeting it, given the mechanism, the motion and the resolved limits."""
 
     title: str
-    not_applicable: Callable[[Any, Mapping[str, float | None]], str | None]
-    smallest: Callable[[Any, MotionLike, Mapping[str, float | None]], float]
+    not_applicable: Callable[[Any, Mapping[str, Any]], str | None]
+    smallest: Callable[[Any, MotionLike, Mapping[str, Any]], float]
 
 
 _ROLLERS = (TranslatingRoller, OscillatingRoller)
 _FLATS = (TranslatingFlat, OscillatingFlat)
 
 
-def _rollers_only(mech: Any, lim: Mapping[str, float | None]) -> str | None:
+def _rollers_only(mech: Any, lim: Mapping[str, Any]) -> str | None:
     return None if isinstance(mech, _ROLLERS) else "roller followers only"
 
 
-def _undercut_na(mech: Any, lim: Mapping[str, float | None]) -> str | None:
+def _undercut_na(mech: Any, lim: Mapping[str, Any]) -> str | None:
     if not isinstance(mech, _ROLLERS):
         return "roller followers only (a flat face: see cusp)"
     return "a knife edge cannot undercut" if mech.roller_radius_mm <= 0 else None
 
 
-def _cutter_na(mech: Any, lim: Mapping[str, float | None]) -> str | None:
+def _cutter_na(mech: Any, lim: Mapping[str, Any]) -> str | None:
     if not isinstance(mech, _ROLLERS):
         return "a flat face's profile has no concave stretch"
     return None if lim.get("tool_radius_mm") else "no cutter: give [manufacturing] tool_diameter_mm"
+
+
+def _stress_na(mech: Any, lim: Mapping[str, Any]) -> str | None:
+    if lim.get("peak_stress") is None:
+        return "no contact force: give [dynamics] (the materials: [strength])"
+    if isinstance(mech, _ROLLERS) and mech.roller_radius_mm <= 0:
+        return "a knife edge's contact stress is infinite: use a roller"
+    return None
 
 
 #: the sizing constraints, by their name in ``[sizing] constraints``
@@ -99,7 +109,27 @@ SIZERS: dict[str, Sizer] = {
                   lambda m, p, lim: min_base_radius_no_cusp(m, p)),
     "cutter": Sizer("concave radius ≥ cutter radius", _cutter_na,
                     lambda m, p, lim: min_base_radius_for_cutter(m, p, float(lim["tool_radius_mm"] or 0.0))),
+    "contact_stress": Sizer("Hertz contact stress ≤ allowable", _stress_na,
+                            lambda m, p, lim: min_base_radius_for_stress(m, p, lim["peak_stress"],
+                                                                         float(lim["allowable_contact_stress_mpa"]))),
 }
+
+
+def _peak_stress(spec: Any, program: MotionLike) -> Callable[[Any], float] | None:
+    """The peak contact stress (MPa, both followers; +inf where infinite) of the design's mechanism at another
+    size: its force model and materials (``[dynamics]``, ``[strength]``); None without them."""
+    if spec.dynamics is None or spec.strength is None:
+        return None
+    from .assemble import strength_input  # the design's force model; assemble imports spec, which imports us
+    from .profile import CamGeometry
+    from .strength import analyse_strength
+
+    def peak(mech: Any) -> float:
+        geom = CamGeometry(mech, program)
+        inp = strength_input(spec, geom)
+        summary = analyse_strength(geom, inp)[0] if inp is not None else None
+        return math.inf if summary is None or summary.max_mpa is None else float(summary.max_mpa)
+    return peak
 
 
 @dataclass(frozen=True)
@@ -202,7 +232,9 @@ def size_design(spec: Any) -> SizingResult:
                                  else None)
     pa = sz.pressure_angle_limit_deg or spec.pressure_angle_limit_deg or \
         DEFAULT_PRESSURE_LIMIT_DEG["oscillating" if osc else "translating"]
-    limits: dict[str, float | None] = {"pressure_angle_limit_deg": pa, "tool_radius_mm": tool}
+    limits: dict[str, Any] = {"pressure_angle_limit_deg": pa, "tool_radius_mm": tool,
+                              "peak_stress": _peak_stress(spec, program),
+                              "allowable_contact_stress_mpa": spec.strength.allowable_mpa if spec.strength else None}
     wanted = sz.constraints or tuple(SIZERS)
     for i, name in enumerate(sz.constraints or ()):
         why = SIZERS[name].not_applicable(mech, limits)
@@ -221,7 +253,8 @@ def size_design(spec: Any) -> SizingResult:
     changes["follower.base_radius_mm"] = sized
     mech = dataclasses.replace(mech, base_radius_mm=sized)
     peak = peak_pressure_angle_deg(mech, program) if isinstance(mech, _ROLLERS) else None
-    return SizingResult(tuple(rows), gov, sized, changes, limits, best_e, best_pa, peak)
+    stated = {k: v for k, v in limits.items() if k != "peak_stress"}  # the numbers, not the stress model
+    return SizingResult(tuple(rows), gov, sized, changes, stated, best_e, best_pa, peak)
 
 
 def _follower_changes(mech: Any, program: MotionLike, sz: SizingSpec, rb: float) -> tuple[
@@ -248,7 +281,7 @@ def _follower_changes(mech: Any, program: MotionLike, sz: SizingSpec, rb: float)
 
 
 def _size_rows(mech: Any, program: MotionLike, wanted: tuple[str, ...],
-               limits: Mapping[str, float | None]) -> tuple[list[SizingRow], str, float]:
+               limits: Mapping[str, Any]) -> tuple[list[SizingRow], str, float]:
     """Every constraint's row, the governing constraint and its radius."""
     rows: list[SizingRow] = []
     for name in wanted:

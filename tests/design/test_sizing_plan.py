@@ -15,7 +15,7 @@ from camfab.design.profile import CamGeometry
 from camfab.design.program import MotionProgram
 from camfab.design.sizing_plan import size_design
 from camfab.design.spec import design_from_dict
-from camfab.errors import SpecError
+from camfab.errors import InputError, SpecError
 
 from ..conftest import EJEMPLO9RT, EJEMPLO11RO
 
@@ -129,3 +129,50 @@ def test_best_pivot_lowers_the_peak_pressure_angle():
     before = sizing.peak_pressure_angle_deg(mech, E11)
     after = sizing.peak_pressure_angle_deg(dataclasses.replace(mech, pivot_distance_mm=m, arm_length_mm=a), E11)
     assert after < before - 1.0
+
+
+def _stressed(follower: dict, allowable: float) -> dict:
+    """Ejemplo9RT's motion at 300 rpm driving 2 kg against a 20 N/mm spring, a 5 mm wide steel face judged
+    against a low allowable stress, so that the contact stress sizes the cam."""
+    return _e9(follower=follower, cam={"kind": "disc", "speed_rpm": 300.0},
+               dynamics={"mass_kg": 2.0, "spring_rate_n_per_mm": 20.0, "spring_preload_n": 100.0},
+               strength={"roller_width_mm": 5.0, "allowable_contact_stress_mpa": allowable})
+
+
+def _with_rb(spec, rb: float):
+    return dataclasses.replace(spec, follower=dataclasses.replace(spec.follower, base_radius_mm=float(rb)))
+
+
+@pytest.mark.parametrize("follower,allowable", [
+    ({"type": "roller", "motion": "translating", "base_radius_mm": 35.0, "roller_radius_mm": 7.0}, 595.0),
+    ({"type": "flat", "motion": "translating", "base_radius_mm": 35.0}, 300.0),
+])
+def test_contact_stress_sizing_matches_a_brute_force_scan(follower, allowable):
+    """The contact-stress constraint's radius r: on a 0.05 mm grid of whole designs checked by `check` (the exact
+    stress search of the contact-stress rule), the first radius without CONTACT_STRESS_ABOVE_LIMIT lies in
+    [r, r + 0.05); the sized design (governed by the stress) has no such finding, 0.01 mm under r has."""
+    spec = design_from_dict(_stressed(follower, allowable))
+    res = size_design(spec)
+    r = {row.constraint: row for row in res.rows}["contact_stress"].radius_mm
+    assert res.governing == "contact_stress" and r is not None
+    step = 0.05
+    grid = np.round(np.arange(np.floor(r / step) * step - 0.2, r + 0.3, step), 6)
+    found = next(rb for rb in grid if "CONTACT_STRESS_ABOVE_LIMIT" not in check_design(_with_rb(spec, rb)).codes())
+    assert r - 1e-9 <= found < r + step + 1e-9, (r, found)
+    assert "CONTACT_STRESS_ABOVE_LIMIT" not in check_design(_with_rb(spec, res.base_radius_mm)).codes()
+    assert "CONTACT_STRESS_ABOVE_LIMIT" in check_design(_with_rb(spec, r - 0.01)).codes()
+
+
+def test_contact_stress_out_of_reach_is_said():
+    """A roller's stress never falls below the roller-on-a-plane value: asking for less is refused with the fix."""
+    spec = design_from_dict(_stressed({"type": "roller", "motion": "translating", "base_radius_mm": 35.0,
+                                       "roller_radius_mm": 7.0}, 420.0))
+    with pytest.raises(InputError, match="larger roller"):
+        size_design(spec)
+
+
+def test_contact_stress_constraint_needs_the_force():
+    res = size_design(design_from_dict(_e9()))
+    row = {r.constraint: r for r in res.rows}["contact_stress"]
+    assert row.radius_mm is None and "[dynamics]" in row.note
+    assert "peak_stress" not in res.to_dict()["limits"]  # the stated limits are numbers only
