@@ -57,8 +57,8 @@ class HermiteSurrogate:
         """The cubic holding each ``t`` (within the cubics of ``piece`` when given)."""
         i = np.searchsorted(self.x, t, side="right") - 1
         if piece is None:
-            return np.clip(i, 0, self.x.size - 2)
-        return np.clip(i, self.first[piece], self.first[piece + 1] - 1)
+            return np.minimum(np.maximum(i, 0), self.x.size - 2)  # (np.clip: 10× the call)
+        return np.minimum(np.maximum(i, self.first[piece]), self.first[piece + 1] - 1)
 
     def _local(self, t, piece):
         """Offset ``u`` of ``t`` in its cubic and that cubic's coefficients (``t`` wrapped into the
