@@ -19,6 +19,8 @@ __all__ = ["span_model", "cumtrapz", "SpanModel", "equioscillate"]
 _LAWSON_ITERS = 8
 #: Gauss-Newton rounds equalising the arc errors (knots and curvatures together)
 _EQUI_ITERS = 8
+#: a failed step ends the rounds when every local extremum of the deviation lies within this share of the largest
+_EQUI_LEVEL = 0.01
 
 
 def span_model(sur: HermiteSurrogate, segs, n_grid: int, curvature: bool = False):
@@ -240,6 +242,8 @@ def equioscillate(model: SpanModel, knots: np.ndarray, iters: int = _EQUI_ITERS)
             Cj = np.hstack([C, Bc, np.zeros((C.shape[0], 1))])
             wc = 1e3 / max(float(np.abs(Cj).max()), 1e-300)
             lin = (np.vstack([J, wc * Cj]), np.concatenate([-e[p], wc * (d - C @ k), np.zeros(m - 1)]))
+            level = np.abs(e[p])
+            level_spread = 1.0 - float(level.min()) / emax if level.size else 1.0
         damp = np.zeros((m - 1, 2 * m))
         damp[:, m:2 * m - 1] = np.eye(m - 1) * (lam * emax / hmean)
         y, *_ = np.linalg.lstsq(np.vstack([lin[0], damp]), lin[1], rcond=None)
@@ -264,8 +268,10 @@ def equioscillate(model: SpanModel, knots: np.ndarray, iters: int = _EQUI_ITERS)
                 improved, lin = True, None
                 break
         if not improved:
+            # the extrema already share one level (within _EQUI_LEVEL): the model's minimax is reached, and more
+            # damping would only buy a fraction of that spread (the Levenberg steps after it were wasted)
             lam *= 4.0
-            if lam > 10.0:
+            if lam > 10.0 or level_spread <= _EQUI_LEVEL:
                 break
         elif emax - best[0] < 1e-3 * emax:
             break
