@@ -22,7 +22,7 @@ from .curve import ParametricCurve, points_at
 from .entities import LINE_SWEEP_RAD, MAX_TURNING_RAD, arc_from, biarc, entity_point
 from .measure import measure_deviation
 from .spanmodel import SpanModel, cumtrapz, equioscillate
-from .spans import Span, cut_spans, span_density, span_ends
+from .spans import Span, cut_spans, span_density, span_ends, span_shape
 from .surrogate import HermiteSurrogate
 from .tolerance import within
 
@@ -53,6 +53,12 @@ _SPAN_REFITS = 4
 _FIXED_END_ARCS = (0.35, 0.9)
 #: further fixed-end ratios tried at the smallest failing count (none: they rarely paid for their time)
 _FIXED_END_ARCS_ALT: tuple = ()
+#: a span with a fixed end curvature whose first count (the asymptotic estimate, usually within a few % of the
+#: count that fits) misses its target more than this many times over is refitted with free end curvatures: the
+#: curvature jumps at its dwell (an SHM rise of a flat follower), no count would fit, and the search used to try a
+#: dozen counts per span before the whole spline fell back to spans clamped at every breakpoint.  Fits that do
+#: converge start at most 16× over (the examples at 1e-2…1e-4 mm), the hopeless ones at 80–1700×.
+_FIXED_HOPELESS = 40.0
 
 
 def _place_knots(s, density, m, ends=_END_ARCS, ends_hi=None):
@@ -76,7 +82,9 @@ class _SpanFit:
 
     def __init__(self, sur: HermiteSurrogate, span: Span, target: float):
         self.sur, self.span, self.target = sur, span, target
-        _, self.s0, self.density, _ = span_density(sur, span.segs, target)
+        if span.shape is None:
+            span.shape = span_shape(sur, span.segs)
+        _, self.s0, self.density, _ = span_density(sur, span.segs, target, shape=span.shape)
         self.est = float(cumtrapz(self.density, self.s0)[-1])
         self.n_fixed = sum(f is not None for f in span.fixed)
         self.m_min = 2 + self.n_fixed
@@ -112,6 +120,8 @@ class _SpanFit:
                 return None
             err, ok, fit = self.attempt(m)
             self.tried[m] = err
+            if self.n_fixed and len(self.tried) == 1 and not (err <= _FIXED_HOPELESS * self.target):
+                return None  # the fixed end curvature does not fit the curve (see _FIXED_HOPELESS)
             if ok and (best is None or m < best[0].size - 1):
                 best = fit
             nxt = self._next_count(m, err, ok, best)
@@ -156,7 +166,7 @@ class _SpanFit:
 
 
 def _fit_span(sur: HermiteSurrogate, span: Span, target: float):
-    """Fewest arcs (model) for a clamped span: ``(knots, k, error)`` or None.
+    """Fewest arcs (model) for a clamped span: ``(knots, k, error, fixed)`` or None.
 
     The arc count starts from the asymptotic estimate ``∫ (|κ'| / (124.7·target))^(1/3) ds``;
     every count gets knots equidistributing that density (end arcs shortened at clamped ends),
@@ -164,10 +174,16 @@ def _fit_span(sur: HermiteSurrogate, span: Span, target: float):
     the count goes down while the span still fits ``target`` and up until it does.
     The optimum is not monotone in the count: at the smallest failing count a warm start
     and other end-arc ratios (:data:`_END_ARCS_ALT`) are tried when it failed narrowly.
+    A span with a fixed end curvature that misses by far at its first count (:data:`_FIXED_HOPELESS`) is fitted
+    again with free end curvatures (``fixed`` returned: the curvatures the fit imposes).
     """
     fit = _SpanFit(sur, span, target)
     best = fit.search()
-    return None if best is None else fit.retry_one_fewer(best)
+    if best is None and fit.n_fixed and len(fit.tried) == 1:
+        free = Span(span.segs, (None, None), span.exact, span.label, span.shape)
+        fit = _SpanFit(sur, free, target)
+        best = fit.search()
+    return None if best is None else fit.retry_one_fewer(best) + (fit.span.fixed,)
 
 
 def _tanlen(kk, ll):
@@ -257,9 +273,9 @@ def _fit_span_chain(curve: ParametricCurve, sur: HermiteSurrogate, span: Span, t
     fit = _fit_span(sur, span, target)
     if fit is None:
         return None
-    knots, k, err = fit
+    knots, k, err, fixed = fit
     p0, t0, p1, t1 = span_ends(sur, span)
-    chain = _span_chain(p0, t0, p1, t1, knots, k, span.fixed)
+    chain = _span_chain(p0, t0, p1, t1, knots, k, fixed)
     return None if chain is None else (chain, err)
 
 

@@ -126,7 +126,8 @@ class ArcDiscretisation(ArcChain):
 
     def chain(self) -> Chain:
         """The entities as a :class:`Chain`."""
-        radii = self.radii
-        k = np.where(self.is_line, 0.0, np.sign(self.sweeps) / radii)
-        length = np.where(self.is_line, np.hypot(*(self.ends - self.starts).T), np.abs(self.sweeps) * radii)
+        line = self.is_line
+        radii = np.where(line, 1.0, self.radii)  # a line's infinite radius never enters a product (inf·0)
+        k = np.where(line, 0.0, np.sign(self.sweeps) / radii)
+        length = np.where(line, np.hypot(*(self.ends - self.starts).T), np.abs(self.sweeps) * radii)
         return Chain(self.starts, self.tangents, k, length, self.ends)

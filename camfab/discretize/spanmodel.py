@@ -19,6 +19,8 @@ __all__ = ["span_model", "cumtrapz", "SpanModel", "equioscillate"]
 _LAWSON_ITERS = 8
 #: Gauss-Newton rounds equalising the arc errors (knots and curvatures together)
 _EQUI_ITERS = 8
+#: a failed step ends the rounds when every local extremum of the deviation lies within this share of the largest
+_EQUI_LEVEL = 0.01
 
 
 def span_model(sur: HermiteSurrogate, segs, n_grid: int, curvature: bool = False):
@@ -66,9 +68,9 @@ def _cumhermite(f: np.ndarray, fp: np.ndarray, s: np.ndarray) -> np.ndarray:
 
 def _hermite_at(x: np.ndarray, s: np.ndarray, F: np.ndarray, f: np.ndarray, fp: np.ndarray) -> np.ndarray:
     """``F(x) = ∫₀ˣ f`` between grid points: integral of the cubic Hermite interpolant of ``f``."""
-    i = np.clip(np.searchsorted(s, x, side="right") - 1, 0, s.size - 2)
+    i = np.minimum(np.maximum(np.searchsorted(s, x, side="right") - 1, 0), s.size - 2)  # (np.clip: 10× the call)
     h = s[i + 1] - s[i]
-    tau = np.clip((x - s[i]) / np.where(h > 0, h, 1.0), 0.0, 1.0)
+    tau = np.minimum(np.maximum((x - s[i]) / np.where(h > 0, h, 1.0), 0.0), 1.0)
     t2, t3, t4 = tau * tau, tau ** 3, tau ** 4
     w = (h * (tau - t3 + 0.5 * t4), h * h * (0.25 * t4 - 2.0 * t3 / 3.0 + 0.5 * t2),
          h * (t3 - 0.5 * t4), h * h * (0.25 * t4 - t3 / 3.0))
@@ -139,6 +141,7 @@ class SpanModel:
         self.nN, self.nM = dot(nrm, self.N), dot(nrm, self.M)
         self._nm = (np.hstack([self.N, self.M]), np.hstack([nrm, self.m_fp[0]]), np.hstack([dn, self.m_fp[1]]))
         self._last_key: bytes | None = None
+        self._rows: dict = {}  # the rows of the fixed curvatures, per arc count
         self._last_nm: tuple[np.ndarray, np.ndarray] = (np.empty((0, 2)), np.empty((0, 2)))
 
     def NM_at(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -160,7 +163,7 @@ class SpanModel:
         G = Mx - knots[:, None] * Nx                                        # (m + 1, 2)
         m = ell.size
         A = nrm @ (G[1:] - G[:-1]).T + self.nN[:, None] * ell[None, :]
-        jj = np.clip(np.searchsorted(knots, s, side="right") - 1, 0, m - 1)
+        jj = np.minimum(np.maximum(np.searchsorted(knots, s, side="right") - 1, 0), m - 1)
         A[np.arange(m)[None, :] >= jj[:, None]] = 0.0
         A[np.arange(s.size), jj] = self.nM - knots[jj] * self.nN - dot(nrm, G[jj])
         Dk_end = (Mx[1:] - Mx[:-1]) - knots[:-1, None] * (Nx[1:] - Nx[:-1]) + ell[:, None] * (self.N[-1] - Nx[1:])
@@ -173,6 +176,11 @@ class SpanModel:
         return A, C, d
 
     def _fixed_rows(self, m: int):
+        if m not in self._rows:
+            self._rows[m] = self._make_fixed_rows(m)
+        return self._rows[m]
+
+    def _make_fixed_rows(self, m: int):
         rows, vals = [], []
         for j, kf in ((0, self.fixed[0]), (m - 1, self.fixed[1])):
             if kf is not None:
@@ -224,17 +232,21 @@ def equioscillate(model: SpanModel, knots: np.ndarray, iters: int = _EQUI_ITERS)
         return _peak(e), knots, k
     lam = 1e-2
     hmean = model.L / m
+    lin = None  # the linearisation at ``best`` (kept while steps fail: only the damping changes)
     for _ in range(iters):
         emax, knots, k, e = best
-        p = _local_extrema(e)
-        B, Bc = model.knot_jacobian(knots, k)
-        J = np.hstack([A[p], B[p], -np.sign(e[p])[:, None]])
-        Cj = np.hstack([C, Bc, np.zeros((C.shape[0], 1))])
-        wc = 1e3 / max(float(np.abs(Cj).max()), 1e-300)
+        if lin is None:
+            p = _local_extrema(e)
+            B, Bc = model.knot_jacobian(knots, k)
+            J = np.hstack([A[p], B[p], -np.sign(e[p])[:, None]])
+            Cj = np.hstack([C, Bc, np.zeros((C.shape[0], 1))])
+            wc = 1e3 / max(float(np.abs(Cj).max()), 1e-300)
+            lin = (np.vstack([J, wc * Cj]), np.concatenate([-e[p], wc * (d - C @ k), np.zeros(m - 1)]))
+            level = np.abs(e[p])
+            level_spread = 1.0 - float(level.min()) / emax if level.size else 1.0
         damp = np.zeros((m - 1, 2 * m))
         damp[:, m:2 * m - 1] = np.eye(m - 1) * (lam * emax / hmean)
-        y, *_ = np.linalg.lstsq(np.vstack([J, wc * Cj, damp]),
-                                np.concatenate([-e[p], wc * (d - C @ k), np.zeros(m - 1)]), rcond=None)
+        y, *_ = np.linalg.lstsq(np.vstack([lin[0], damp]), lin[1], rcond=None)
         dk, dx = y[:m], y[m:2 * m - 1]
         improved = False
         for alpha in (1.0, 0.5, 0.25):
@@ -253,11 +265,13 @@ def equioscillate(model: SpanModel, knots: np.ndarray, iters: int = _EQUI_ITERS)
             if emax2 < best[0]:
                 best = (emax2, xn, k2, e2)
                 A, C, d = A2, C2, d2
-                improved = True
+                improved, lin = True, None
                 break
         if not improved:
+            # the extrema already share one level (within _EQUI_LEVEL): the model's minimax is reached, and more
+            # damping would only buy a fraction of that spread (the Levenberg steps after it were wasted)
             lam *= 4.0
-            if lam > 10.0:
+            if lam > 10.0 or level_spread <= _EQUI_LEVEL:
                 break
         elif emax - best[0] < 1e-3 * emax:
             break

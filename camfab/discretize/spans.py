@@ -8,7 +8,7 @@ tangent.  Each span is clamped to the curve's point and tangent at both ends.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -18,7 +18,7 @@ from .entities import MAX_TURNING_RAD, arc_from
 from .spanmodel import cumtrapz, span_model
 from .surrogate import HermiteSurrogate
 
-__all__ = ["SPLINE_SPAN", "Span", "span_density", "span_ends", "cut_spans"]
+__all__ = ["SPLINE_SPAN", "Span", "span_shape", "span_density", "span_ends", "cut_spans"]
 
 
 #: most arcs of one free span: a longer smooth piece is cut into spans joined G1 at (surrogate)
@@ -28,24 +28,32 @@ SPLINE_SPAN = 40
 _G1_RAD = 1e-6
 
 
-def span_density(sur: HermiteSurrogate, segs, target: float, n: int = 257):
-    """``(t, s, density)``: arcs per unit length, ``(|κ'| / (124.7·target))^(1/3)`` (+ a turning bound).
-
-    ``t`` holds the parameters of the grid and ``piece`` (4th value) their pieces."""
+def span_shape(sur: HermiteSurrogate, segs, n: int = 257):
+    """``(t, s, |κ'|, |κ|, piece)`` on a grid of about ``n`` points along the span (what its arc density needs,
+    whatever the target): parameters, arc length, and the pieces of the grid points."""
     total = sum(hi - lo for _, lo, hi in segs)
-    ts, ss, ds, ps = [], [], [], []
+    ts, ss, dks, ks, ps = [], [], [], [], []
     s_off = 0.0
     for seg in segs:
         k = max(33, int(round(n * (seg[2] - seg[1]) / total))) if len(segs) > 1 else n
         t, s0, theta = span_model(sur, [seg], k)
         kappa = np.gradient(theta, s0)
-        dk = np.abs(np.gradient(kappa, s0))
         ts.append(t)
         ss.append(s0 + s_off)
-        ds.append((dk / (124.7 * target)) ** (1.0 / 3.0) + np.abs(kappa) / MAX_TURNING_RAD)
+        dks.append(np.abs(np.gradient(kappa, s0)))
+        ks.append(np.abs(kappa))
         ps.append(np.full(t.size, seg[0]))
         s_off += float(s0[-1])
-    return np.concatenate(ts), np.concatenate(ss), np.concatenate(ds), np.concatenate(ps)
+    return tuple(np.concatenate(a) for a in (ts, ss, dks, ks, ps))
+
+
+def span_density(sur: HermiteSurrogate, segs, target: float, n: int = 257, shape=None):
+    """``(t, s, density)``: arcs per unit length, ``(|κ'| / (124.7·target))^(1/3)`` (+ a turning bound).
+
+    ``t`` holds the parameters of the grid and ``piece`` (4th value) their pieces; ``shape``: the span's
+    :func:`span_shape`, when already computed."""
+    t, s, dk, kappa, piece = span_shape(sur, segs, n) if shape is None else shape
+    return t, s, (dk / (124.7 * target)) ** (1.0 / 3.0) + kappa / MAX_TURNING_RAD, piece
 
 
 @dataclass
@@ -61,6 +69,8 @@ class Span:
     fixed: tuple = (None, None)
     exact: tuple | None = None
     label: int = 0
+    #: its :func:`span_shape` when known (computed once: the cut and every fit of the span read it)
+    shape: tuple | None = field(default=None, repr=False, compare=False)
 
     def sample(self, n: int) -> np.ndarray:
         """About ``n`` parameters spread over the span by parameter length (each piece's end left out)."""
@@ -151,14 +161,15 @@ def _anchors(curve: ParametricCurve, sur: HermiteSurrogate, tol: float, anchored
     return anchors, exact
 
 
-def _split_stretch(sur: HermiteSurrogate, segs: list, target: float) -> list:
+def _split_stretch(sur: HermiteSurrogate, segs: list, target: float) -> tuple[list, tuple | None]:
     """A stretch ``segs`` cut into equal shares of about :data:`SPLINE_SPAN` arcs (never on a junction):
-    the ``[(piece, lo, hi), ...]`` of every share."""
-    t, s0, density, piece = span_density(sur, segs, target)
+    the ``[(piece, lo, hi), ...]`` of every share, and the stretch's :func:`span_shape` when it is one share."""
+    shape = span_shape(sur, segs)
+    t, s0, density, piece = span_density(sur, segs, target, shape=shape)
     cum = cumtrapz(density, s0)
     m = max(1, math.ceil(1.08 * float(cum[-1]) / SPLINE_SPAN))
     if m == 1:
-        return [segs]
+        return [segs], shape
     goal = cum[-1] * np.arange(1, m) / m
     j = np.clip(np.searchsorted(cum, goal) - 1, 0, cum.size - 2)
     j = np.where(piece[j] == piece[j + 1], j, j + 1)
@@ -174,7 +185,7 @@ def _split_stretch(sur: HermiteSurrogate, segs: list, target: float) -> list:
             cur, lo, ci = [], float(cut_t[ci]), ci + 1
         cur.append((seg[0], lo, seg[2]))
     pieces_segs.append(cur)
-    return pieces_segs
+    return pieces_segs, None
 
 
 def cut_spans(curve: ParametricCurve, sur: HermiteSurrogate, target: float, tol: float,
@@ -205,10 +216,10 @@ def cut_spans(curve: ParametricCurve, sur: HermiteSurrogate, target: float, tol:
             continue
         if not segs:
             continue
-        shares = _split_stretch(sur, segs, target)
+        shares, shape = _split_stretch(sur, segs, target)
         for q, sg in enumerate(shares):
             f = (fixed[0] if q == 0 else None, fixed[1] if q == len(shares) - 1 else None)
-            out.append(Span(sg, f, None, label))
+            out.append(Span(sg, f, None, label, shape))
     return out
 
 

@@ -34,8 +34,15 @@ class HermiteSurrogate:
         p = points_at(curve, x)
         if curve.closed:
             p[-1] = p[0]
-        d = derivatives_at(curve, np.concatenate([a, b]), np.tile(lo[piece], 2), np.tile(hi[piece], 2))
-        d0, d1 = d[:a.size], d[a.size:]
+        # one derivative per node and smooth piece: an interval's end is the next one's start (same piece) except
+        # at each piece's end, whose one-sided derivative comes from that piece
+        ends = np.cumsum(counts) - 1  # the last interval of every piece (each piece has one at least)
+        d = derivatives_at(curve, np.concatenate([a, b[ends]]), np.concatenate([lo[piece], lo]),
+                           np.concatenate([hi[piece], hi]))
+        d0 = d[:a.size]
+        d1 = np.empty_like(d0)
+        d1[:-1] = d0[1:]
+        d1[ends] = d[a.size:]
         h = (b - a)[:, None]
         p0, p1 = p[:-1], p[1:]
         self.curve = curve
@@ -50,8 +57,8 @@ class HermiteSurrogate:
         """The cubic holding each ``t`` (within the cubics of ``piece`` when given)."""
         i = np.searchsorted(self.x, t, side="right") - 1
         if piece is None:
-            return np.clip(i, 0, self.x.size - 2)
-        return np.clip(i, self.first[piece], self.first[piece + 1] - 1)
+            return np.minimum(np.maximum(i, 0), self.x.size - 2)  # (np.clip: 10× the call)
+        return np.minimum(np.maximum(i, self.first[piece]), self.first[piece + 1] - 1)
 
     def _local(self, t, piece):
         """Offset ``u`` of ``t`` in its cubic and that cubic's coefficients (``t`` wrapped into the
