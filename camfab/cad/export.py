@@ -146,6 +146,11 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
     if shapes is None:
         say(f"fitting arcs within {tol:g} mm")
         shapes = cam_shapes(geometry, tol=tol, with_pitch="dxf" in formats)
+    if getattr(getattr(geometry, "mechanism", None), "cam_kind", None) == "groove":
+        from .groove import groove_artifacts  # one plate, two flanks: camfab.cad.groove
+
+        return groove_artifacts(spec, geometry, formats, shapes=shapes, tol=tol, dxf_flavour=dxf_flavour,
+                                tool_paths=tool_paths)
     plate = _plate(spec)
     out: list[Artifact] = []
     n = len(shapes.profiles)
