@@ -348,7 +348,8 @@ def gcode_job(spec: DesignSpec, *, tol: float, overrides: Mapping[str, Any] | No
         raise SpecError(Problem("manufacturing.tool_diameter_mm", None, "G-code needs a tool",
                                 "add tool_diameter_mm to [manufacturing] (or give --tool-diameter)"), spec.source)
     mfg = spec.manufacturing
-    return job_from_machining(m, tool_diameter_mm=tool, thickness_mm=mfg.thickness_mm,
+    m = replace(m, breakthrough_mm=0.0, mill_bore=False) if spec.cam.kind == "groove" else m  # a slot (README)
+    return job_from_machining(m, tool_diameter_mm=tool, thickness_mm=spec.follower.groove_depth_mm or mfg.thickness_mm,
                               material=over.get("material", mfg.material),
                               bore_mm=mfg.bore_mm, stock_shape="plate" if spec.is_translating_cam else "round",
                               tolerance_mm=tol, design_name=spec.name, source=spec.source)
@@ -444,12 +445,15 @@ def _assembly(cam: Cam, req: Request) -> list[Artifact]:
 def _gcode(cam: Cam, req: Request) -> list[Artifact]:
     from .gcode import dumps
     from .gcode.cam import cam_program
+    from .gcode.groove import groove_gcode
 
     tol = cam.tolerance(req.tol)
     require_followable(cam.check())
     job = gcode_job(cam.spec, tol=tol, overrides=req.machining)
     m = machining_of(cam.spec, req.machining)
     n = len(cam.geometry.profiles)
+    if cam.spec.cam.kind == "groove":  # one program mills the slot of both flanks
+        return [Artifact(f"{safe_stem(cam.name)}.nc", *groove_gcode(cam.geometry, job, tol, m, req.post), req.post)]
     out = []
     for i, contact in enumerate(cam.geometry.profiles):
         cp = cam_program(contact, job, tol=tol, compensation=m.compensation, arcs_allowed=not m.lines_only,
