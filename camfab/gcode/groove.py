@@ -40,10 +40,10 @@ from .parse import parse
 from .toolpath import contour_items, start_near
 from .verify import VerifyReport, verify_program
 
-__all__ = ["groove_program", "groove_gcode", "verify_groove_program", "FLANK_LABELS"]
+__all__ = ["groove_program", "groove_gcode", "verify_groove_program"]
 
-#: the labels of the two finishing contours (both start with "FINISH CONTOUR", the label verify measures)
-FLANK_LABELS = ("FINISH CONTOUR INNER FLANK", "FINISH CONTOUR OUTER FLANK")
+#: the label of both finishing contours (what verify measures); the comment before names the flank
+_FINISH = "FINISH CONTOUR"
 #: exact points per flank tool-centre curve the coverage check probes
 _PROBES = 4096
 
@@ -88,10 +88,10 @@ def groove_program(inner, outer, job: Job, *, tol: float, arcs_allowed: bool = T
                   Comment("ROUGH CONTOUR")]
         items += contour_items(centre, z, job.feed_mm_min)
     z = levels[-1]
-    for name, segs, label in (("INNER", fin_in, FLANK_LABELS[0]), ("OUTER", fin_out, FLANK_LABELS[1])):
+    for name, segs in (("INNER", fin_in), ("OUTER", fin_out)):
         q = np.asarray(segs[0].start, dtype=float)
         items += [Comment(f"FINISH PASS {name} FLANK"), Comment("FINISH LEAD-IN"), Feed(q[0], q[1], z, job.feed_mm_min),
-                  Comment(label)]
+                  Comment(_FINISH)]
         items += contour_items(segs, z, job.feed_mm_min)
         items += [Comment("FINISH LEAD-OUT"), Feed(s[0], s[1], z, job.feed_mm_min)]
     items.append(Rapid(s[0], s[1], job.safe_z_mm))
@@ -132,23 +132,32 @@ def verify_groove_program(program: str | bytes, inner, outer, job: Job, *, tol: 
 
 def _directions(program: str | bytes, job: Job) -> list[Finding]:
     """DIRECTION per flank pass: climb (M3) runs clockwise round the inner flank, counter-clockwise along the
-    outer; conventional the reverse."""
+    outer; conventional the reverse.  The finishing runs (consecutive moves labelled FINISH CONTOUR) are told
+    apart by the area they enclose: the inner flank's is the smaller."""
     text = program.decode("utf-8") if isinstance(program, bytes) else program
-    moves = parse(text).moves
-    out = []
-    for label, material_inside in zip(FLANK_LABELS, (True, False), strict=True):
-        run = [m for m in moves if (m.label or "").upper() == label and m.kind != "rapid"]
-        if not run:
-            continue
+    runs: list[list] = []
+    last = None
+    for m in parse(text).moves:
+        label = (m.label or "").upper()
+        if label == _FINISH and m.kind != "rapid":
+            if last != _FINISH:
+                runs.append([])
+            runs[-1].append(m)
+        last = label
+    areas = []
+    for run in runs:
         pts = np.array([m.end[:2] for m in run], dtype=float)
         x, y = pts[:, 0] - pts[:, 0].mean(), pts[:, 1] - pts[:, 1].mean()
-        area = 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
-        want_cw = (job.direction == "climb") == material_inside
+        areas.append(0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y)))
+    out = []
+    smallest = int(np.argmin(np.abs(areas))) if areas else -1
+    for k, (run, area) in enumerate(zip(runs, areas, strict=True)):
+        inner = k == smallest
+        want_cw = (job.direction == "climb") == inner
         if area != 0.0 and (area < 0) != want_cw:
-            flank = label.rsplit(" ", 2)[-2].lower()
-            out.append(Finding.at_line(IssueCode.DIRECTION, f"the {flank} flank's finishing pass runs "
-                                       f"{'counter-' if want_cw else ''}clockwise: not {job.direction} milling "
-                                       "with M3", run[0].line))
+            out.append(Finding.at_line(IssueCode.DIRECTION, f"the {'inner' if inner else 'outer'} flank's finishing "
+                                       f"pass runs {'counter-' if want_cw else ''}clockwise: not {job.direction} "
+                                       "milling with M3", run[0].line))
     return out
 
 
