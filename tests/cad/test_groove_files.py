@@ -115,3 +115,21 @@ def test_dxf_layers_and_stl_watertight(files):
     BRepGProp.VolumeProperties_s(shape, props)
     # the mesh's chords are inscribed within tol/2: its volume within (perimeters × tol/2 × thickness)
     assert mesh.volume == pytest.approx(props.Mass(), rel=2e-4)
+
+
+def test_assembly_roller_sits_in_the_groove_within_the_backlash(tmp_path):
+    """The assembly at several cam angles: the roller (radius R_r, centred on the pitch curve) is b/2 from the
+    grooved plate (OCC distance between the read-back parts): it touches neither flank nor the floor."""
+    from camfab.cad import assembly
+
+    from .test_assembly import _read
+
+    cam = pipeline.load(NAME)
+    mech, tol = cam.geometry.mechanism, cam.tolerance()
+    for ang in (0.0, 50.0, 140.0):
+        text = assembly.dumps(cam.spec, cam.geometry, list(cam.shapes().profiles), math.radians(ang))
+        path = tmp_path / f"{ang:g}.step"
+        path.write_text(text, encoding="utf-8")
+        parts = _read(path)
+        assert {"cam", "shaft", "roller"} <= set(parts)
+        assert _dist(parts["roller"].wrapped, parts["cam"].wrapped) == pytest.approx(mech.backlash_mm / 2, abs=tol)
