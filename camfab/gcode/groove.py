@@ -101,7 +101,8 @@ def groove_program(inner, outer, job: Job, *, tol: float, arcs_allowed: bool = T
     notes = (*job.notes, f"groove: {job.depth_mm:g} mm deep, cut from the front face Z0",
              "entry: plunge on the pitch curve (centre-cutting end mill), then a centre pass and a finishing pass "
              "per flank")
-    prog = Program(job=job, items=tuple(items), contour=fin_in, roughing=(centre,), notes=notes)
+    prog = Program(job=job, items=tuple(items), contour=fin_in, roughing=(centre,), notes=notes,
+                   milled="groove slot (a centre pass, then a finishing pass per flank)")
     shapely_dev = max(paths.inner.shapely_deviation, paths.outer.shapely_deviation)
     return CamProgram(prog, dev, shapely_dev, len(centre) + len(fin_in) + len(fin_out))
 

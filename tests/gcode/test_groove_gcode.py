@@ -82,3 +82,22 @@ def test_compensation_is_refused_for_a_groove(made):
     with pytest.raises(SpecError) as e:
         cam.to_gcode(compensation="G41")
     assert "machining.compensation" in {p.path for p in e.value.problems}
+
+
+def test_oscillating_groove_program_verifies(tmp_path):
+    """An oscillating roller in a groove, ccw: the program from `camfab run` passes `camfab verify` (CLI)."""
+    import tomllib
+
+    from camfab.cli import main
+    from camfab.formats import EXAMPLES_DIR
+
+    text = (EXAMPLES_DIR / "groove_translating.toml").read_text()
+    data = tomllib.loads(text)
+    assert data["follower"]["motion"] == "translating"
+    text = text.replace('motion = "translating"', 'motion = "oscillating"\npivot_distance_mm = 90.0\n'
+                        'arm_length_mm = 70.0').replace('rotation = "cw"', 'rotation = "ccw"')
+    text = text.replace("lift = 12.0", "lift = 15.0").replace("lift = -12.0", "lift = -15.0")
+    design = tmp_path / "osc.toml"
+    design.write_text(text)
+    assert main(["run", str(design), "-o", str(tmp_path / "out"), "--outputs", "gcode"]) == 0
+    assert main(["verify", str(tmp_path / "out" / "GrooveTranslating.nc"), "--design", str(design)]) == 0
