@@ -397,9 +397,9 @@ def _step(cam: Cam, req: Request) -> list[Artifact]:
 def _iges(cam: Cam, req: Request) -> list[Artifact]:
     """``<stem>.igs`` (``_cam1``/``_cam2`` for a pair): the plate for older CAM systems."""
     from .cad import iges
-    from .cad.export import plate_of, solid_outlines
+    from .cad.export import plate_of
 
-    loops, devs = solid_outlines(cam.shapes(req.tol), cam.tolerance(req.tol))
+    loops, devs = iges.outlines(cam.shapes(req.tol), cam.tolerance(req.tol))  # refuses a groove cam (README)
     n = len(loops)
     return [Artifact(f"{safe_stem(cam.name)}{_suffix(i, n)}.igs",
                      iges.dumps(loop, plate_of(cam.spec), name=f"{cam.name}{_suffix(i, n)}").encode("ascii"),

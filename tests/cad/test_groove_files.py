@@ -133,3 +133,12 @@ def test_assembly_roller_sits_in_the_groove_within_the_backlash(tmp_path):
         parts = _read(path)
         assert {"cam", "shaft", "roller"} <= set(parts)
         assert _dist(parts["roller"].wrapped, parts["cam"].wrapped) == pytest.approx(mech.backlash_mm / 2, abs=tol)
+
+
+def test_iges_of_a_groove_is_refused_without_output(tmp_path, capsys):
+    from camfab.cli import main
+
+    out = tmp_path / "out"
+    assert main(["run", "groove_translating", "-o", str(out), "--outputs", "iges"]) == 2
+    assert "IGES of a groove cam is not made yet" in capsys.readouterr().err
+    assert not out.exists() or not any(out.iterdir())
