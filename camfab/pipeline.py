@@ -585,7 +585,7 @@ def shop_file_names(cam: Cam) -> set[str]:
     """The names of every shop file (:data:`SHOP_OUTPUTS`) camfab writes for ``cam``: what an unacceptable
     verdict withholds, and removes when an earlier run left it."""
     stem = safe_stem(cam.name)
-    n = len(cam.geometry.profiles)
+    n = 1 if cam.spec.cam.kind == "groove" else len(cam.geometry.profiles)  # a groove: one plate, one program
     per_profile = [f"{stem}{_suffix(i, n)}" for i in range(n)]
     names = {f"{stem}.dxf", f"{stem}_drawing.dxf", f"{stem}_drawing.pdf", f"{stem}_lift.csv",
              f"{stem}_assembly.step", *([f"{stem}_pair.step"] if n > 1 else [])}

@@ -142,3 +142,11 @@ def test_iges_of_a_groove_is_refused_without_output(tmp_path, capsys):
     assert main(["run", "groove_translating", "-o", str(out), "--outputs", "iges"]) == 2
     assert "IGES of a groove cam is not made yet" in capsys.readouterr().err
     assert not out.exists() or not any(out.iterdir())
+
+
+def test_shop_file_names_of_a_groove_are_its_one_plate_files(files):
+    cam, out = files
+    names = pipeline.shop_file_names(cam)
+    assert {"GrooveTranslating.step", "GrooveTranslating.stl", "GrooveTranslating.nc"} <= names
+    assert not any("_cam" in n or "_pair" in n for n in names)
+    assert {p.name for p in out.iterdir()} - {"check.json"} <= names
