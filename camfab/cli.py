@@ -315,8 +315,14 @@ def cmd_verify(args: argparse.Namespace) -> int:
         raise UsageError(f"--profile {args.profile}: the design has {len(profiles)} profile(s)")
     job = pipeline.gcode_job(cam.spec, tol=tol, overrides=_job_overrides(args))
     data = Path(args.program).read_bytes()  # a missing file is an I/O error (3); an unreadable one a finding
-    rep = verify_cam_program(data, profiles[args.profile - 1], job, tol=tol, post=args.post,
-                             default_post=cam.spec.outputs.gcode or "linuxcnc", comp_radius=args.comp_radius)
+    if cam.spec.cam.kind == "groove":  # both flanks are the targets (camfab.gcode.groove)
+        from .gcode.groove import verify_groove_program
+
+        rep = verify_groove_program(data, profiles[0], profiles[1], job, tol=tol, post=args.post,
+                                    default_post=cam.spec.outputs.gcode or "linuxcnc", comp_radius=args.comp_radius)
+    else:
+        rep = verify_cam_program(data, profiles[args.profile - 1], job, tol=tol, post=args.post,
+                                 default_post=cam.spec.outputs.gcode or "linuxcnc", comp_radius=args.comp_radius)
     if args.json:
         print(json.dumps(rep.to_dict(), indent=2))
     else:

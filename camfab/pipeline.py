@@ -348,7 +348,8 @@ def gcode_job(spec: DesignSpec, *, tol: float, overrides: Mapping[str, Any] | No
         raise SpecError(Problem("manufacturing.tool_diameter_mm", None, "G-code needs a tool",
                                 "add tool_diameter_mm to [manufacturing] (or give --tool-diameter)"), spec.source)
     mfg = spec.manufacturing
-    return job_from_machining(m, tool_diameter_mm=tool, thickness_mm=mfg.thickness_mm,
+    m = replace(m, breakthrough_mm=0.0, mill_bore=False) if spec.cam.kind == "groove" else m  # a slot (README)
+    return job_from_machining(m, tool_diameter_mm=tool, thickness_mm=spec.follower.groove_depth_mm or mfg.thickness_mm,
                               material=over.get("material", mfg.material),
                               bore_mm=mfg.bore_mm, stock_shape="plate" if spec.is_translating_cam else "round",
                               tolerance_mm=tol, design_name=spec.name, source=spec.source)
@@ -396,9 +397,9 @@ def _step(cam: Cam, req: Request) -> list[Artifact]:
 def _iges(cam: Cam, req: Request) -> list[Artifact]:
     """``<stem>.igs`` (``_cam1``/``_cam2`` for a pair): the plate for older CAM systems."""
     from .cad import iges
-    from .cad.export import plate_of, solid_outlines
+    from .cad.export import plate_of
 
-    loops, devs = solid_outlines(cam.shapes(req.tol), cam.tolerance(req.tol))
+    loops, devs = iges.outlines(cam.shapes(req.tol), cam.tolerance(req.tol))  # refuses a groove cam (README)
     n = len(loops)
     return [Artifact(f"{safe_stem(cam.name)}{_suffix(i, n)}.igs",
                      iges.dumps(loop, plate_of(cam.spec), name=f"{cam.name}{_suffix(i, n)}").encode("ascii"),
@@ -444,12 +445,15 @@ def _assembly(cam: Cam, req: Request) -> list[Artifact]:
 def _gcode(cam: Cam, req: Request) -> list[Artifact]:
     from .gcode import dumps
     from .gcode.cam import cam_program
+    from .gcode.groove import groove_gcode
 
     tol = cam.tolerance(req.tol)
     require_followable(cam.check())
     job = gcode_job(cam.spec, tol=tol, overrides=req.machining)
     m = machining_of(cam.spec, req.machining)
     n = len(cam.geometry.profiles)
+    if cam.spec.cam.kind == "groove":  # one program mills the slot of both flanks
+        return [Artifact(f"{safe_stem(cam.name)}.nc", *groove_gcode(cam.geometry, job, tol, m, req.post), req.post)]
     out = []
     for i, contact in enumerate(cam.geometry.profiles):
         cp = cam_program(contact, job, tol=tol, compensation=m.compensation, arcs_allowed=not m.lines_only,
@@ -581,7 +585,7 @@ def shop_file_names(cam: Cam) -> set[str]:
     """The names of every shop file (:data:`SHOP_OUTPUTS`) camfab writes for ``cam``: what an unacceptable
     verdict withholds, and removes when an earlier run left it."""
     stem = safe_stem(cam.name)
-    n = len(cam.geometry.profiles)
+    n = 1 if cam.spec.cam.kind == "groove" else len(cam.geometry.profiles)  # a groove: one plate, one program
     per_profile = [f"{stem}{_suffix(i, n)}" for i in range(n)]
     names = {f"{stem}.dxf", f"{stem}_drawing.dxf", f"{stem}_drawing.pdf", f"{stem}_lift.csv",
              f"{stem}_assembly.step", *([f"{stem}_pair.step"] if n > 1 else [])}

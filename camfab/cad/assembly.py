@@ -366,6 +366,8 @@ def build(spec, geometry, outlines: Sequence[ArcChain], x: float, *, dims: Dimen
     layer_gap = 2 * (d.clearance + d.arm_thickness) + 2 * d.clearance + max(d.pivot_diameter, d.arm_thickness)
     pitch = t + hub + layer_gap
     parts = _Parts([])
+    if getattr(geometry.mechanism, "cam_kind", None) == "groove":
+        return _groove_parts(cq, parts, geometry, outlines, x, cam_move, plate, d)
     two = len(outlines) > 1
     for i, outline in enumerate(outlines):
         at = (cam_move, 0.0, i * pitch) if not geometry.closed else (0.0, 0.0, i * pitch)
@@ -382,6 +384,27 @@ def build(spec, geometry, outlines: Sequence[ArcChain], x: float, *, dims: Dimen
     for k, p in enumerate(poses):
         sfx = f"_{k + 1}" if len(poses) > 1 else ""
         _follower(cq, parts, p, d, p.layer * pitch, t, sfx)
+    return parts
+
+
+def _groove_parts(cq, parts: _Parts, geometry, outlines: Sequence[ArcChain], x: float, cam_move: float, plate,
+                  d: Dimensions) -> _Parts:
+    """A groove cam's assembly: the grooved plate turned to ``x``, the shaft, and the roller (radius R_r) centred on
+    the pitch curve in the groove, standing ``clearance`` out of the front face (z = 0) and clear of the floor by
+    as much.  The follower's stem or arm is not drawn yet (README, "Groove cams")."""
+    from .groove import plate_radius
+    from .plate import circle_loop
+    from .step import groove_solid
+
+    mech = geometry.mechanism
+    depth = mech.groove_depth_mm
+    parts.add("cam", groove_solid(circle_loop(plate_radius(geometry)), outlines[0], outlines[1], plate, depth),
+              (0.0, 0.0, 0.0), cam_move)
+    if plate.bore_mm > 0:
+        t = plate.thickness_mm + (plate.hub_length_mm or 0.0)
+        parts.add("shaft", _cyl(cq, 0.0, 0.0, plate.bore_mm / 2, -t, 2 * t))
+    c = geometry.profiles[0].evaluate_fixed(np.array([x])).pitch[0]
+    parts.add("roller", _cyl(cq, float(c[0]), float(c[1]), mech.roller_radius_mm, -d.clearance, depth - d.clearance))
     return parts
 
 

@@ -163,6 +163,13 @@ def notes_text(spec, geometry, report, shapes, layout: SheetLayout) -> list[str]
     rmax = geometry.max_radius
     plates = (f"{len(geometry.profiles)} cams, CAM 1 drives the first follower, CAM 2 the second; each"
               if len(shapes.profiles) > 1 else "")
+    groove = []
+    if spec.cam.kind == "groove":  # one plate: the flanks of one groove (camfab.cad.groove)
+        from .groove import groove_width_note, plate_radius
+
+        rmax, plates = plate_radius(geometry), "One plate with a face groove (inner flank solid, outer dashed);"
+        groove = [f"Groove: {groove_width_note(geometry)} from the front face; outer flank up to R "
+                  f"{geometry.radius_extremes(1).max:.3f} mm; R max below is the plate's radius."]
     return [
         f"Material: {_material(spec)}.",
         f"{plates or 'Plate'} thickness {m.thickness_mm:g} mm (side view); {bore}.",
@@ -175,6 +182,7 @@ def notes_text(spec, geometry, report, shapes, layout: SheetLayout) -> list[str]
         f"Base radius R_b = {f.base_radius_mm:g} mm; largest radius R max = {rmax:.3f} mm; "
         f"blank diameter at least Ø max = 2 × R max = {2 * rmax:.3f} mm.",
         *centre,
+        *groove,
         f"Lift table: lift in {'degrees of arm rotation' if f.motion == 'oscillating' else 'mm'}; "
         f"RADIUS = {radius_word} from the cam centre (mm).",
         verdict + ".",
@@ -296,7 +304,9 @@ def _cam_labels(msp, spec, geometry, shapes, layout: SheetLayout) -> None:
     followers)."""
     x0, _, _, y1 = layout.view
     kind = str(spec.cam.kind)
-    if len(shapes.profiles) > 1:
+    if kind == "groove":
+        rows = [("PROFILE", "INNER FLANK (groove)"), ("PROFILE_2", "OUTER FLANK (groove)")]
+    elif len(shapes.profiles) > 1:
         rows = [("PROFILE", "CAM 1 (first follower)"), ("PROFILE_2", "CAM 2 (second follower)")]
     elif kind in ("constant_width", "constant_diameter"):
         width = spec.follower.width_mm or 0.0

@@ -13,7 +13,8 @@ Flavours
 
 Layers: ``PROFILE``, ``PITCH_CURVE``, ``BASE_CIRCLE``, ``PRIME_CIRCLE``, ``BORE``,
 ``TOOL_PATH``, ``CENTRE_MARKS``; the second cam of a conjugate pair is on ``PROFILE_2``
-and ``PITCH_CURVE_2``.  For a curved-face follower the pitch curve is the path of the
+and ``PITCH_CURVE_2``; a groove cam has its inner flank on ``PROFILE``, its outer flank on ``PROFILE_2`` and
+its plate's rim on ``PLATE`` (:mod:`camfab.cad.groove`).  For a curved-face follower the pitch curve is the path of the
 face's centre of curvature and the prime circle the circle R_b + R it starts on.  Units
 are recorded as ``$INSUNITS = 4`` (mm) and the tolerance and achieved deviation as custom
 header properties ``CAMFAB_TOL_MM`` / ``CAMFAB_DEVIATION_MM``; the design's name is ``CAMFAB_NAME``, one
@@ -55,6 +56,8 @@ class DxfContent:
     deviation_mm: float | None = None
     name: str = "cam"
     extra_circles: tuple[tuple[str, float], ...] = field(default_factory=tuple)
+    #: a groove cam's plate outline (its rim), on the layer ``PLATE`` (added only then)
+    plate_outline: ArcChain | None = None
 
 
 def ezdxf_module():
@@ -145,6 +148,9 @@ def build_document(content: DxfContent, *, flavour: str = "lwpolyline"):
         _add_loop(msp, loop, "TOOL_PATH", flavour)
     if content.bore is not None:
         _add_loop(msp, content.bore, "BORE", flavour)
+    if content.plate_outline is not None:
+        doc.layers.add("PLATE", color=7)
+        _add_loop(msp, content.plate_outline, "PLATE", flavour)
     for layer, r in (("BASE_CIRCLE", content.base_radius), ("PRIME_CIRCLE", content.prime_radius),
                      *content.extra_circles):
         if r:

@@ -57,6 +57,8 @@ class CamShapes:
     pitch: tuple[ArcChain, ...]
     curves: tuple  # exact ParametricCurve of each profile
     tol: float
+    #: the two flanks of one groove cam's plate (camfab.cad.groove), not one plate per profile
+    groove: bool = False
 
     @property
     def profile_deviation(self) -> tuple[float, ...]:
@@ -76,7 +78,8 @@ def cam_shapes(geometry, *, tol: float, with_pitch: bool = True) -> CamShapes:
         pc = pitch_curve(c) if with_pitch and c.roller_radius > 0 else None
         if pc is not None:
             pitch.append(_pitch_loop(profiles[-1], c.roller_radius, pc, tol))
-    return CamShapes(tuple(profiles), tuple(pitch), tuple(curves), tol)
+    groove = getattr(getattr(geometry, "mechanism", None), "cam_kind", None) == "groove"
+    return CamShapes(tuple(profiles), tuple(pitch), tuple(curves), tol, groove)
 
 
 def _require_continuous(curve, tol: float) -> None:
@@ -146,6 +149,11 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
     if shapes is None:
         say(f"fitting arcs within {tol:g} mm")
         shapes = cam_shapes(geometry, tol=tol, with_pitch="dxf" in formats)
+    if getattr(getattr(geometry, "mechanism", None), "cam_kind", None) == "groove":
+        from .groove import groove_artifacts  # one plate, two flanks: camfab.cad.groove
+
+        return groove_artifacts(spec, geometry, formats, shapes=shapes, tol=tol, dxf_flavour=dxf_flavour,
+                                tool_paths=tool_paths)
     plate = _plate(spec)
     out: list[Artifact] = []
     n = len(shapes.profiles)

@@ -11,6 +11,7 @@ import re
 import tempfile
 from pathlib import Path
 
+from ..errors import ExportError
 from ..geom2d import ArcChain
 from ..io import safe_stem
 from ..version import __version__
@@ -18,9 +19,25 @@ from .plate import PlateSpec
 from .step import cadquery, plate_solid
 from .stepheader import step_timestamp
 
-__all__ = ["dumps"]
+__all__ = ["dumps", "outlines"]
 
 _DATE = re.compile(r"15H\d{8}\.\d{6}")
+
+
+def outlines(shapes, tol: float) -> tuple[list, list[float]]:
+    """The plate outlines an IGES file extrudes (:func:`~camfab.cad.export.solid_outlines`).
+
+    Raises
+    ------
+    ExportError
+        A groove cam: its plate is a pocketed solid, which this writer (one extruded outline) cannot make yet.
+    """
+    from .export import solid_outlines
+
+    if shapes.groove:
+        raise ExportError("IGES of a groove cam is not made yet: the IGES writer extrudes one outline and cannot "
+                          "pocket the groove; use the STEP file (step = true) for the grooved plate")
+    return solid_outlines(shapes, tol)
 
 
 def dumps(outline: ArcChain, plate: PlateSpec, *, name: str = "cam") -> str:

@@ -15,7 +15,7 @@ from ..textsafe import step_string
 from .plate import PlateSpec
 from .stepheader import StepMeta, header_dumps
 
-__all__ = ["plate_solid", "dumps", "stack_dumps", "canonical_reals", "cadquery"]
+__all__ = ["plate_solid", "groove_solid", "dumps", "groove_dumps", "stack_dumps", "canonical_reals", "cadquery"]
 
 
 def cadquery():
@@ -52,6 +52,22 @@ def plate_solid(outline: ArcChain, plate: PlateSpec):
         height = plate.thickness_mm + (plate.hub_length_mm or 0.0) + 2.0
         body = body.cut(_wire(cq, hole, -1.0).extrude(height))
     return body
+
+
+def groove_solid(outline: ArcChain, inner: ArcChain, outer: ArcChain, plate: PlateSpec, depth_mm: float):
+    """A groove cam's plate: :func:`plate_solid` of ``outline`` with the region between the ``inner`` and
+    ``outer`` flank loops pocketed from the face z = 0 (the face opposite the hub) up to z = ``depth_mm``."""
+    cq = _cq()
+    body = plate_solid(outline, plate)
+    tall = depth_mm + 1.0
+    pocket = _wire(cq, outer, -1.0).extrude(tall).cut(_wire(cq, inner, -2.0).extrude(tall + 2.0))
+    return body.cut(pocket)
+
+
+def groove_dumps(outline: ArcChain, inner: ArcChain, outer: ArcChain, plate: PlateSpec, depth_mm: float, *,
+                 name: str = "cam", meta: StepMeta | None = None) -> str:
+    """STEP text of a groove cam's plate (:func:`groove_solid`), as :func:`dumps`."""
+    return _export(groove_solid(outline, inner, outer, plate, depth_mm), name, meta)
 
 
 def dumps(outline: ArcChain, plate: PlateSpec, *, name: str = "cam", meta: StepMeta | None = None) -> str:

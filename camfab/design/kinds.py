@@ -41,6 +41,8 @@ class CamKind(StrEnum):
     CONSTANT_WIDTH = "constant_width"
     CONSTANT_DIAMETER = "constant_diameter"
     TRANSLATING = "translating"
+    #: a disc with a face groove: one pitch curve, two flanks, one roller driven both ways
+    GROOVE = "groove"
 
     @property
     def form_closed(self) -> bool:

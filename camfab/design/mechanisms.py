@@ -25,6 +25,7 @@ from .conjugate import (
 )
 from .curved import OscillatingCurved, TranslatingCurved
 from .faces import OscillatingFlat, TranslatingFlat
+from .groove import GrooveOscillatingRoller, GrooveTranslatingRoller
 from .kinds import CamKind, FollowerMotion, FollowerType
 from .mechanism import Mechanism
 from .profile import CamGeometry
@@ -53,6 +54,8 @@ __all__ = [
     "ConstantWidthCam",
     "ConstantDiameterCam",
     "DesmodromicGeometry",
+    "GrooveTranslatingRoller",
+    "GrooveOscillatingRoller",
 ]
 
 _D, _CJ, _CW, _CD, _TC = (CamKind.DISC, CamKind.CONJUGATE, CamKind.CONSTANT_WIDTH, CamKind.CONSTANT_DIAMETER,
@@ -77,6 +80,8 @@ MECHANISMS: dict[tuple[CamKind, FollowerType, FollowerMotion], type[Mechanism]] 
     (_CW, _FL, _T): ConstantWidthCam,
     (_CD, _RO, _T): ConstantDiameterCam,
     (_TC, _RO, _T): TranslatingCamRoller,
+    (CamKind.GROOVE, _RO, _T): GrooveTranslatingRoller,
+    (CamKind.GROOVE, _RO, _O): GrooveOscillatingRoller,
 }
 
 

@@ -204,6 +204,8 @@ class Contact:
     oscillating = False
     has_face = False
     roller_radius = 0.0
+    #: how the checks name this profile when a cam has several ("" = "profile k"); e.g. "inner flank"
+    label = ""
 
     @property
     def sliding(self) -> bool:

@@ -68,12 +68,12 @@ _CAM_KEYS = ("kind", "rotation", "direction", "speed_rpm", "omega_rad_s", "speed
 _FOLLOWER_FLOATS = ("base_radius_mm", "roller_radius_mm", "offset_mm", "pivot_distance_mm",
                     "arm_length_mm", "face_offset_mm", "follower_distance_mm",
                     "second_roller_radius_mm", "follower_angle_deg", "cam_length_mm",
-                    "base_height_mm", "width_mm", "rise_deg", "face_radius_mm")
+                    "base_height_mm", "width_mm", "rise_deg", "face_radius_mm", "backlash_mm", "groove_depth_mm")
 _FOLLOWER_KEYS = ("type", "motion", *_FOLLOWER_FLOATS)
 #: [follower] lengths that must be > 0, and those that may be 0 (the others lie in ±1e6)
 _POSITIVE = ("base_radius_mm", "arm_length_mm", "cam_length_mm", "follower_distance_mm", "width_mm",
-             "face_radius_mm")
-_NON_NEGATIVE = ("roller_radius_mm", "pivot_distance_mm", "second_roller_radius_mm", "base_height_mm")
+             "face_radius_mm", "groove_depth_mm")
+_NON_NEGATIVE = ("roller_radius_mm", "pivot_distance_mm", "second_roller_radius_mm", "base_height_mm", "backlash_mm")
 _SEGMENT_KEYS = ("law", "lift", "angle_deg", "length_mm", "shape")
 _CHECK_KEYS = ("pressure_angle_limit_deg", "face_margin_mm")
 #: [dynamics] keys by follower motion (the units are in the names) and for both
@@ -121,6 +121,9 @@ class FollowerSpec:
     width_mm: float | None = None
     rise_deg: float | None = None
     face_radius_mm: float | None = None
+    #: groove cams: the groove's extra width over the roller diameter, and its depth in the plate
+    backlash_mm: float | None = None
+    groove_depth_mm: float | None = None
 
     @property
     def lift_unit(self) -> LiftUnit:
@@ -321,6 +324,7 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
     machining = machining_section(v, v.table(data, "machining"))
     assembly = assembly_section(v, v.table(data, "assembly"))
     _depth_levels(v, mfg, machining)
+    _groove_depth(v, fol, mfg)
     drawing = drawing_section(v, v.table(data, "drawing"), mfg.tolerance_mm)
     checks = v.table(data, "checks")
     v.keys(checks, _CHECK_KEYS, "checks")
@@ -345,6 +349,15 @@ def _depth_levels(v: Validator, mfg: ManufacturingSpec, machining: MachiningSpec
         v.add("machining.step_down_mm", step, f"cuts the {depth:g} mm depth (plate and breakthrough) in more than "
               f"{MAX_DEPTH_LEVELS} depth "
               "levels (the input limit)", f"give a step-down of at least {depth / MAX_DEPTH_LEVELS:.3g} mm")
+
+
+def _groove_depth(v: Validator, fol: FollowerSpec, mfg: ManufacturingSpec) -> None:
+    """A groove must leave a floor: its depth below the plate thickness (docs/decisions.md, "Groove cams")."""
+    depth = fol.groove_depth_mm
+    if depth is not None and depth >= mfg.thickness_mm:
+        v.add("follower.groove_depth_mm", depth, f"must be smaller than the plate thickness "
+              f"([manufacturing] thickness_mm = {mfg.thickness_mm:g} mm): the groove needs a floor",
+              f"give groove_depth_mm < {mfg.thickness_mm:g}, or a thicker plate")
 
 
 # ---------------------------------------------------------------------------
@@ -510,6 +523,9 @@ def _dynamics(v: Validator, data: Mapping[str, Any], cam: CamSpec, fol: Follower
     osc = fol.motion == FollowerMotion.OSCILLATING and cam.kind != CamKind.TRANSLATING
     own = _DYN_OSCILLATING if osc else _DYN_TRANSLATING
     _dynamics_keys(v, t, osc)
+    if cam.kind == CamKind.GROOVE:
+        v.add("dynamics", None, "the force model of a groove cam (which flank carries the roller when) is not "
+              "built yet", "remove [dynamics] from a groove design")
     if cam.kind.form_closed:
         for k in (own[1], own[2], "safety_force_n"):
             if k in t:

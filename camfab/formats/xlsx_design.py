@@ -409,7 +409,8 @@ def _follower_rows(f: FollowerSpec) -> list[tuple[str, Any]]:
     kv: list[tuple[str, Any]] = [("follower.type", str(f.type)), ("follower.motion", str(f.motion))]
     for name in ("base_radius_mm", "roller_radius_mm", "offset_mm", "pivot_distance_mm", "arm_length_mm",
                  "face_offset_mm", "follower_distance_mm", "second_roller_radius_mm", "follower_angle_deg",
-                 "cam_length_mm", "base_height_mm", "width_mm", "rise_deg", "face_radius_mm"):
+                 "cam_length_mm", "base_height_mm", "width_mm", "rise_deg", "face_radius_mm", "backlash_mm",
+                 "groove_depth_mm"):
         v = getattr(f, name)
         if v is not None:
             kv.append((f"follower.{name}", _num(v)))

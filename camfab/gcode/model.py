@@ -400,6 +400,9 @@ class Program:
         The roughing contours, outermost first.
     notes : tuple of str
         Header lines: the job's cutting-data notes, the stock, the depth, the entry and the bore.
+    milled : str
+        What is milled, for the header (``"outside contour"``, or a groove's slot); only an outside contour has
+        roughing passes in the header.
     """
 
     job: Job
@@ -408,3 +411,5 @@ class Program:
     contour: tuple = ()
     roughing: tuple = field(default=())
     notes: tuple = ()
+    #: what is milled, for the header: the periphery, or a groove's slot (camfab.gcode.groove)
+    milled: str = "outside contour"

@@ -55,7 +55,7 @@ from camfab.gcode.model import (
 from camfab.geom2d import TWO_PI
 from camfab.limits import MAX_PROGRAM_MOVES
 
-__all__ = ["ENTRY_CLEARANCE_MM", "contour_toolpath", "stock_outline"]
+__all__ = ["ENTRY_CLEARANCE_MM", "contour_toolpath", "stock_outline", "contour_items", "start_near"]
 
 #: the plunge point of every pass keeps the tool this far outside the stock (mm)
 ENTRY_CLEARANCE_MM = 1.0
@@ -368,3 +368,8 @@ def contour_toolpath(path_entities, job: Job, *, roughing_contours=None,
     items.append(Spindle(0.0))
     return Program(job=job, items=tuple(items), compensation=compensation, contour=finish,
                    roughing=tuple(rough), notes=tuple(notes))
+
+
+#: the feed moves along a contour at one height, and a closed contour restarted at its point nearest a target
+#: (public: the groove slot's passes use them)
+contour_items, start_near = _contour_items, _start_near

@@ -214,7 +214,7 @@ def profile_figure(spec, geometry, report):
             x = sample_grid(c.period, c.breakpoints)
             s = c.evaluate(np.append(x, x[0]))
             col = f"C{k}"
-            tag = f"cam {k + 1} " if multi else ""
+            tag = f"{c.label or f'cam {k + 1}'} " if multi else ""  # a groove's flanks by name
             ax.plot(s.point[:, 0], s.point[:, 1], color=col, lw=2.0, label=f"{tag}profile")
             if s.pitch is not None and c.roller_radius > 0 and not c.curved_face:
                 ax.plot(s.pitch[:, 0], s.pitch[:, 1], color=col, lw=0.9, ls="--", label=f"{tag}pitch curve")
@@ -304,7 +304,7 @@ def curvature_figure(spec, geometry, report, *, n: int = _N):
         ax = fig.subplots()
         lo, hi = 0.0, 0.0
         for k, (c, x, s) in enumerate(_profile_samples(geometry, n)):
-            tag = f"cam {k + 1}: " if multi else ""
+            tag = f"{c.label or f'cam {k + 1}'}: " if multi else ""
             rho = off_view(s.rho, lim)
             ax.plot(x * axis.scale, rho, color=f"C{k}", label=f"{tag}profile ρ")
             lo, hi = min(lo, np.nanmin(rho, initial=0.0)), max(hi, np.nanmax(rho, initial=0.0))
@@ -354,11 +354,11 @@ def pressure_angle_figure(spec, geometry, report, *, n: int = _N):
     with plot_style():
         fig = new_figure(9.0, 4.2)
         ax = fig.subplots()
-        for k, (_c, x, s) in enumerate(_profile_samples(geometry, n)):
+        for k, (c, x, s) in enumerate(_profile_samples(geometry, n)):
             if s.pressure_angle is None:
                 continue
             xu, delta = x * axis.scale, np.degrees(s.pressure_angle)
-            ax.plot(xu, delta, color=f"C{k}", label=f"cam {k + 1}" if multi else "pressure angle δ")
+            ax.plot(xu, delta, color=f"C{k}", label=(c.label or f"cam {k + 1}") if multi else "pressure angle δ")
             if lim is not None:
                 ax.fill_between(xu, delta, lim, where=delta > lim, interpolate=True, color=_BAD, alpha=0.45, lw=0)
                 ax.fill_between(xu, delta, -lim, where=delta < -lim, interpolate=True, color=_BAD, alpha=0.45, lw=0)

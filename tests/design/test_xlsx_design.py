@@ -59,8 +59,9 @@ E9_MOTION = [("law", "lift", "angle_deg"), ("modified_sine", 10, 50), ("dwell", 
              ("dwell", 0, 40), ("poly345", 10, 50), ("dwell", 0, 40), ("poly4567", -10, 50), ("dwell", 0, 40)]
 
 
-def test_round_trip_toml_example(tmp_path):
-    spec = load_design(EXAMPLES / "ejemplo9rt.toml")
+@pytest.mark.parametrize("name", ["ejemplo9rt", "groove_translating"])
+def test_round_trip_toml_example(tmp_path, name):
+    spec = load_design(EXAMPLES / f"{name}.toml")
     back = load_design_xlsx(_write(tmp_path, design_to_xlsx(spec)))
     assert _bare(back) == _bare(spec)
     assert back.source == str(tmp_path / "design.xlsx") and back.sources == (back.source,)

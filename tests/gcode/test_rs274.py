@@ -120,6 +120,17 @@ def _check(name: str, post: str, tmp_path: Path) -> None:
     cam, texts = _programs(name, post)
     tol = cam.tolerance()
     job = pipeline.gcode_job(cam.spec, tol=tol)
+    if cam.spec.cam.kind == "groove":  # one program, two flanks: each finishing point on one of their paths
+        from camfab.gcode.groove import verify_groove_program
+
+        (text,) = texts
+        pts, _ = finishing_points(interpret(text, tmp_path))
+        paths = [CurveDistance(offset_curve(c, job.tool_radius_mm)) for c in cam.geometry.profiles]
+        dev = float(np.max(np.minimum(*(np.abs(d(pts)) for d in paths))))
+        assert dev <= tol, f"{name} {post}: rs274's finishing path is {dev:.6f} mm off the exact tool-centre curves"
+        rep = verify_groove_program(text, *cam.geometry.profiles, job, tol=tol, post=post)
+        assert rep.ok, f"{name} {post}: camfab verify finds {[p.message for p in rep.problems][:3]}"
+        return
     for contact, text in zip(cam.geometry.profiles, texts, strict=True):
         calls = interpret(text, tmp_path)
         pts, _ = finishing_points(calls)

@@ -111,7 +111,7 @@ def check(geometry: CamGeometry, *, pressure_angle_limit_deg: float | None = Non
         if scope is Scope.CAM:
             results = [(r.run(geometry, limits, samples), "") for r in rules]
         else:
-            results = [(r.run(s.contact, limits, s), f"profile {k + 1}: " if multi else "")
+            results = [(r.run(s.contact, limits, s), f"{s.contact.label or f'profile {k + 1}'}: " if multi else "")
                        for k, s in enumerate(samples) for r in rules]
         for res, tag in results:
             findings += [dataclasses.replace(f, message=tag + f.message) for f in res.findings] if tag else \

@@ -88,9 +88,10 @@ def header_lines(program: Program, post_name: str, arc_note: str = "", decimals:
         f"feed: {job.feed_mm_min * k:.{fd}f} {u}/min, plunge {job.plunge_feed_mm_min * k:.{fd}f} {u}/min",
         f"stock top Z0, final depth Z{L(-job.depth_mm)}, safe Z{L(job.safe_z_mm)}",
         f"depth levels: {len(job.levels)}, step-down {L(job.depth_mm / len(job.levels))} {u}",
-        f"milling: {job.direction}, outside contour, {path}",
+        f"milling: {job.direction}, {program.milled}, {path}",
         f"cutter compensation: {comp}",
-        f"roughing passes: {job.roughing_passes}, allowance {L(job.roughing_allowance_mm)} {u}",
+        *([f"roughing passes: {job.roughing_passes}, allowance {L(job.roughing_allowance_mm)} {u}"]
+          if program.milled == "outside contour" else []),
     ]
     return lines + list(program.notes)  # cutting data, stock, depth, entry, bore (camfab.gcode.toolpath)
 
