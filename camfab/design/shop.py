@@ -14,11 +14,12 @@ from dataclasses import dataclass
 from enum import StrEnum
 from typing import Any
 
+from ..limits import MAX_DEPTH_LEVELS
 from ..tolerances import DEFAULT_EXPORT_TOL_MM, MAX_EXPORT_TOL_MM, MIN_EXPORT_TOL_MM
 from .validator import Validator
 
 __all__ = ["POSTS", "Post", "ManufacturingSpec", "MachiningSpec", "OutputsSpec", "AssemblySpec", "ASSEMBLY_KEYS",
-           "manufacturing_section", "machining_section", "outputs_section", "assembly_section"]
+           "manufacturing_section", "machining_section", "outputs_section", "assembly_section", "depth_problems"]
 
 
 class Post(StrEnum):
@@ -237,3 +238,19 @@ def assembly_section(v: Validator, t: Mapping[str, Any]) -> AssemblySpec:
     v.keys(t, tuple(ASSEMBLY_KEYS), "assembly")
     return AssemblySpec(**{k: v.number(t, k, "assembly", None, lo=0.0, lo_open=True, hi=hi)
                            for k, hi in ASSEMBLY_KEYS.items()})
+
+
+def depth_problems(v: Validator, mfg: ManufacturingSpec, machining: MachiningSpec,
+                   groove_depth_mm: float | None = None) -> None:
+    """The depths the plate is cut to: in at most :data:`~camfab.limits.MAX_DEPTH_LEVELS` step-downs
+    (``docs/decisions.md``, "Input limits"), and a groove that leaves a floor — its depth below the plate thickness
+    (``docs/decisions.md``, "Groove cams")."""
+    depth, step = mfg.thickness_mm + machining.breakthrough_mm, machining.step_down_mm
+    if depth / step > MAX_DEPTH_LEVELS:
+        v.add("machining.step_down_mm", step, f"cuts the {depth:g} mm depth (plate and breakthrough) in more than "
+              f"{MAX_DEPTH_LEVELS} depth levels (the input limit)",
+              f"give a step-down of at least {depth / MAX_DEPTH_LEVELS:.3g} mm")
+    if groove_depth_mm is not None and groove_depth_mm >= mfg.thickness_mm:
+        v.add("follower.groove_depth_mm", groove_depth_mm, f"must be smaller than the plate thickness "
+              f"([manufacturing] thickness_mm = {mfg.thickness_mm:g} mm): the groove needs a floor",
+              f"give groove_depth_mm < {mfg.thickness_mm:g}, or a thicker plate")

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ..errors import Problem, SpecError
-from ..limits import MAX_DEPTH_LEVELS, MAX_LENGTH_MM, MAX_LIFT_MM, MAX_SEGMENTS, data_problems
+from ..limits import MAX_LENGTH_MM, MAX_LIFT_MM, MAX_SEGMENTS, data_problems
 from ..units import DEG, RPM
 from .drawing import DrawingSpec, drawing_section
 from .kinds import CamKind, Direction, FollowerMotion, FollowerType, LiftUnit, Rotation
@@ -34,6 +34,7 @@ from .shop import (
     ManufacturingSpec,
     OutputsSpec,
     assembly_section,
+    depth_problems,
     machining_section,
     manufacturing_section,
     outputs_section,
@@ -323,8 +324,7 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
     out = outputs_section(v, v.table(data, "outputs"))
     machining = machining_section(v, v.table(data, "machining"))
     assembly = assembly_section(v, v.table(data, "assembly"))
-    _depth_levels(v, mfg, machining)
-    _groove_depth(v, fol, mfg)
+    depth_problems(v, mfg, machining, fol.groove_depth_mm)
     drawing = drawing_section(v, v.table(data, "drawing"), mfg.tolerance_mm)
     checks = v.table(data, "checks")
     v.keys(checks, _CHECK_KEYS, "checks")
@@ -339,25 +339,6 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
                       vibration=vibration_section(v, data, cam.kind, fol.motion),
                       sizing=sizing_section(v, v.table(data, "sizing")),
                       optimise=optimise_section(v, v.table(data, "optimise")) if "optimise" in data else None)
-
-
-def _depth_levels(v: Validator, mfg: ManufacturingSpec, machining: MachiningSpec) -> None:
-    """The plate cut in at most :data:`~camfab.limits.MAX_DEPTH_LEVELS` step-downs (``docs/decisions.md``,
-    "Input limits")."""
-    depth, step = mfg.thickness_mm + machining.breakthrough_mm, machining.step_down_mm
-    if depth / step > MAX_DEPTH_LEVELS:
-        v.add("machining.step_down_mm", step, f"cuts the {depth:g} mm depth (plate and breakthrough) in more than "
-              f"{MAX_DEPTH_LEVELS} depth "
-              "levels (the input limit)", f"give a step-down of at least {depth / MAX_DEPTH_LEVELS:.3g} mm")
-
-
-def _groove_depth(v: Validator, fol: FollowerSpec, mfg: ManufacturingSpec) -> None:
-    """A groove must leave a floor: its depth below the plate thickness (docs/decisions.md, "Groove cams")."""
-    depth = fol.groove_depth_mm
-    if depth is not None and depth >= mfg.thickness_mm:
-        v.add("follower.groove_depth_mm", depth, f"must be smaller than the plate thickness "
-              f"([manufacturing] thickness_mm = {mfg.thickness_mm:g} mm): the groove needs a floor",
-              f"give groove_depth_mm < {mfg.thickness_mm:g}, or a thicker plate")
 
 
 # ---------------------------------------------------------------------------

@@ -267,9 +267,7 @@ def equioscillate(model: SpanModel, knots: np.ndarray, iters: int = _EQUI_ITERS)
                 A, C, d = A2, C2, d2
                 improved, lin = True, None
                 break
-        if not improved:
-            # the extrema already share one level (within _EQUI_LEVEL): the model's minimax is reached, and more
-            # damping would only buy a fraction of that spread (the Levenberg steps after it were wasted)
+        if not improved:  # extrema level within _EQUI_LEVEL: minimax reached, more damping buys only that spread
             lam *= 4.0
             if lam > 10.0 or level_spread <= _EQUI_LEVEL:
                 break
