@@ -306,3 +306,19 @@ def test_toml_text_loads_or_is_refused(tmp_path_factory, text):
             assert str(exc)
             return
     assert spec.name is not None
+
+
+@pytest.mark.parametrize("speed", [1e300, 1e7, float("inf")])
+def test_a_knot_table_speed_beyond_the_bound_is_refused_by_name(speed):
+    """Hypothesis found speed_rpm = 1e300 with a table in time units overflowing ω² (OverflowError, not a problem
+    naming the field): the table's speed has the bound of [cam] speed_rpm."""
+    from camfab.design.spec import design_from_dict
+    from camfab.errors import SpecError
+    rows = [[0.0, 0.0, 0.0, 0.0], [180.0, 0.01, 0.0, 0.0], [360.0, 0.0, 0.0, 0.0]]
+    data = {"name": "k", "cam": {"kind": "disc"},
+            "follower": {"type": "roller", "motion": "translating", "base_radius_mm": 40.0, "roller_radius_mm": 8.0},
+            "motion_table": {"rows": rows, "units": {"angle": "deg", "s": "m", "v": "m/s", "a": "m/s2"},
+                             "speed_rpm": speed}}
+    with pytest.raises(SpecError) as e:
+        design_from_dict(data)
+    assert "motion_table.speed_rpm" in {p.path for p in e.value.problems}

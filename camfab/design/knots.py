@@ -99,6 +99,9 @@ UNITS: dict[str, tuple[str, ...]] = {
 }
 COLUMNS = ("angle", "s", "v", "a", "j")
 TABLE_KEYS = ("rows", "file", "units", "speed_rpm", "degree")
+#: the largest ``speed_rpm`` of a knot table: that of ``[cam] speed_rpm`` (past it ω³ overflows a float for a
+#: table in time units)
+MAX_TABLE_SPEED_RPM = 1e6
 #: two knot values are "equal" (360° row = 0° row) within this relative tolerance
 CLOSURE_REL_TOL = 1e-9
 #: default ratio of implied peak to knot values above which a segment is flagged
@@ -367,8 +370,9 @@ def _omega_from(speed: Any, units: Mapping[str, str], degree: int, path: str,
                                     "need the design speed", "add speed_rpm = the camshaft speed the table "
                                     "was written for, or give v, a in mm/deg or mm/rad"))
         return float("nan")
-    if not _is_real(speed) or not math.isfinite(speed) or speed <= 0:
-        problems.append(Problem(p, speed, "speed_rpm must be a finite number > 0", "give the speed in rpm"))
+    if not _is_real(speed) or not math.isfinite(speed) or not 0 < speed <= MAX_TABLE_SPEED_RPM:
+        problems.append(Problem(p, speed, f"speed_rpm must be a number > 0 and <= {MAX_TABLE_SPEED_RPM:g} (the bound "
+                                "of [cam] speed_rpm)", "give the speed in rpm"))
         return float("nan")
     return rpm_to_rad_s(float(speed))
 
