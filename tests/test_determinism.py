@@ -47,3 +47,23 @@ def test_every_artifact_identical_on_one_and_two_threads(tmp_path, example):
     two = _run(example, tmp_path / "two", 2, 2)
     assert len(one) >= 8, one  # every kind was written (several files per kind for some)
     assert one == two, sorted(k for k in one if one.get(k) != two.get(k))
+
+
+@pytest.mark.slow
+def test_a_conjugate_pair_step_is_the_same_after_other_work_in_the_process(tmp_path):
+    """OpenCascade numbers the usage occurrences of a compound from a counter of the process: the pair's STEP
+    written after another cam's assembly in the same process (a package worker) had other ids than in a fresh
+    process (found by the golden manifest).  camfab numbers them in file order."""
+    code = ("import sys; from camfab.cli import main\n"
+            "for i, ex in enumerate(sys.argv[2:]):\n"
+            "    main(['run', ex, '-o', sys.argv[1] + '-' + str(i), '--outputs', 'step,assembly'])\n")
+    script = tmp_path / "s"
+    runs = {"fresh": ["ejemplo8da_conjugate"], "after": ["ejemplo9rt", "ejemplo8da_conjugate"]}
+    digests = {}
+    for key, examples in runs.items():
+        p = subprocess.run([sys.executable, "-c", code, str(script) + key, *examples],
+                           env={**os.environ, "PYTHONPATH": str(ROOT)}, capture_output=True, text=True, timeout=1200)
+        assert p.returncode == 0, p.stderr
+        pair = Path(f"{script}{key}-{len(examples) - 1}") / "Ejemplo8DA_pair.step"
+        digests[key] = hashlib.sha256(pair.read_bytes()).hexdigest()
+    assert digests["fresh"] == digests["after"]

@@ -436,7 +436,6 @@ def dumps(spec, geometry, outlines: Sequence[ArcChain], x: float, *, meta: StepM
 
 _ENTITY = re.compile(r"^#(\d+) = (.*?);$", re.S | re.M)
 _REF = re.compile(r"#(\d+)")
-_NAUO = re.compile(r"NEXT_ASSEMBLY_USAGE_OCCURRENCE\('[^']*'")
 
 
 def canonical_order(text: str) -> str:
@@ -447,8 +446,9 @@ def canonical_order(text: str) -> str:
     presentation entities are renumbered from the groups sorted by their content (each entity spelled out with
     what it uses), in pre-order, so a shared colour takes its number at its first use.  Any other layout is left
     as it is."""
-    counter = iter(range(1, 1 << 30))
-    text = _NAUO.sub(lambda m: f"NEXT_ASSEMBLY_USAGE_OCCURRENCE('{next(counter)}'", text)
+    from .step import canonical_occurrences
+
+    text = canonical_occurrences(text)
     head, sep, data = text.partition("DATA;")
     body, end, tail = data.partition("ENDSEC;")
     ents = [(int(m.group(1)), m.group(2)) for m in _ENTITY.finditer(body)]

@@ -94,7 +94,18 @@ def _export(solid, name: str, meta: StepMeta | None = None) -> str:
     text = header_dumps(text, name, meta)  # camfab's header: name, organisation, reproducible timestamp
     product = step_string(name)  # the full name, as an ISO 10303-21 string (a function: no backslash expansion)
     text = re.sub(r"Open CASCADE STEP translator [0-9.]+ [0-9]+", lambda m: product, text)
-    return canonical_reals(text)
+    return canonical_reals(canonical_occurrences(text))
+
+
+_NAUO = re.compile(r"NEXT_ASSEMBLY_USAGE_OCCURRENCE\('[^']*'")
+
+
+def canonical_occurrences(text: str) -> str:
+    """``text`` with its usage occurrences (the solids of a compound, the parts of an assembly) numbered 1, 2 …
+    in file order: OpenCascade numbers them from a counter of the process, so a conjugate pair written after
+    another file in the same process (a ``package`` worker, a script) had other ids than in a fresh one."""
+    counter = iter(range(1, 1 << 30))
+    return _NAUO.sub(lambda m: f"NEXT_ASSEMBLY_USAGE_OCCURRENCE('{next(counter)}'", text)
 
 
 def canonical_reals(text: str) -> str:
