@@ -503,6 +503,8 @@ def _map(fn: Callable, items: list, jobs: int) -> Generator[dict, None, None]:
         return
     # "spawn": a forked worker can deadlock on locks held by threads of the parent (OCCT, browsers)
     ctx = multiprocessing.get_context("spawn")
+    tracker = _resource_tracker()
+    ours = tracker is not None and getattr(tracker, "_fd", 0) is None  # the pool starts it: the pool ends it
     pool = ProcessPoolExecutor(max_workers=min(jobs, len(items), os.cpu_count() or 1), mp_context=ctx,
                                initializer=_worker_init, initargs=(os.getpid(),))
     before = set(multiprocessing.active_children())
@@ -514,6 +516,25 @@ def _map(fn: Callable, items: list, jobs: int) -> Generator[dict, None, None]:
         _stop(pool, [p for p in multiprocessing.active_children() if p not in before])
         raise
     pool.shutdown()
+    del pool
+    if ours:  # the pool's semaphores are gone: its tracker has nothing left to watch
+        _end_resource_tracker(tracker)
+
+
+def _resource_tracker():
+    """multiprocessing's resource tracker (CPython's; None elsewhere)."""
+    from multiprocessing import resource_tracker
+
+    return getattr(resource_tracker, "_resource_tracker", None)
+
+
+def _end_resource_tracker(tracker) -> None:
+    """End the resource tracker the pool started (for its semaphores) now, not just after this process:
+    ``package --jobs 2`` leaves no process in its group when it exits."""
+    stop = getattr(tracker, "_stop", None)
+    if stop is not None:
+        with contextlib.suppress(Exception):
+            stop()
 
 
 def _stop(pool: ProcessPoolExecutor, workers: list) -> None:
