@@ -169,7 +169,7 @@ def build_cam(job: Job) -> dict:
     """Worker: build one cam from bytes and return its manifest entry with the files' bytes (``entry["output"]``:
     name → bytes, deviations, shop file names); nothing is written outside a temporary folder, so any machine
     can run it (the parent writes: :func:`_commit`).  Never raises but on an interrupt: errors go into the entry."""
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     entry: dict = {"source": job.source, "key": job.key, "rebuilt": True}
     back: Callable[[str], str] = str
     try:
@@ -197,6 +197,7 @@ def build_cam(job: Job) -> dict:
         _failed(entry, exc, back)
     entry.setdefault("name", job.name)
     entry["seconds"] = time.perf_counter() - t0
+    entry["cpu_seconds"] = time.process_time() - c0  # of the whole worker process meanwhile
     return entry
 
 

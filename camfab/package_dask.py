@@ -24,7 +24,7 @@ from typing import Any
 
 from .errors import InputError, MissingDependencyError
 
-__all__ = ["dask_executor", "LOCAL_CONFIG", "CONNECT_TIMEOUT_S", "parse_config", "executor_options"]
+__all__ = ["dask_executor", "LOCAL_CONFIG", "NO_DASHBOARD", "CONNECT_TIMEOUT_S", "parse_config", "executor_options"]
 
 #: seconds to reach the scheduler, and for it to have a worker, before giving up (exit 3, nothing written)
 CONNECT_TIMEOUT_S = 10.0
@@ -65,6 +65,10 @@ def executor_options(executor: str, scheduler: str | None, workers: int | None, 
     if executor == "builtin":
         return {}
     return {"executor": executor, "scheduler": scheduler, "dask_workers": workers, "dask_config": parse_config(config)}
+
+
+#: the scheduler of a local cluster: no dashboard, its HTTP server on a free port (not Dask's 8787)
+NO_DASHBOARD = {"dashboard": False, "dashboard_address": ":0"}
 
 
 def parse_config(items: list[str] | None) -> dict[str, Any]:
@@ -112,8 +116,8 @@ def dask_executor(scheduler: str | None, workers: int | None, config: Mapping[st
     with dask.config.set(settings), contextlib.ExitStack() as stack:
         if scheduler is None:
             cluster = stack.enter_context(distributed.LocalCluster(
-                n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                silence_logs=logging.ERROR))
+                n_workers=workers, threads_per_worker=1, processes=True, silence_logs=logging.ERROR,
+                dashboard_address=None, scheduler_kwargs=NO_DASHBOARD))
             client = stack.enter_context(distributed.Client(cluster, set_as_default=False))
         else:
             client = stack.enter_context(_connect(distributed, scheduler))

@@ -24,7 +24,7 @@ ROOT = Path(__file__).resolve().parents[1]
 #: outputs of these tests: a drawing, a spreadsheet and a program, quick to make
 OUTPUTS = "dxf,xlsx,gcode"
 #: the parts of an entry that depend on the run, not on the cam
-RUN_KEYS = ("seconds", "timings", "rebuilt")
+RUN_KEYS = ("seconds", "cpu_seconds", "timings", "rebuilt")
 
 
 @pytest.fixture(scope="module")
@@ -35,11 +35,11 @@ def cluster():
                                                             "(pip install camfab[dask])")
     import dask
 
-    from camfab.package_dask import LOCAL_CONFIG
+    from camfab.package_dask import LOCAL_CONFIG, NO_DASHBOARD
 
     with dask.config.set(LOCAL_CONFIG):  # read when the scheduler and the nannies start
         c = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
-                                     silence_logs=logging.CRITICAL)
+                                     scheduler_kwargs=NO_DASHBOARD, silence_logs=logging.CRITICAL)
     try:
         yield c
     finally:
