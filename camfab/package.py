@@ -504,8 +504,7 @@ def _map(fn: Callable, items: list, jobs: int) -> Generator[dict, None, None]:
         return
     # "spawn": a forked worker can deadlock on locks held by threads of the parent (OCCT, browsers)
     ctx = multiprocessing.get_context("spawn")
-    tracker = _resource_tracker()
-    ours = tracker is not None and getattr(tracker, "_fd", 0) is None  # the pool starts it: the pool ends it
+    tracker = _idle_resource_tracker()
     pool = ProcessPoolExecutor(max_workers=min(jobs, len(items), os.cpu_count() or 1), mp_context=ctx,
                                initializer=_worker_init, initargs=(os.getpid(),))
     before = set(multiprocessing.active_children())
@@ -518,24 +517,18 @@ def _map(fn: Callable, items: list, jobs: int) -> Generator[dict, None, None]:
         raise
     pool.shutdown()
     del pool
-    if ours:  # the pool's semaphores are gone: its tracker has nothing left to watch
-        _end_resource_tracker(tracker)
+    if tracker is not None:  # the pool's semaphores are gone: the tracker it started has nothing to watch
+        with contextlib.suppress(Exception):
+            tracker._stop()
 
 
-def _resource_tracker():
-    """multiprocessing's resource tracker (CPython's; None elsewhere)."""
+def _idle_resource_tracker():
+    """multiprocessing's resource tracker (CPython's) when it is not running yet: the pool starts it for its
+    semaphores and ends it with itself, so that ``package --jobs 2`` leaves no process in its group at exit."""
     from multiprocessing import resource_tracker
 
-    return getattr(resource_tracker, "_resource_tracker", None)
-
-
-def _end_resource_tracker(tracker) -> None:
-    """End the resource tracker the pool started (for its semaphores) now, not just after this process:
-    ``package --jobs 2`` leaves no process in its group when it exits."""
-    stop = getattr(tracker, "_stop", None)
-    if stop is not None:
-        with contextlib.suppress(Exception):
-            stop()
+    tracker = getattr(resource_tracker, "_resource_tracker", None)
+    return tracker if getattr(tracker, "_fd", 0) is None and hasattr(tracker, "_stop") else None
 
 
 def _stop(pool: ProcessPoolExecutor, workers: list) -> None:
