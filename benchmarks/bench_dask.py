@@ -6,11 +6,11 @@ Generates N designs (:func:`bench_package.design`), then times, each into a fres
 * ``dask-local``: ``--executor dask-local --dask-workers W`` with camfab's worker settings
   (:data:`camfab.package_dask.LOCAL_CONFIG`);
 * ``dask-defaults``: the same with Dask's own defaults put back (``--dask-config``: the statistical profiler on,
-  ``MALLOC_TRIM_THRESHOLD_=65536``, worker saturation 1.1, 3 allowed failures);
+  ``MALLOC_TRIM_THRESHOLD_=65536``, the monitors' intervals, worker saturation 1.1, 3 allowed failures);
 * ``dask-profiler`` and ``dask-trim``: camfab's settings with only the profiler, or only the memory trimming,
   of Dask's defaults: which of them matters (docs/decisions.md, "Dask executor");
-* ``dask-quiet``: camfab's settings with the workers' periodic work (event-loop ticks, memory and system
-  monitors) slowed down to 1 s / 5 s.
+* ``dask-monitors``: camfab's settings with Dask's intervals of the workers' periodic work put back (event-loop
+  ticks 20 ms, memory monitor 100 ms, system monitor 500 ms; camfab: 1 s, 1 s, 5 s).
 
 Reports per run the wall time of the process, the build's own wall time (the manifest's ``wall_seconds``: after
 the cluster has started), the CPU time of the process and its children (user + system), the ratio to
@@ -37,13 +37,13 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_package import OUTPUTS, design  # noqa: E402
 
-DEFAULTS = ["distributed.worker.profile.enabled=true",
-            "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_=65536",
-            "distributed.scheduler.worker-saturation=1.1", "distributed.scheduler.allowed-failures=3"]
-PROFILER, TRIM = DEFAULTS[:1], DEFAULTS[1:2]
-#: the worker's own periodic work slowed down: event-loop ticks, memory monitor, system monitor
-QUIET = ["distributed.admin.tick.interval=1s", "distributed.worker.memory.monitor-interval=1s",
-         "distributed.admin.system-monitor.interval=5s"]
+PROFILER = ["distributed.worker.profile.enabled=true"]
+TRIM = ["distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_=65536"]
+#: Dask's intervals of the worker's own periodic work: event-loop ticks, memory monitor, system monitor
+MONITORS = ["distributed.admin.tick.interval=20ms", "distributed.worker.memory.monitor-interval=100ms",
+            "distributed.admin.system-monitor.interval=500ms"]
+DEFAULTS = PROFILER + TRIM + MONITORS + ["distributed.scheduler.worker-saturation=1.1",
+                                         "distributed.scheduler.allowed-failures=3"]
 
 
 def variants(workers: int) -> dict[str, list[str]]:
@@ -52,7 +52,7 @@ def variants(workers: int) -> dict[str, list[str]]:
             "dask-defaults": local + [f"--dask-config={c}" for c in DEFAULTS],
             "dask-profiler": local + [f"--dask-config={c}" for c in PROFILER],
             "dask-trim": local + [f"--dask-config={c}" for c in TRIM],
-            "dask-quiet": local + [f"--dask-config={c}" for c in QUIET]}
+            "dask-monitors": local + [f"--dask-config={c}" for c in MONITORS]}
 
 
 def run(src: Path, out: Path, args: list[str], outputs: str) -> tuple[float, float, float, float]:

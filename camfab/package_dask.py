@@ -10,7 +10,8 @@ scheduler's ``distributed.scheduler.allowed-failures``, set to 1 for ``dask-loca
 ``KilledWorker`` and the cam is recorded as failed (error kind ``worker``, exit status 3), the others built.
 
 Worker settings (docs/decisions.md, "Dask executor"): for ``dask-local`` camfab applies :data:`LOCAL_CONFIG`
-(Dask's statistical profiler off, glibc's own memory trimming, one task per worker process, one BLAS thread),
+(Dask's statistical profiler off, glibc's own memory trimming, the workers' periodic monitors slowed down, one
+task per worker process, one BLAS thread),
 overridden by the caller's ``config`` (``--dask-config KEY=VALUE``).  A remote cluster keeps its own settings
 (give its workers the same ones); ``config`` then only affects this client.
 """
@@ -39,6 +40,11 @@ LOCAL_CONFIG: dict[str, Any] = {
     "distributed.nanny.pre-spawn-environ.OMP_NUM_THREADS": 1,
     "distributed.nanny.pre-spawn-environ.OPENBLAS_NUM_THREADS": 1,
     "distributed.nanny.pre-spawn-environ.MKL_NUM_THREADS": 1,
+    # the workers' own periodic work beside the task: event-loop health ticks (20 ms), memory monitor (100 ms),
+    # system monitor (500 ms) -- 15 % more CPU in the cams on 4 cams (docs/decisions.md, "Dask executor")
+    "distributed.admin.tick.interval": "1s",
+    "distributed.worker.memory.monitor-interval": "1s",
+    "distributed.admin.system-monitor.interval": "5s",
     # a cam whose worker dies is retried once; a worker holds only the cam it runs (a death loses only it)
     "distributed.scheduler.allowed-failures": 1,
     "distributed.scheduler.worker-saturation": 1.0,
