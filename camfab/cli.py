@@ -404,6 +404,14 @@ def _package_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--jobs", type=int, default=1, help="designs built in parallel (processes)")
     p.add_argument("--outputs", metavar="LIST", help="comma list overriding every design's [outputs]")
     p.add_argument("--force", action="store_true", help="write shop artifacts even for unacceptable designs")
+    p.add_argument("--executor", choices=("builtin", "dask", "dask-local"), default="builtin",
+                   help="where the cams are built: camfab's process pool (default), a Dask cluster (--scheduler), "
+                        "or a local Dask cluster (--dask-workers); Dask needs pip install camfab[dask]")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="the Dask scheduler's address (with --executor dask)")
+    p.add_argument("--dask-workers", type=int, metavar="N", help="worker processes of --executor dask-local "
+                   "(default: one per CPU)")
+    p.add_argument("--dask-config", action="append", metavar="KEY=VALUE",
+                   help="a Dask setting over camfab's (repeatable), e.g. distributed.worker.profile.enabled=true")
 
 
 @register("package", "many designs in parallel: per-cam folders, index.html, manifest.json, incremental",
@@ -416,9 +424,12 @@ def cmd_package(args: argparse.Namespace) -> int:
     missing = [p for p in args.paths if not Path(p).exists()]
     if missing:
         raise UsageError(f"no such file or folder: {missing[0]}")
+    from .package_dask import executor_options
+
+    dask = executor_options(args.executor, args.scheduler, args.dask_workers, args.dask_config, args.jobs)
     manifest = package(args.paths, args.output, jobs=args.jobs, outputs=outputs_list(args.outputs),
                        force=args.force, progress=lambda m: print(m, file=sys.stderr),
-                       allow_outside_files=args.allow_outside_files)
+                       allow_outside_files=args.allow_outside_files, **dask)
     cams = manifest["cams"]
     rebuilt = sum(1 for c in cams if c.get("rebuilt"))
     bad = [c for c in cams if c.get("status") == "error"]

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import itertools
 import json
 import logging
 import multiprocessing
@@ -42,31 +43,36 @@ import os
 import shutil
 import signal
 import sys
+import tempfile
 import threading
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Generator, Iterable, Sequence
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any
 
 from .assets import templates_hash
 from .design.spec import DesignSpec
-from .errors import ExportError, MissingDependencyError
+from .errors import ApiError, CamfabError, ExportError, InternalError, MissingDependencyError
 from .formats import load_design
-from .io import atomic_write, hold_sigint, inside, leftover_name, output_folder, safe_stem, swap_dir
-from .pipeline import Cam, Output, Request, run, shop_file_names
+from .io import atomic_write, hold_sigint, inside, leftover_name, output_folder, safe_stem, swap_dir, write_all
+from .pipeline import Cam, Output, Request, RunResult, build_files, shop_file_names
 from .report.overview import cam_summary, index_html
 from .results import Verdict
 from .textsafe import bounded, plain
 from .threads import blas_single_threaded
 from .version import __version__
 
-__all__ = ["discover", "folders", "input_key", "package", "exit_status", "MANIFEST", "INDEX", "DRAWING_SET"]
+__all__ = ["discover", "folders", "input_key", "package", "exit_status", "build_cam", "Job", "EXECUTORS",
+           "MANIFEST", "INDEX", "DRAWING_SET"]
 
 MANIFEST = "manifest.json"
 INDEX = "index.html"
 #: the package's drawing set: a contents page, then every cam's sheet (:func:`camfab.cad.pdf.write_drawing_set`)
 DRAWING_SET = "drawings.pdf"
+#: where the cams are built: camfab's own process pool, or Dask (:mod:`camfab.package_dask`)
+EXECUTORS = ("builtin", "dask", "dask-local")
 
 log = logging.getLogger(__name__)
 
@@ -132,63 +138,130 @@ def input_key(sources: Sequence[str | Path], options: dict, templates: str) -> s
     return h.hexdigest()
 
 
-def _read(path: Path, allow_outside_files: bool = False) -> tuple[DesignSpec | None, tuple[str | Path, ...]]:
-    """The design's spec and the files it was built from; (None, the file) when it cannot be read
-    (the build then records why)."""
+def _read(path: Path, allow_outside_files: bool = False) -> tuple[DesignSpec | None, tuple[str | Path, ...],
+                                                                   Exception | None]:
+    """The design's spec and the files it was built from; (None, the file, why) when it cannot be read (its
+    entry then records why, without a worker)."""
     try:
         spec = load_design(path, allow_outside_files=allow_outside_files)
-    except Exception as exc:  # any failure is reported by the build of this design, with the others kept
+    except Exception as exc:  # any failure is reported in this design's entry, with the others kept
         log.info("%s cannot be read (%s: %s); its key hashes the file alone", path, type(exc).__name__, exc)
-        return None, (path,)
-    return spec, spec.sources
+        return None, (path,), exc
+    return spec, spec.sources, None
 
 
-def _build(args: tuple) -> dict:
-    """Worker: build one design into a staging folder and swap it in as ``out/<stem>/``; never raises
-    (errors go into the entry; an interrupt does, after the staging folder is removed)."""
-    path, out, options, key, spec, stem, recorded = args
-    from .errors import ApiError, CamfabError, InternalError
+@dataclass(frozen=True)
+class Job:
+    """One cam to build, as a worker receives it: the design's bytes and those of the files it references
+    (``inputs``: (path as the parent knows it, bytes), the design first), the job options, its input key and
+    folder; ``spec`` only when it is built in the parent's own process (then not read again)."""
 
-    t0 = time.perf_counter()
-    entry = {"source": str(path), "key": key, "rebuilt": True}
-    staging = folder = None
+    source: str
+    name: str
+    stem: str
+    key: str
+    options: dict
+    inputs: tuple[tuple[str, bytes], ...]
+    spec: DesignSpec | None = None
+
+
+def build_cam(job: Job) -> dict:
+    """Worker: build one cam from bytes and return its manifest entry with the files' bytes (``entry["output"]``:
+    name → bytes, deviations, shop file names); nothing is written outside a temporary folder, so any machine
+    can run it (the parent writes: :func:`_commit`).  Never raises but on an interrupt: errors go into the entry."""
+    t0, c0 = time.perf_counter(), time.process_time()
+    entry: dict = {"source": job.source, "key": job.key, "rebuilt": True}
+    back: Callable[[str], str] = str
     try:
-        allow = bool(options.get("allow_outside_files"))
-        spec = spec if spec is not None else load_design(Path(path), allow_outside_files=allow)
-        entry["name"] = spec.name
-        folder = inside(out, stem)
-        staging = inside(out, leftover_name(folder.name, "staging"))
-        shutil.rmtree(staging, ignore_errors=True)
-        outputs = options.get("outputs")
-        req = Request.from_design(spec, outputs, force=options.get("force") or None,
-                                  post="linuxcnc" if outputs is not None else None)
-        if Output.PDF in req.outputs:  # the drawing set's page is rendered from the sheet: keep it beside the PDF
-            req = replace(req, outputs=req.outputs | {Output.DRAWING})
-        cam = Cam(spec)
-        res = run(cam, staging, req, lock=False)
-        _keep_other_files(folder, staging, Path(out), recorded, shop_file_names(cam))
-        swap_dir(staging, folder)
+        with contextlib.ExitStack() as stack:
+            spec = job.spec
+            if spec is None:  # the design read again from its bytes, its knot files beside it as on the disk
+                design, back = _unpack(job.inputs, Path(stack.enter_context(tempfile.TemporaryDirectory(
+                    prefix="camfab-design-"))))
+                spec = load_design(design, allow_outside_files=bool(job.options.get("allow_outside_files")))
+            entry["name"] = spec.name
+            outputs = job.options.get("outputs")
+            req = Request.from_design(spec, outputs, force=job.options.get("force") or None,
+                                      post="linuxcnc" if outputs is not None else None)
+            if Output.PDF in req.outputs:  # the drawing set's page is rendered from the sheet: keep it beside the PDF
+                req = replace(req, outputs=req.outputs | {Output.DRAWING})
+            cam = Cam(spec)
+            res = RunResult(cam.name, "", tol=cam.tolerance(req.tol))
+            files = build_files(cam, req, res, lambda m: None)
         entry.update(status="unacceptable" if res.verdict == Verdict.UNACCEPTABLE else "ok", verdict=str(res.verdict),
                      tolerance_mm=res.tol, withheld=res.withheld, skipped=res.skipped, timings=res.timings,
-                     folder=str(folder.relative_to(out)),
-                     files=[_file_entry(folder / n, Path(out), res.deviations.get(n)) for n in sorted(res.files)])
+                     folder=job.stem, files=[])
         entry.update(cam_summary(spec, cam.geometry, cam.check(), res.deviations.values()))
-    except (ApiError, InternalError) as exc:  # bugs of camfab: recorded as internal failures
-        _internal_error(entry, exc)
-    except (CamfabError, OSError, ValueError) as exc:
-        kind = "io" if isinstance(exc, OSError) else "dependency" if isinstance(exc, MissingDependencyError) \
-            else "input"
-        error = str(exc) if staging is None else str(exc).replace(str(staging), str(folder))
-        entry.update(status="error", verdict=None, error=bounded(error), files=[], error_type=type(exc).__name__,
-                     error_kind=kind)
-    except Exception as exc:  # an internal failure on one design must not lose the others
-        _internal_error(entry, exc)
+        entry["output"] = {"files": files, "deviations": res.deviations, "shop": sorted(shop_file_names(cam))}
+    except Exception as exc:  # contained: one design's failure must not lose the others
+        _failed(entry, exc, back)
+    entry.setdefault("name", job.name)
+    entry["seconds"] = time.perf_counter() - t0
+    entry["cpu_seconds"] = time.process_time() - c0  # of the whole worker process meanwhile
+    return entry
+
+
+def _unpack(inputs: Sequence[tuple[str, bytes]], root: Path) -> tuple[Path, Callable[[str], str]]:
+    """Write the design and its knot files under ``root``, in the same places relative to each other; returns
+    the design's path there and a function putting its real folder back into a message."""
+    where = [Path(os.path.abspath(p)) for p, _ in inputs]
+    base = Path(os.path.commonpath([w.parent for w in where]))
+    for w, (_, data) in zip(where, inputs, strict=True):
+        local = root / w.relative_to(base)
+        local.parent.mkdir(parents=True, exist_ok=True)
+        local.write_bytes(data)
+    design = root / where[0].relative_to(base)
+    here, there = str(design.parent), str(Path(inputs[0][0]).parent)
+
+    def back(text: str) -> str:
+        return text.replace(here + os.sep, "" if there == "." else there + os.sep).replace(here, there)
+
+    return design, back
+
+
+def _commit(entry: dict, out: Path, recorded: frozenset[str]) -> dict:
+    """Parent: write a built cam's files into a staging folder, carry over the files camfab did not write, swap
+    it in as ``out/<folder>/`` and list the files in the entry; an error goes into the entry."""
+    made = entry.pop("output", None)
+    if made is None:  # the build failed: nothing to write
+        return entry
+    t0 = time.perf_counter()
+    folder = staging = None
+    try:
+        folder = inside(out, entry["folder"])
+        staging = inside(out, leftover_name(folder.name, "staging"))
+        shutil.rmtree(staging, ignore_errors=True)
+        files = made["files"]
+        write_all({inside(staging, n): files[n] for n in sorted(files)})
+        _keep_other_files(folder, staging, out, recorded, set(made["shop"]))
+        swap_dir(staging, folder)
+        entry["files"] = [_file_entry(folder / n, out, files[n], made["deviations"].get(n)) for n in sorted(files)]
+    except Exception as exc:  # contained, like a failure of the build
+        where = str(staging) if staging is not None else None
+        _failed(entry, exc, (lambda t: t.replace(where, str(folder))) if where else str)
     finally:
         if staging is not None:
             shutil.rmtree(staging, ignore_errors=True)
-    entry.setdefault("name", Path(path).stem)
-    entry["seconds"] = time.perf_counter() - t0
+    entry["seconds"] = entry.get("seconds", 0.0) + time.perf_counter() - t0
     return entry
+
+
+def _failed(entry: dict, exc: Exception, back: Callable[[str], str] = str) -> None:
+    """Record why a design could not be built: an input, I/O or dependency error with its message (``back``
+    names the real files), any other exception as an internal failure."""
+    if isinstance(exc, (ApiError, InternalError)) or not isinstance(exc, (CamfabError, OSError, ValueError)):
+        _internal_error(entry, exc)  # bugs of camfab: recorded as internal failures
+        return
+    kind = "io" if isinstance(exc, OSError) else "dependency" if isinstance(exc, MissingDependencyError) else "input"
+    entry.update(status="error", verdict=None, error=bounded(back(str(exc))), files=[], error_type=type(exc).__name__,
+                 error_kind=kind)
+
+
+def _lost(job: Job, reason: str) -> dict:
+    """The entry of a cam whose worker was lost (:mod:`camfab.package_dask`): an error of kind ``worker``."""
+    return {"source": job.source, "key": job.key, "rebuilt": True, "name": job.name, "status": "error",
+            "verdict": None, "files": [], "error_type": "WorkerLost", "error_kind": "worker",
+            "error": bounded(reason), "seconds": 0.0}
 
 
 def _keep_other_files(folder: Path, staging: Path, out: Path, recorded: frozenset[str], shop: set[str]) -> None:
@@ -223,8 +296,7 @@ def _internal_error(entry: dict, exc: Exception) -> None:
                  traceback=traceback.format_exc())
 
 
-def _file_entry(p: Path, out: Path, dev) -> dict:
-    data = p.read_bytes()
+def _file_entry(p: Path, out: Path, data: bytes, dev) -> dict:
     return {"path": str(p.relative_to(out)), "sha256": _sha(data), "bytes": len(data), "deviation_mm": dev}
 
 
@@ -240,19 +312,44 @@ def _still_valid(entry: dict, out: Path) -> bool:
 
 def package(paths: Iterable[str | Path], out: str | Path, *, jobs: int = 1, outputs: Sequence[str] | None = None,
             force: bool = False, progress: Callable[[str], None] | None = None,
-            allow_outside_files: bool = False) -> dict:
+            allow_outside_files: bool = False, executor: str = "builtin", scheduler: str | None = None,
+            dask_workers: int | None = None, dask_config: dict | None = None) -> dict:
     """Build every design; returns the manifest (also written to ``out/manifest.json``).
 
     ``outputs`` replaces every design's ``[outputs]`` (None: each design's own); ``force`` writes the shop
     outputs of unacceptable designs too; ``allow_outside_files`` lets designs read knot files outside their
     folders.  ``out`` is created, proved writable and locked before any design is read
-    (:func:`camfab.io.output_folder`: an ``OSError`` naming it otherwise)."""
-    with output_folder(out) as folder:
-        return _package(paths, folder, jobs, outputs, force, progress or (lambda m: None), allow_outside_files)
+    (:func:`camfab.io.output_folder`: an ``OSError`` naming it otherwise).
+
+    ``executor`` (:data:`EXECUTORS`): ``builtin``, camfab's process pool of ``jobs`` processes; ``dask``, the
+    Dask cluster whose scheduler is at ``scheduler``; ``dask-local``, a local Dask cluster of ``dask_workers``
+    processes (:mod:`camfab.package_dask`; ``dask_config``: Dask settings over camfab's).  Dask is connected to
+    before ``out`` is touched."""
+    if executor not in EXECUTORS:
+        raise ValueError(f"executor {executor!r}: must be one of {', '.join(EXECUTORS)}")
+    with contextlib.ExitStack() as stack:
+        if executor == "builtin":
+            def runner(items: list[Job]) -> Generator[dict, None, None]:
+                return _map(build_cam, items, jobs)
+        else:
+            from .package_dask import dask_executor
+
+            mapper = stack.enter_context(dask_executor(scheduler if executor == "dask" else None, dask_workers,
+                                                       dask_config or {}))
+
+            def runner(items: list[Job]) -> Generator[dict, None, None]:
+                return mapper(build_cam, [replace(j, spec=None) for j in items], _lost)
+        folder = stack.enter_context(output_folder(out))
+        return _package(paths, folder, runner, {"jobs": jobs, "executor": executor}, outputs, force,
+                        progress or (lambda m: None), allow_outside_files)
 
 
-def _package(paths: Iterable[str | Path], out: Path, jobs: int, outputs: Sequence[str] | None, force: bool,
-             say: Callable[[str], None], allow_outside_files: bool) -> dict:
+#: builds a list of jobs, yielding their entries as they are done
+Runner = Callable[[list[Job]], Generator[dict, None, None]]
+
+
+def _package(paths: Iterable[str | Path], out: Path, runner: Runner, meta: dict,
+             outputs: Sequence[str] | None, force: bool, say: Callable[[str], None], allow_outside_files: bool) -> dict:
     options = {"outputs": sorted(outputs) if outputs is not None else None, "force": force}
     designs = discover(paths)
     old = _old_entries(out)
@@ -263,28 +360,35 @@ def _package(paths: Iterable[str | Path], out: Path, jobs: int, outputs: Sequenc
         options["allow_outside_files"] = True
         opts = {**opts, "allow_outside_files": True}
     read = [(p, *_read(p, allow_outside_files)) for p in designs]
-    stems = folders([safe_stem(spec.name if spec is not None else p.stem) for p, spec, _ in read])
-    todo: list[tuple] = []
+    stems = folders([safe_stem(spec.name if spec is not None else p.stem) for p, spec, _, _ in read])
+    todo: list[Job] = []
+    unreadable: list[dict[str, Any]] = []
     entries: dict[str, dict] = {}
-    for (p, spec, sources), stem in zip(read, stems, strict=True):
+    for (p, spec, sources, error), stem in zip(read, stems, strict=True):
         key = input_key(sources, opts, templates) if p.is_file() else "missing"
         prev = old.get(str(p))
         if prev and prev.get("key") == key and prev.get("folder") == stem and _still_valid(prev, out):
             entries[str(p)] = {**prev, "rebuilt": False}
             say(f"[up to date] {plain(str(prev.get('name', p.stem)))}")
+        elif spec is None:  # its entry records why, as a worker's would
+            bad: dict[str, Any] = {"source": str(p), "key": key, "rebuilt": True}
+            _failed(bad, error or OSError(f"{p}: cannot be read"))
+            unreadable.append({**bad, "name": p.stem, "seconds": 0.0})
         else:
-            todo.append((str(p), str(out), options, key, spec, stem, recorded))
-    if jobs > 1 and len(todo) > 1:  # worker processes read their design again (a program does not pickle)
-        todo = [(*t[:4], None, *t[5:]) for t in todo]
+            todo.append(Job(str(p), spec.name, stem, key, options,
+                            tuple((str(f), Path(f).read_bytes()) for f in sources if Path(f).is_file()), spec))
+    if len(todo) > 1:  # worker processes read their design again from its bytes (a program does not pickle)
+        todo = [replace(j, spec=None) for j in todo]
     t0 = time.perf_counter()
-    with contextlib.closing(_map(_build, todo, jobs)) as results:
-        for done, entry in enumerate(results, 1):
+    total = len(todo) + len(unreadable)
+    with contextlib.closing(runner(todo)) as results:
+        for done, built in enumerate(itertools.chain(unreadable, results), 1):
+            entry = _commit(built, out, recorded)
             entries[entry["source"]] = entry
             first = (entry.get("error") or "").split("\n", 1)[0]  # an empty error has no first line to index
             tail = entry.get("verdict") or f"ERROR: {first}"
-            say(f"{_bar(done, len(todo))} {done}/{len(todo)} {plain(entry['name'])}: {tail} "
-                f"({entry['seconds']:.2f} s)")
-    manifest = {"camfab_version": __version__, "jobs": jobs, "wall_seconds": time.perf_counter() - t0,
+            say(f"{_bar(done, total)} {done}/{total} {plain(entry['name'])}: {tail} ({entry['seconds']:.2f} s)")
+    manifest = {"camfab_version": __version__, **meta, "wall_seconds": time.perf_counter() - t0,
                 "cams": [entries[str(p)] for p in designs]}
     _remove_stale(out, old, manifest)
     failed: list[OSError] = []
@@ -394,12 +498,13 @@ def _bar(done: int, total: int, width: int = 20) -> str:
     return "[" + "#" * k + "-" * (width - k) + "]"
 
 
-def _map(fn, items: list, jobs: int):
+def _map(fn: Callable, items: list, jobs: int) -> Generator[dict, None, None]:
     if jobs <= 1 or len(items) <= 1:
         yield from map(fn, items)
         return
     # "spawn": a forked worker can deadlock on locks held by threads of the parent (OCCT, browsers)
     ctx = multiprocessing.get_context("spawn")
+    tracker = _idle_resource_tracker()
     pool = ProcessPoolExecutor(max_workers=min(jobs, len(items), os.cpu_count() or 1), mp_context=ctx,
                                initializer=_worker_init, initargs=(os.getpid(),))
     before = set(multiprocessing.active_children())
@@ -411,6 +516,19 @@ def _map(fn, items: list, jobs: int):
         _stop(pool, [p for p in multiprocessing.active_children() if p not in before])
         raise
     pool.shutdown()
+    del pool
+    if tracker is not None:  # the pool's semaphores are gone: the tracker it started has nothing to watch
+        with contextlib.suppress(Exception):
+            tracker._stop()
+
+
+def _idle_resource_tracker():
+    """multiprocessing's resource tracker (CPython's) when it is not running yet: the pool starts it for its
+    semaphores and ends it with itself, so that ``package --jobs 2`` leaves no process in its group at exit."""
+    from multiprocessing import resource_tracker
+
+    tracker = getattr(resource_tracker, "_resource_tracker", None)
+    return tracker if getattr(tracker, "_fd", 0) is None and hasattr(tracker, "_stop") else None
 
 
 def _stop(pool: ProcessPoolExecutor, workers: list) -> None:
@@ -470,9 +588,10 @@ def _old_entries(out: Path) -> dict:
 
 
 def exit_status(manifest: dict) -> int:
-    """3 if any design could not be written (an I/O error, a missing dependency), else 2 if any design is
-    invalid, else 1 if any is unacceptable, else 0."""
+    """3 if any design could not be written (an I/O error, a missing dependency, its Dask worker lost), else 2 if
+    any design is invalid, else 1 if any is unacceptable, else 0."""
     st = [e.get("status") for e in manifest["cams"]]
-    if any(e.get("status") == "error" and e.get("error_kind") in ("io", "dependency") for e in manifest["cams"]):
+    if any(e.get("status") == "error" and e.get("error_kind") in ("io", "dependency", "worker")
+           for e in manifest["cams"]):
         return 3
     return 2 if "error" in st else 1 if "unacceptable" in st else 0

@@ -14,6 +14,7 @@ command-line flags.
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import math
@@ -38,8 +39,8 @@ from .io import atomic_write, inside, output_folder, safe_stem, write_all
 from .limits import MAX_SIZE_OVER_TOL
 from .results import CheckReport, IssueCode, Severity, Verdict
 
-__all__ = ["Output", "SHOP_OUTPUTS", "Request", "RunResult", "Cam", "EXPORTERS", "gcode_job", "run", "load",
-           "examples", "shop_file_names"]
+__all__ = ["Output", "SHOP_OUTPUTS", "Request", "RunResult", "Cam", "EXPORTERS", "gcode_job", "run", "build_files",
+           "load", "examples", "shop_file_names"]
 
 
 class Output(StrEnum):
@@ -540,13 +541,23 @@ def run(cam: Cam, outdir: str | Path, req: Request, *, progress: Callable[[str],
     """
     say = progress or (lambda m: None)
     res = RunResult(cam.name, "", tol=cam.tolerance(req.tol))
-    if not lock:
-        return _run(cam, Path(outdir), req, res, say)
-    with output_folder(outdir) as folder:
-        return _run(cam, folder, req, res, say)
+    with output_folder(outdir) if lock else contextlib.nullcontext(Path(outdir)) as folder:
+        files = build_files(cam, req, res, say)
+        paths = {name: inside(folder, name) for name in files}  # every path proved inside outdir before any write
+        names = sorted(files)
+        written = write_all({paths[n]: files[n] for n in names})
+        res.files = dict(zip(names, written, strict=True))
+        if res.verdict == Verdict.UNACCEPTABLE and not req.force:  # no shop file beside an unacceptable verdict
+            poses = {p.name for p in folder.glob(f"{safe_stem(cam.name)}_assembly_pose*.step")}  # any --poses N
+            res.removed = [name for name in sorted(shop_file_names(cam) | poses) if (folder / name).is_file()]
+            for name in res.removed:
+                (folder / name).unlink(missing_ok=True)
+        return res
 
 
-def _run(cam: Cam, folder: Path, req: Request, res: RunResult, say: Callable[[str], None]) -> RunResult:
+def build_files(cam: Cam, req: Request, res: RunResult, say: Callable[[str], None]) -> dict[str, bytes]:
+    """The files ``req`` asks for, by name, not written (:func:`run` writes them; ``package`` workers return them);
+    ``res`` gets the verdict, the withheld and skipped outputs, the deviations and the timings."""
     report = _timed(res, "check", say, cam.check)
     res.verdict = report.verdict
     wanted = [o for o in EXPORTERS if o in req.outputs]
@@ -569,16 +580,7 @@ def _run(cam: Cam, folder: Path, req: Request, res: RunResult, say: Callable[[st
             files[art.filename] = art.data
             if art.kind != "report":
                 res.deviations[art.filename] = art.deviation_mm
-    paths = {name: inside(folder, name) for name in files}  # every path proved inside outdir before any write
-    names = sorted(files)
-    written = write_all({paths[n]: files[n] for n in names})
-    res.files = dict(zip(names, written, strict=True))
-    if refused:  # a shop must never find G-code beside an unacceptable verdict
-        poses = {p.name for p in folder.glob(f"{safe_stem(cam.name)}_assembly_pose*.step")}  # any --poses N
-        res.removed = [name for name in sorted(shop_file_names(cam) | poses) if (folder / name).is_file()]
-        for name in res.removed:
-            (folder / name).unlink(missing_ok=True)
-    return res
+    return files
 
 
 def shop_file_names(cam: Cam) -> set[str]:

@@ -44,7 +44,9 @@ LAYERS: dict[str, tuple[str, ...]] = {
                                "camfab.formats", "camfab.cad", "camfab.gcode", "camfab.report", "camfab.assets",
                                "camfab.pipeline"),
     "camfab.package": BASE + ("camfab.io", "camfab.design", "camfab.formats", "camfab.pipeline",
-                              "camfab.assets", "camfab.package", "camfab.cad", "camfab.report"),
+                              "camfab.assets", "camfab.package", "camfab.package_dask", "camfab.cad",
+                              "camfab.report"),
+    "camfab.package_dask": BASE,  # Dask imported inside its functions only
     "camfab.cli": ("camfab",),
     "camfab.terminal": (),
     "camfab.__main__": ("camfab.cli",),

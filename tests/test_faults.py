@@ -212,6 +212,20 @@ def test_kill_9_of_package_takes_its_workers_along(designs, tmp_path):
 
 
 @linux_only
+@pytest.mark.slow
+def test_package_with_two_jobs_leaves_no_process_behind(designs, tmp_path):
+    """When ``package --jobs 2`` has exited, nothing of it is left in its process group: not its workers, not
+    multiprocessing's resource tracker (which used to outlive it for a moment)."""
+    (designs / "ejemplo10ex.toml").unlink()
+    (designs / "ejemplo11ro.toml").unlink()
+    p = subprocess.Popen([sys.executable, "-m", "camfab", "package", str(designs), "-o", str(tmp_path / "out"),
+                          "--jobs", "2", "--outputs", "xlsx"], cwd=tmp_path, env=ENV, start_new_session=True,
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    assert p.wait(300) == 0
+    assert _group(p.pid) == []
+
+
+@linux_only
 def test_a_worker_whose_parent_is_already_gone_exits():
     """The race the worker initializer closes: the parent died before the worker asked to die with it."""
     code = "import sys; from camfab.package import _worker_init; _worker_init(1); print('still here')"

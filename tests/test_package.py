@@ -144,14 +144,14 @@ def test_package_examples_library(tmp_path):
 def test_internal_error_on_one_design_does_not_lose_the_others(designs, tmp_path, monkeypatch):
     import camfab.package
 
-    real = camfab.package.run
+    real = camfab.package.build_files
 
     def flaky(cam, *a, **k):
         if cam.name == "Ejemplo1RT":
             raise RuntimeError("simulated bug")
         return real(cam, *a, **k)
 
-    monkeypatch.setattr(camfab.package, "run", flaky)
+    monkeypatch.setattr(camfab.package, "build_files", flaky)
     out = tmp_path / "out"
     assert main(["package", str(designs), "-o", str(out), "--outputs", "dxf", "--jobs", "1"]) == 2
     cams = {c["name"]: c for c in _manifest(out)["cams"]}

@@ -92,7 +92,8 @@ def _outline(spec, geometry, n: int = 241) -> dict | None:
             "stroke": num(size / 120.0)}
 
 
-_ERROR_LABEL = {"io": "I/O error", "dependency": "missing dependency", "internal": "internal error"}
+_ERROR_LABEL = {"io": "I/O error", "dependency": "missing dependency", "internal": "internal error",
+                "worker": "worker lost"}
 _VERDICTS = (("acceptable", "acceptable"), ("not_for_high_speed", "not for high speed"),
              ("unacceptable", "unacceptable"), ("error", "failed"))
 #: file groups of the index, in order: (label, test on the file's path relative to the cam folder)
