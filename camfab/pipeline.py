@@ -20,7 +20,7 @@ import logging
 import math
 import time
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from enum import StrEnum
 from pathlib import Path
 from typing import Any
@@ -330,40 +330,18 @@ def examples() -> list[str]:
 # ---------------------------------------------------------------------------
 # the G-code job: [machining], overridden by the command line
 def gcode_job(spec: DesignSpec, *, tol: float, overrides: Mapping[str, Any] | None = None) -> Any:
-    """The :class:`camfab.gcode.Job` of a design: ``[manufacturing]`` tool, thickness, material and bore and
-    ``[machining]``, each value replaced by ``overrides[key]`` when given (not None); ``tool_diameter_mm``
-    and ``material`` may be overridden too.  Cutting data the design does not give come from the cutting-data table
-    (:func:`camfab.gcode.model.job_from_machining`).
+    """The :class:`camfab.gcode.Job` of a design, ``overrides`` (the command line) applied:
+    :func:`camfab.gcode.model.design_job`."""
+    from .gcode.model import design_job
 
-    Raises
-    ------
-    SpecError
-        No tool diameter, or a job value out of range.
-    """
-    from .gcode.model import job_from_machining
-
-    over = {k: v for k, v in (overrides or {}).items() if v is not None}
-    m = replace(spec.machining, **{k: v for k, v in over.items() if k not in _MFG_OVERRIDES})
-    tool = over.get("tool_diameter_mm", spec.manufacturing.tool_diameter_mm)
-    if not tool:
-        raise SpecError(Problem("manufacturing.tool_diameter_mm", None, "G-code needs a tool",
-                                "add tool_diameter_mm to [manufacturing] (or give --tool-diameter)"), spec.source)
-    mfg = spec.manufacturing
-    m = replace(m, breakthrough_mm=0.0, mill_bore=False) if spec.cam.kind == "groove" else m  # a slot (README)
-    return job_from_machining(m, tool_diameter_mm=tool, thickness_mm=spec.follower.groove_depth_mm or mfg.thickness_mm,
-                              material=over.get("material", mfg.material),
-                              bore_mm=mfg.bore_mm, stock_shape="plate" if spec.is_translating_cam else "round",
-                              tolerance_mm=tol, design_name=spec.name, source=spec.source)
+    return design_job(spec, tol=tol, overrides=overrides)
 
 
 def machining_of(spec: DesignSpec, overrides: Mapping[str, Any] | None = None) -> Any:
     """``[machining]`` with the given overrides applied (None values ignored)."""
-    over = {k: v for k, v in (overrides or {}).items() if v is not None and k not in _MFG_OVERRIDES}
-    return replace(spec.machining, **over)
+    from .gcode.model import machining_of as of
 
-
-#: the overrides of gcode_job that are [manufacturing] values, not [machining] ones
-_MFG_OVERRIDES = ("tool_diameter_mm", "material")
+    return of(spec, overrides)
 
 
 # ---------------------------------------------------------------------------

@@ -7,7 +7,9 @@ finally written in: the post-processor converts (``Job.units``).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from typing import Any
 
 from camfab.design.shop import MachiningSpec
 from camfab.errors import Problem, SpecError
@@ -16,7 +18,7 @@ from camfab.limits import MAX_DEPTH_LEVELS
 from camfab.tolerances import MAX_EXPORT_TOL_MM, MIN_EXPORT_TOL_MM
 
 __all__ = ["Rapid", "Feed", "Arc", "Comment", "ToolChange", "Spindle", "Coolant", "CutterComp", "Item", "Job",
-           "Program", "job_from_machining"]
+           "Program", "job_from_machining", "design_job", "machining_of"]
 
 
 @dataclass(frozen=True)
@@ -413,3 +415,38 @@ class Program:
     notes: tuple = ()
     #: what is milled, for the header: the periphery, or a groove's slot (camfab.gcode.groove)
     milled: str = "outside contour"
+
+
+#: the overrides of :func:`design_job` that are [manufacturing] values, not [machining] ones
+_MFG_OVERRIDES = ("tool_diameter_mm", "material")
+
+
+def machining_of(spec: Any, overrides: Mapping[str, Any] | None = None) -> MachiningSpec:
+    """A design's ``[machining]`` with the given overrides applied (None values ignored)."""
+    over = {k: v for k, v in (overrides or {}).items() if v is not None and k not in _MFG_OVERRIDES}
+    return replace(spec.machining, **over)
+
+
+def design_job(spec: Any, *, tol: float, overrides: Mapping[str, Any] | None = None) -> Job:
+    """The :class:`Job` of a validated design: ``[manufacturing]`` tool, thickness, material and bore and
+    ``[machining]``, each value replaced by ``overrides[key]`` when given (not None); ``tool_diameter_mm``
+    and ``material`` may be overridden too.  Cutting data the design does not give come from the cutting-data table
+    (:func:`job_from_machining`).  A groove cam's job mills a slot: to the groove depth, no breakthrough, no bore.
+
+    Raises
+    ------
+    SpecError
+        No tool diameter, or a job value out of range.
+    """
+    over = {k: v for k, v in (overrides or {}).items() if v is not None}
+    m = machining_of(spec, over)
+    tool = over.get("tool_diameter_mm", spec.manufacturing.tool_diameter_mm)
+    if not tool:
+        raise SpecError(Problem("manufacturing.tool_diameter_mm", None, "G-code needs a tool",
+                                "add tool_diameter_mm to [manufacturing] (or give --tool-diameter)"), spec.source)
+    mfg = spec.manufacturing
+    m = replace(m, breakthrough_mm=0.0, mill_bore=False) if spec.cam.kind == "groove" else m  # a slot (README)
+    return job_from_machining(m, tool_diameter_mm=tool, thickness_mm=spec.follower.groove_depth_mm or mfg.thickness_mm,
+                              material=over.get("material", mfg.material),
+                              bore_mm=mfg.bore_mm, stock_shape="plate" if spec.is_translating_cam else "round",
+                              tolerance_mm=tol, design_name=spec.name, source=spec.source)
