@@ -10,7 +10,13 @@ same run.  ``--steep`` times, instead, the steep designs of issue 12 (a 10 mm ri
 turning at 0.9995× the cam speed, knots 1e-6° apart with a 1 µm step) with their peak traced allocation: the
 cost of a check must not grow with how steep the design is (docs/decisions.md, "Search budgets").
 
-Run:  python3 benchmarks/bench_check.py [--repeat 7] [--baseline | --steep]
+``--process`` times, instead, ``python -m camfab check EXAMPLE`` as a whole process (interpreter start,
+imports, reading, checking, printing) for every built-in example: CPU time (user + system, from
+``getrusage`` of the child, the measure a loaded machine disturbs least) and wall time, best of ``--repeat``,
+against the goal of 0.35 s (issue 15).  ``--root DIR`` runs the camfab found in DIR instead (a checkout to
+compare with).
+
+Run:  python3 benchmarks/bench_check.py [--repeat 7] [--baseline | --steep | --process [--root DIR]]
 """
 from __future__ import annotations
 
@@ -121,6 +127,49 @@ def steep(repeat: int) -> None:
         print(f"  {name:30}{best * 1e3:9.1f} ms {peak / 2**20:7.1f} MB  {answer}")
 
 
+PROCESS_TARGET_S = 0.35
+
+
+def process_timings(repeat: int, root: str | None) -> dict[str, tuple[float, float]]:
+    """{example: (best CPU s, best wall s)} of ``python -m camfab check EXAMPLE`` as a whole process."""
+    import os
+    import resource
+    import subprocess
+    import tempfile
+
+    # bytecode cached as in an installed package (a checkout run with PYTHONDONTWRITEBYTECODE would
+    # compile every module on every start); one untimed run per example fills the cache.  The runs start in
+    # `cache`, not in a checkout, whose ./camfab `python -m` would import first.
+    cache = tempfile.mkdtemp(prefix="camfab-pyc-")
+    env = dict(os.environ, PYTHONPATH=root or str(HERE.parent), PYTHONPYCACHEPREFIX=cache)
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    examples = [name for name, _ in _api()[0]]
+    out = {}
+    for name in examples:
+        cpu = wall = math.inf
+        for i in range(repeat + 1):
+            before = resource.getrusage(resource.RUSAGE_CHILDREN)
+            t0 = time.perf_counter()
+            subprocess.run([sys.executable, "-m", "camfab", "check", name], env=env, cwd=cache,
+                           stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=False)
+            if i == 0:
+                continue
+            wall = min(wall, time.perf_counter() - t0)
+            after = resource.getrusage(resource.RUSAGE_CHILDREN)
+            cpu = min(cpu, after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
+        out[name] = (cpu, wall)
+    return out
+
+
+def process(repeat: int, root: str | None) -> None:
+    t = process_timings(repeat, root)
+    print(f"python -m camfab check EXAMPLE as a process, best of {repeat}; goal <= {PROCESS_TARGET_S:g} s CPU")
+    for name, (cpu, wall) in t.items():
+        print(f"  {name:28}{cpu:7.3f} s CPU {wall:7.3f} s wall" + ("" if cpu <= PROCESS_TARGET_S else "  MISSED"))
+    worst = max(c for c, _ in t.values())
+    print(f"slowest {worst:.3f} s CPU: {'OK' if worst <= PROCESS_TARGET_S else 'MISSED'}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=7)
@@ -128,7 +177,12 @@ def main() -> None:
     ap.add_argument("--rounds", type=int, default=2)
     ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--steep", action="store_true", help="time the steep designs of issue 12 instead")
+    ap.add_argument("--process", action="store_true", help="time `python -m camfab check` as a whole process")
+    ap.add_argument("--root", default=None, help="with --process: the checkout whose camfab runs")
     a = ap.parse_args()
+    if a.process:
+        process(a.repeat, a.root)
+        return
     if a.steep:
         steep(a.repeat)
         return

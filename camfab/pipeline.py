@@ -27,12 +27,11 @@ from typing import Any
 
 import numpy as np
 
-from .cad.export import Artifact, CamShapes, build_artifacts, cam_shapes
+from .cad.artifact import Artifact, CamShapes, build_artifacts, cam_shapes, validate_tol
 from .design.assemble import check_design, mechanism_from_spec
 from .design.mechanisms import geometry_from_spec
 from .design.profile import CamGeometry, ProfileSample
 from .design.spec import DesignSpec
-from .discretize import validate_tol
 from .errors import GeometryError, InputError, MissingDependencyError, Problem, SpecError
 from .formats import EXAMPLES_DIR, load_design, resolve_design_path
 from .io import atomic_write, inside, output_folder, safe_stem, write_all

@@ -11,13 +11,12 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from ..design.kinds import ContactKind
-from ..discretize import ArcDiscretisation, arcs, arcs_within_radius, measure_deviation, validate_tol
+from ..discretize import arcs, arcs_within_radius, measure_deviation, validate_tol
 from ..discretize.curve import discontinuities
 from ..discretize.tolerance import within
 from ..errors import GeometryError
@@ -27,6 +26,7 @@ from ..offset.cutter import pitch_curve, profile_curve, tool_centre_path
 from ..tolerances import arc_radius_limit
 from . import dxf as dxf_mod
 from . import step, stl
+from .artifact import Artifact, CamShapes
 from .plate import PlateSpec, bore_loop
 from .stepheader import design_meta
 
@@ -35,35 +35,6 @@ __all__ = ["Artifact", "CamShapes", "cam_shapes", "build_artifacts", "write_arti
 FORMATS = ("dxf", "step", "stl")
 
 log = logging.getLogger(__name__)
-
-
-@dataclass(frozen=True)
-class Artifact:
-    """One file to write: name, bytes, and what was measured about it."""
-
-    filename: str
-    data: bytes
-    kind: str
-    entities: int | None = None
-    deviation_mm: float | None = None
-    note: str = ""
-
-
-@dataclass(frozen=True)
-class CamShapes:
-    """Arc chains of every profile (and pitch curve) of a cam, each with its measured deviation (mm)."""
-
-    profiles: tuple[ArcDiscretisation, ...]
-    pitch: tuple[ArcChain, ...]
-    curves: tuple  # exact ParametricCurve of each profile
-    tol: float
-    #: the two flanks of one groove cam's plate (camfab.cad.groove), not one plate per profile
-    groove: bool = False
-
-    @property
-    def profile_deviation(self) -> tuple[float, ...]:
-        """The measured deviation of every profile's arc chain from its exact curve (mm)."""
-        return tuple(float(p.max_deviation) for p in self.profiles)
 
 
 def cam_shapes(geometry, *, tol: float, with_pitch: bool = True) -> CamShapes:

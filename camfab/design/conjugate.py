@@ -45,8 +45,10 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from ..brent import brentq
 from ..errors import ApiError, Problem
 from ..numeric import extremum
+from ..sets import sorted_unique
 from .faces import OscillatingFlat, OscillatingFlatContact, TranslatingFlat, TranslatingFlatContact
 from .kinds import CamKind, FollowerMotion, FollowerType
 from .mechanism import Mechanism, finite_fields, require_rotation
@@ -305,7 +307,7 @@ def _margin(mech: _Desmodromic, program, h: float, q: float, rmin: float, explai
     f = (lambda t: c._inner.evaluate(t).rho) if flat else (lambda t: -c._inner.evaluate(t).curvature_pitch)
     if flat or c.roller_radius > 0:
         if coarse:
-            xs = np.unique(np.r_[np.linspace(edges[0], edges[-1], 1441), edges])
+            xs = sorted_unique(np.r_[np.linspace(edges[0], edges[-1], 1441), edges])
             v = f(xs)
             i = int(np.argmin(v))
             x, val = xs[i], v[i]
@@ -350,8 +352,6 @@ def follower_limits(mechanism: _Desmodromic, program, *, bore_mm: float | None =
     i = next((j for j in np.flatnonzero(vals > 0) if g(grid[j]) > 0), None)
     if i is None:
         return math.nan, math.nan
-    from scipy.optimize import brentq  # here, not at module level: scipy.optimize is half of camfab's import time
-
     xt = 1e-12 * max(1.0, abs(grid[-1]))
     a = grid[i - 1] if i else lo0
     lo = brentq(g, a, grid[i], xtol=xt) if g(a) < 0 else a

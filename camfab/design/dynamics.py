@@ -60,6 +60,7 @@ from ..results import (
     Preload,
     Severity,
 )
+from ..sets import sorted_unique
 from ..units import DEG, RPM
 from .conjugate import DesmodromicGeometry
 from .profile import CamGeometry, Contact
@@ -359,7 +360,7 @@ def analyse_dynamics(geometry: CamGeometry, loads: Loads, speed: float, *, prelo
                          "a force-closed cam has one follower; pass form_closed=True for a conjugate pair")
     c = geometry.profiles[0]
     dyn = pair_of(geometry, loads, speed) if form_closed else ContactDynamics(c, loads, speed)
-    edges = np.unique(np.concatenate([c.breakpoints, np.mod(c.breakpoints - math.pi, 2 * math.pi)])) \
+    edges = sorted_unique(np.concatenate([c.breakpoints, np.mod(c.breakpoints - math.pi, 2 * math.pi)])) \
         if form_closed and len(geometry.profiles) == 1 else geometry.breakpoints
     found, ranges = _searches(dyn, form_closed, loads.safety_force_n, edges, c.closed)
 

@@ -57,6 +57,8 @@ from typing import Any
 
 import numpy as np
 
+from ..brent import brentq
+
 __all__ = [
     "horner",
     "Law",
@@ -187,8 +189,6 @@ class Law:
         return hit
 
     def _scan_roots(self, nu: int, lo: float, hi: float) -> list[float]:
-        from scipy.optimize import brentq
-
         def d(t: float) -> float:
             return self.scalar(t, nu)
 

@@ -63,6 +63,7 @@ import numpy as np
 from ..errors import ApiError, InputError, SpecError
 from ..geom2d import cross, dot
 from ..numeric import extrema, integrate
+from ..sets import sorted_unique
 from .kinds import Axis, ContactKind
 
 __all__ = [
@@ -359,7 +360,7 @@ class CamGeometry:
     @property
     def breakpoints(self) -> np.ndarray:
         """Union of every profile's breakpoints (radians, or mm), 0 and period included."""
-        return np.unique(np.concatenate([c.breakpoints for c in self.profiles]))
+        return sorted_unique(np.concatenate([c.breakpoints for c in self.profiles]))
 
     def evaluate(self, phi, profile: int = 0) -> ProfileSample:
         """Evaluate profile ``profile`` at cam angles ``phi`` (radians, any real; (n,))."""

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
+from ..sets import sorted_unique
 from ..tolerances import CONTINUITY_REL_TOL
 from .evaluation import Grouped, by_segment
 from .extrema import Junction, Peak, exact_peaks, junctions, sampled_peaks
@@ -98,7 +99,7 @@ class MotionProgram:
         for s in self.segments:
             if s.breaks:
                 pts.append(s.start + s.span * np.asarray(s.breaks))
-        return np.unique(np.concatenate(pts))
+        return sorted_unique(np.concatenate(pts))
 
     def segment_index(self, x: np.ndarray) -> np.ndarray:
         """Index of the segment containing each ``x`` (already reduced to [0, period))."""

@@ -14,17 +14,27 @@ Examples
 """
 from __future__ import annotations
 
-from .compare import render_comparison
-from .html import render_report, write_files
-from .plots import (
-    curvature_figure,
-    face_position_figure,
-    figure_bytes,
-    pressure_angle_figure,
-    profile_figure,
-    report_figures,
-    svaj_figure,
-)
+from importlib import import_module
+from typing import Any
+
+#: each public name and the submodule that defines it, imported on first access (PEP 562), so that
+#: ``camfab check`` (which needs only :mod:`camfab.report.text`) loads no page or figure code
+_WHERE = {"render_comparison": "compare", "render_report": "html", "write_files": "html",
+          **dict.fromkeys(("curvature_figure", "face_position_figure", "figure_bytes", "pressure_angle_figure",
+                           "profile_figure", "report_figures", "svaj_figure"), "plots")}
 
 __all__ = ["render_report", "render_comparison", "write_files", "figure_bytes", "svaj_figure", "profile_figure",
            "curvature_figure", "pressure_angle_figure", "face_position_figure", "report_figures"]
+
+
+def __getattr__(name: str) -> Any:
+    where = _WHERE.get(name)
+    if where is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(import_module(f"{__name__}.{where}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted([*globals(), *__all__])

@@ -28,6 +28,7 @@ from ..errors import InputError
 from ..results import Extreme, IssueCode
 from ..textsafe import mpl_text
 from ._common import CURVATURE_CODES, Axis, axis_of, finding_spans, fmt, fmt_at, sample_grid
+from .layout import fixed_layout
 
 __all__ = ["svaj_figure", "profile_figure", "curvature_figure", "pressure_angle_figure", "face_position_figure",
            "dynamics_figure", "report_figures", "figure_bytes", "new_figure", "plot_style", "SVAJ_UNITS",
@@ -82,6 +83,10 @@ def figure_bytes(fig, fmt: str = "png") -> bytes:
     """
     buf = io.BytesIO()
     with plot_style():
+        from matplotlib.layout_engine import ConstrainedLayoutEngine
+
+        if isinstance(fig.get_layout_engine(), ConstrainedLayoutEngine):
+            fixed_layout(fig)  # measured once, then fixed: a second format reuses it
         if fmt == "png":
             fig.savefig(buf, format="png", metadata={"Software": None})
         elif fmt == "svg":

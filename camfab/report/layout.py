@@ -1,0 +1,121 @@
+"""A report figure's layout measured once from its own texts, then fixed: one draw per saved file.
+
+matplotlib's constrained layout draws a figure once without output and measures every artist's
+tight box before each save — the largest cost of a report plot.  Here the margins come from the
+texts that need room — tick labels (their strings from each axis's locator and formatter), axis
+labels, titles, the suptitle and a legend outside the axes — measured with the canvas's renderer;
+the axes are placed by their grid's parameters (as ``subplots_adjust`` would) and the layout engine is
+turned off (docs/decisions.md "Plot layout").  Figures are one column of axes (the report's shapes).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["fixed_layout"]
+
+#: breathing room at each figure edge and between stacked axes (points)
+_EDGE_PT = 5.0
+
+
+def _size(renderer, text: str, prop) -> tuple[float, float]:
+    """(width, height) of ``text`` in points."""
+    if not text:
+        return 0.0, 0.0
+    w, h, _ = renderer.get_text_width_height_descent(text, prop, ismath=False)
+    k = 72.0 / renderer.dpi
+    return w * k, h * k
+
+
+def _tick_labels(axis) -> list[str]:
+    """The major tick labels the axis will draw (its locator's ticks inside the view, formatted)."""
+    lo, hi = sorted(axis.get_view_interval())
+    locs = np.asarray(axis.get_majorticklocs(), dtype=float)
+    span = (hi - lo) or 1.0
+    locs = locs[(locs >= lo - 1e-9 * span) & (locs <= hi + 1e-9 * span)]
+    return [s for s in axis.get_major_formatter().format_ticks(list(locs)) if s]
+
+
+def _tick_room(renderer, axis, vertical: bool) -> float:
+    """Points taken beside the axes by an axis's tick marks and labels (0 when its labels are hidden)."""
+    tick = axis.get_major_ticks(numticks=1)[0]
+    if not tick.label1.get_visible():
+        return 0.0
+    sizes = [_size(renderer, s, tick.label1.get_fontproperties()) for s in _tick_labels(axis)]
+    text = max((w if vertical else h for w, h in sizes), default=0.0)
+    return text + tick.get_tick_padding() + tick.get_pad()
+
+
+def _overhang(renderer, axis) -> float:
+    """Points an x axis's end tick labels reach past the axes' sides (half the widest label)."""
+    tick = axis.get_major_ticks(numticks=1)[0]
+    if not tick.label1.get_visible():
+        return 0.0
+    prop = tick.label1.get_fontproperties()
+    return max((_size(renderer, s, prop)[0] for s in _tick_labels(axis)), default=0.0) / 2
+
+
+def _label_room(renderer, label) -> float:
+    """Points taken by an axis label (its height: y labels are turned)."""
+    text = label.get_text()
+    return _size(renderer, text, label.get_fontproperties())[1] + 4.0 if text else 0.0
+
+
+def _offset_room(renderer, axis) -> float:
+    """Points above the axes taken by a y axis's offset text ("1e6"; the titles go above it)."""
+    _tick_labels(axis)  # the formatter's offset follows its last ticks
+    text = axis.get_major_formatter().get_offset()
+    return _size(renderer, text, axis.get_offset_text().get_fontproperties())[1] + 2.0 if text else 0.0
+
+
+def _title_room(renderer, ax) -> float:
+    """Points above the axes taken by its titles (centre, left, right) and their pad."""
+    height = 0.0
+    for loc in ("center", "left", "right"):
+        text = ax.get_title(loc)
+        if text:
+            height = max(height, _size(renderer, text, _title_prop(ax, loc, text))[1])
+    return height + 6.0 if height else 0.0
+
+
+def _title_prop(ax, loc: str, text: str):
+    """The font of a title (the left and right ones found among the axes' children by their text)."""
+    if loc != "center":
+        for child in ax.get_children():
+            if child is not ax.title and getattr(child, "get_text", None) and child.get_text() == text:
+                return child.get_fontproperties()
+    return ax.title.get_fontproperties()
+
+
+def fixed_layout(fig) -> None:
+    """Place the figure's axes (one column) with margins measured from its texts; layout engine off."""
+    axes = [ax for ax in fig.axes if ax.get_visible()]
+    if not axes:
+        fig.set_layout_engine("none")
+        return
+    renderer = fig.canvas.get_renderer()
+    w_in, h_in = fig.get_size_inches()
+    left = right = 0.0
+    tops, bottoms = [], []
+    for ax in axes:
+        left = max(left, _tick_room(renderer, ax.yaxis, True) + _label_room(renderer, ax.yaxis.label))
+        legend = ax.get_legend()
+        if legend is not None and legend.get_visible():
+            right = max(right, legend.get_window_extent(renderer).width * 72.0 / fig.dpi + 0.01 * 72.0 * w_in)
+        right = max(right, _overhang(renderer, ax.xaxis))
+        tops.append(_title_room(renderer, ax) + _offset_room(renderer, ax.yaxis))
+        bottoms.append(_tick_room(renderer, ax.xaxis, False) + _label_room(renderer, ax.xaxis.label))
+    suptitle = fig.get_suptitle()
+    artist = getattr(fig, "_suptitle", None)  # matplotlib keeps the suptitle's Text there (no public getter)
+    sup = _size(renderer, suptitle, artist.get_fontproperties())[1] + 4.0 if suptitle and artist else 0.0
+    n = len(axes)
+    gap = max((bottoms[i] + tops[i + 1] for i in range(n - 1)), default=0.0) + _EDGE_PT
+    top_pt, bottom_pt = _EDGE_PT + sup + tops[0], _EDGE_PT + bottoms[-1]
+    usable = h_in * 72.0 - top_pt - bottom_pt
+    mean_h = (usable - gap * (n - 1)) / n
+    fig.set_layout_engine("none")
+    grid = axes[0].get_subplotspec().get_gridspec()
+    grid.update(left=(left + _EDGE_PT) / (72.0 * w_in), right=1.0 - (right + _EDGE_PT) / (72.0 * w_in),
+                top=1.0 - top_pt / (72.0 * h_in), bottom=bottom_pt / (72.0 * h_in),
+                hspace=gap / mean_h if n > 1 else 0.0)
+    for ax in axes:
+        ax.set_position(ax.get_subplotspec().get_position(fig))
