@@ -9,9 +9,9 @@ import math
 
 import numpy as np
 
+from ..design.vibration_results import VibrationSummary
 from ..results import FORCE_CODES, IssueCode, Verdict
 from ..textsafe import plain
-from .vibration_plot import vibration_lines
 
 __all__ = ["motion_csv", "segment_rows", "format_motion", "format_check", "VERDICT_TEXT"]
 
@@ -88,7 +88,7 @@ def format_check(spec, report) -> str:
         out.append(f"spring preload for the safety force: {pre.value:.6g} {pre.unit} (worst at {pre.at:.2f})")
         out.append("jump speed: " + ("none (the follower never leaves the cam)" if jump.value is None else
                                      f"{jump.value:.6g} {jump.unit} (first at {jump.at:.2f})"))
-    out += vibration_lines(report)
+    out += _vibration_lines(report)
     out += _strength_lines(cs)
     if report.findings:
         out += ["", "Findings:"]
@@ -175,3 +175,23 @@ def _num(v) -> str:
     if v != 0 and abs(v) < 0.01:
         return f"{v:.3g}"  # small forces and torques keep their digits
     return f"{v:.2f}" if abs(v) < 1e7 else f"{v:.5g}"
+
+
+def _vibration_lines(report) -> list[str]:
+    """The ``camfab check`` text lines of the follower vibration (none without ``[vibration]``)."""
+    v = report.vibration
+    if not isinstance(v, VibrationSummary):
+        return []
+    sep = v.separation_speed
+    f = v.contact_force
+    out = [f"follower vibration: f_n {v.natural_frequency_hz:.6g} Hz (harmonic {v.nearest_resonance_order} of "
+           f"{v.cycle_frequency_hz:.6g} Hz), zeta {v.damping_ratio:g}",
+           f"  deviation from the kinematic motion: {v.max_deviation.max:.4g} {v.lift_unit} "
+           f"(at {v.max_deviation.at_max:.2f})",
+           f"  contact force with vibration: {f.min:.6g} N (at {f.at_min:.2f}) to {f.max:.6g} N (at {f.at_max:.2f})",
+           "  separation speed: " + ("none up to 10x the design speed" if sep.value is None else
+                                     f"{sep.value:.6g} {sep.unit} (first at {sep.at:.2f})")]
+    if v.residual_amplitude is not None:
+        out.insert(2, f"  residual vibration in dwells: {v.residual_amplitude.max:.4g} {v.lift_unit} "
+                      f"(dwell from {v.residual_amplitude.at_max:.2f})")
+    return out

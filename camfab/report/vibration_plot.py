@@ -15,7 +15,7 @@ from ..textsafe import mpl_text
 from ._common import axis_of, finding_spans
 from .plots import boundaries, new_figure, plot_style, shade, x_axis
 
-__all__ = ["vibration_figure", "vibration_figures", "vibration_lines", "VIBRATION_PLOT_TEXT"]
+__all__ = ["vibration_figure", "vibration_figures", "VIBRATION_PLOT_TEXT"]
 
 #: file stem → (title, caption) of the vibration plot (merged into the report's plot texts)
 VIBRATION_PLOT_TEXT = {
@@ -91,23 +91,3 @@ def vibration_figures(spec, geometry, report) -> dict[str, Any]:
     if spec.vibration is None or spec.dynamics is None:
         return {}
     return {"vibration": vibration_figure(spec, geometry, report)}
-
-
-def vibration_lines(report) -> list[str]:
-    """The ``camfab check`` text lines of the follower vibration (none without ``[vibration]``)."""
-    v = report.vibration
-    if not isinstance(v, VibrationSummary):
-        return []
-    sep = v.separation_speed
-    f = v.contact_force
-    out = [f"follower vibration: f_n {v.natural_frequency_hz:.6g} Hz (harmonic {v.nearest_resonance_order} of "
-           f"{v.cycle_frequency_hz:.6g} Hz), zeta {v.damping_ratio:g}",
-           f"  deviation from the kinematic motion: {v.max_deviation.max:.4g} {v.lift_unit} "
-           f"(at {v.max_deviation.at_max:.2f})",
-           f"  contact force with vibration: {f.min:.6g} N (at {f.at_min:.2f}) to {f.max:.6g} N (at {f.at_max:.2f})",
-           "  separation speed: " + ("none up to 10x the design speed" if sep.value is None else
-                                     f"{sep.value:.6g} {sep.unit} (first at {sep.at:.2f})")]
-    if v.residual_amplitude is not None:
-        out.insert(2, f"  residual vibration in dwells: {v.residual_amplitude.max:.4g} {v.lift_unit} "
-                      f"(dwell from {v.residual_amplitude.at_max:.2f})")
-    return out
