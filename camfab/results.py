@@ -490,6 +490,8 @@ class CheckReport:
     area_mm2: float | None = None
     dynamics: DynamicsSummary | None = None
     initial_arm_angle_deg: float | None = None
+    #: cylindrical cams: the radii checked, the roller and its slip (``camfab.design.cylindrical``), JSON-ready
+    cylinder: dict[str, Any] | None = None
 
     @property
     def verdict(self) -> Verdict:
@@ -518,4 +520,6 @@ class CheckReport:
                     "max_radius_mm": _plain(self.max_radius_mm), "area_mm2": _plain(self.area_mm2),
                     "dynamics": part(self.dynamics), "initial_arm_angle_deg": _plain(self.initial_arm_angle_deg),
                     "x_unit": self.x_unit, "findings": [f.to_dict() for f in self.findings]})
+        if self.cylinder is not None:
+            out["cylinder"] = self.cylinder
         return out

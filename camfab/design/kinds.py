@@ -41,6 +41,7 @@ class CamKind(StrEnum):
     CONSTANT_WIDTH = "constant_width"
     CONSTANT_DIAMETER = "constant_diameter"
     TRANSLATING = "translating"
+    CYLINDRICAL = "cylindrical"
 
     @property
     def form_closed(self) -> bool:

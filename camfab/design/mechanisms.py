@@ -24,6 +24,7 @@ from .conjugate import (
     FormClosed,
 )
 from .curved import OscillatingCurved, TranslatingCurved
+from .cylindrical import FAMILIES as CYLINDRICAL_FAMILIES
 from .faces import OscillatingFlat, TranslatingFlat
 from .kinds import CamKind, FollowerMotion, FollowerType
 from .mechanism import Mechanism
@@ -77,6 +78,7 @@ MECHANISMS: dict[tuple[CamKind, FollowerType, FollowerMotion], type[Mechanism]] 
     (_CW, _FL, _T): ConstantWidthCam,
     (_CD, _RO, _T): ConstantDiameterCam,
     (_TC, _RO, _T): TranslatingCamRoller,
+    **CYLINDRICAL_FAMILIES,
 }
 
 

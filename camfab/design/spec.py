@@ -20,6 +20,7 @@ from typing import Any
 from ..errors import Problem, SpecError
 from ..limits import MAX_DEPTH_LEVELS, MAX_LENGTH_MM, MAX_LIFT_MM, MAX_SEGMENTS, data_problems
 from ..units import DEG, RPM
+from .cylindrical import CylinderSpec, cylinder_section
 from .drawing import DrawingSpec, drawing_section
 from .kinds import CamKind, Direction, FollowerMotion, FollowerType, LiftUnit, Rotation
 from .knots import KnotFile, KnotTable, build_knot_table
@@ -57,7 +58,7 @@ __all__ = [
 
 
 _TOP_KEYS = ("name", "description", "cam", "follower", "motion", "motion_table", "manufacturing", "machining",
-             "outputs", "checks", "dynamics", "assembly", "drawing")
+             "outputs", "checks", "dynamics", "assembly", "drawing", "cylinder")
 _CAM_KEYS = ("kind", "rotation", "direction", "speed_rpm", "omega_rad_s", "speed_mm_s")
 _FOLLOWER_FLOATS = ("base_radius_mm", "roller_radius_mm", "offset_mm", "pivot_distance_mm",
                     "arm_length_mm", "face_offset_mm", "follower_distance_mm",
@@ -184,6 +185,8 @@ class DesignSpec:
     machining: MachiningSpec = field(default_factory=MachiningSpec)
     assembly: AssemblySpec = field(default_factory=AssemblySpec)
     drawing: DrawingSpec = field(default_factory=DrawingSpec)
+    #: ``[cylinder]`` of a cylindrical cam (:class:`~camfab.design.cylindrical.CylinderSpec`), else None
+    cylinder: CylinderSpec | None = None
 
     @property
     def is_translating_cam(self) -> bool:
@@ -315,9 +318,10 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
     pa = v.number(checks, "pressure_angle_limit_deg", "checks", None, lo=0.0, hi=90.0, lo_open=True, hi_open=True)
     margin = v.number(checks, "face_margin_mm", "checks", 0.0, lo=0.0, hi=1e4)
     dyn = _dynamics(v, data, cam, fol)
+    cylinder = cylinder_section(v, v.table(data, "cylinder"), cam.kind)
     return DesignSpec(name.strip(), cam, fol, motion, table, mfg, out, pressure_angle_limit_deg=pa,
                       description=str(data.get("description", "")), source=source, face_margin_mm=margin,
-                      dynamics=dyn, machining=machining, assembly=assembly, drawing=drawing)
+                      dynamics=dyn, machining=machining, assembly=assembly, drawing=drawing, cylinder=cylinder)
 
 
 def _depth_levels(v: Validator, mfg: ManufacturingSpec, machining: MachiningSpec) -> None:
