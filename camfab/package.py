@@ -170,6 +170,7 @@ def _build(args: tuple) -> dict:
         swap_dir(staging, folder)
         entry.update(status="unacceptable" if res.verdict == Verdict.UNACCEPTABLE else "ok", verdict=str(res.verdict),
                      tolerance_mm=res.tol, withheld=res.withheld, skipped=res.skipped, timings=res.timings,
+                     not_applicable=res.not_applicable,
                      folder=str(folder.relative_to(out)),
                      files=[_file_entry(folder / n, Path(out), res.deviations.get(n)) for n in sorted(res.files)])
         entry.update(cam_summary(spec, cam.geometry, cam.check(), res.deviations.values()))

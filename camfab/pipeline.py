@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from .cad.export import Artifact, CamShapes, build_artifacts, cam_shapes
+from .cad.kind_exports import applicable, kind_exporter
 from .design.assemble import check_design, mechanism_from_spec
 from .design.mechanisms import geometry_from_spec
 from .design.profile import CamGeometry, ProfileSample
@@ -145,6 +146,7 @@ class RunResult:
     removed: list[str] = field(default_factory=list)
     #: outputs skipped because a library is missing (cadquery: STEP and assembly), with a warning
     skipped: list[str] = field(default_factory=list)
+    not_applicable: dict[str, str] = field(default_factory=dict)  #: outputs the cam's kind lacks, and why
 
 
 # ---------------------------------------------------------------------------
@@ -545,7 +547,7 @@ def run(cam: Cam, outdir: str | Path, req: Request, *, progress: Callable[[str],
 def _run(cam: Cam, folder: Path, req: Request, res: RunResult, say: Callable[[str], None]) -> RunResult:
     report = _timed(res, "check", say, cam.check)
     res.verdict = report.verdict
-    wanted = [o for o in EXPORTERS if o in req.outputs]
+    wanted, res.not_applicable = applicable(cam, [o for o in EXPORTERS if o in req.outputs])
     refused = report.verdict == Verdict.UNACCEPTABLE and not req.force
     if refused:
         res.withheld = [str(o) for o in SHOP_OUTPUTS if o in req.outputs]
@@ -554,7 +556,7 @@ def _run(cam: Cam, folder: Path, req: Request, res: RunResult, say: Callable[[st
     files: dict[str, bytes] = {"check.json": (json.dumps(report.to_dict(), indent=2) + "\n").encode()}
     for out in wanted:
         try:
-            arts = _timed(res, str(out), say, EXPORTERS[out], cam, req)
+            arts = _timed(res, str(out), say, kind_exporter(cam.spec.cam.kind, out, EXPORTERS[out]), cam, req)
         except MissingDependencyError as exc:
             if out not in CAD_OUTPUTS:
                 raise
