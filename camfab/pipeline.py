@@ -238,7 +238,7 @@ class Cam:
                tool_paths: bool = False) -> Any:
         """The DXF drawing of the profile(s): an ``ezdxf`` document, or written to ``path`` (returned)."""
         req = Request(frozenset({Output.DXF}), tol=tol, dxf_flavour=flavour, tool_paths=tool_paths)
-        (art,) = _dxf(self, req)
+        (art,) = kind_exporter(self.spec.cam.kind, "dxf", _dxf)(self, req)
         if path is not None:
             return atomic_write(path, art.data)
         import io
@@ -249,7 +249,7 @@ class Cam:
 
     def to_stl(self, path: str | Path | None = None, *, tol: float | None = None) -> Any:
         """The plate as a mesh: a ``trimesh.Trimesh`` (profile 1 of a pair), or written to ``path``."""
-        arts = _stl(self, Request(frozenset({Output.STL}), tol=tol))
+        arts = kind_exporter(self.spec.cam.kind, "stl", _stl)(self, Request(frozenset({Output.STL}), tol=tol))
         if path is not None:
             return atomic_write(path, arts[0].data)
         import io
@@ -260,7 +260,7 @@ class Cam:
 
     def to_step(self, path: str | Path, *, tol: float | None = None) -> Path:
         """The plate as a STEP solid, written to ``path`` (needs cadquery)."""
-        arts = _step(self, Request(frozenset({Output.STEP}), tol=tol))
+        arts = kind_exporter(self.spec.cam.kind, "step", _step)(self, Request(frozenset({Output.STEP}), tol=tol))
         return atomic_write(path, arts[0].data)
 
     def to_assembly(self, path: str | Path, *, angle: float = 0.0, tol: float | None = None) -> Path:
@@ -275,7 +275,7 @@ class Cam:
         its text, or written to ``path``."""
         req = Request(frozenset({Output.GCODE}), post or self.spec.outputs.gcode or "linuxcnc", tol=tol,
                       machining=machining)
-        text = _gcode(self, req)[0].data
+        text = kind_exporter(self.spec.cam.kind, "gcode", _gcode)(self, req)[0].data
         return atomic_write(path, text) if path is not None else text.decode("utf-8")
 
     def to_shapely(self, *, tol: float | None = None, profile: int = 0) -> Any:

@@ -11,11 +11,12 @@ import logging
 from collections.abc import Callable, Sequence
 from typing import Any
 
+from ..errors import ExportError
 from ..io import safe_stem
 from .cylinder import cylinder_step, developed_dxf
 from .export import Artifact
 
-__all__ = ["KIND_EXPORTERS", "not_applicable_reason", "kind_exporter", "applicable"]
+__all__ = ["KIND_EXPORTERS", "not_applicable_reason", "kind_exporter", "applicable", "applies"]
 
 log = logging.getLogger("camfab.pipeline")
 
@@ -49,6 +50,8 @@ def not_applicable_reason(kind: str, output: str) -> str:
 def kind_exporter(kind: str, out: str, default: Callable[[Any, Any], list[Artifact]]) -> Any:
     """The function making ``out`` for a cam of ``kind``: its kind's own, else ``default`` (the plate's)."""
     own = KIND_EXPORTERS.get(kind)
+    if own is not None and out not in own:
+        raise ExportError(f"{out}: {not_applicable_reason(kind, str(out))}")
     return default if own is None else own[out]
 
 
@@ -61,3 +64,9 @@ def applicable(cam: Any, outputs: Sequence[Any]) -> tuple[list[Any], dict[str, s
     for out, reason in why.items():
         log.warning("%s: %s skipped: %s", cam.name, out, reason)
     return keep, why
+
+
+def applies(kind: str, output: str) -> bool:
+    """Whether ``output`` is made for a cam of ``kind``."""
+    own = KIND_EXPORTERS.get(kind)
+    return own is None or output in own

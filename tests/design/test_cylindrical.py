@@ -152,3 +152,20 @@ def test_cylinder_table_required_and_refused():
         design_from_dict(base | {"cam": {"kind": "disc"}, "cylinder": {"radius_mm": 40.0},
                                  "follower": base["follower"] | {"base_radius_mm": 30.0}})
     assert "cylinder" in {p.path for p in exc.value.problems}
+
+
+def test_run_writes_the_dxf_and_names_what_does_not_apply(tmp_path):
+    """`camfab run` on the example: check.json with the cylinder summary, the developed DXF, and every output not
+    made for this kind listed with its reason (no crash, nothing silently left out)."""
+    import json
+
+    from camfab import pipeline
+
+    cam = pipeline.load("cylindrical_translating")
+    res = cam.run(tmp_path, ["dxf", "stl", "gcode", "xlsx"])
+    assert sorted(res.files) == ["BarrelCam.dxf", "check.json"]
+    assert set(res.not_applicable) == {"stl", "gcode", "xlsx"}
+    assert all("cylindrical" in why for why in res.not_applicable.values())
+    check = json.loads((tmp_path / "check.json").read_text())
+    assert check["cylinder"]["radii"][0]["radius_mm"] == 35.0
+    assert check["pressure_angle_deg"]["max"] == pytest.approx(check["cylinder"]["radii"][0]["pressure_angle_max_deg"])
