@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from . import pipeline
+from .cad.kind_exports import applicable, kind_exporter
 from .errors import ApiError, CamfabError, InternalError, MissingDependencyError, SpecError
 from .io import atomic_write, inside, output_folder, write_all
 from .pipeline import Cam, Output, Request
@@ -169,7 +170,8 @@ def cmd_export(args: argparse.Namespace) -> int:
             return EXIT_CHECKS
         req = Request(frozenset(Output(f) for f in formats), tol=tol, dxf_flavour=args.dxf_flavour,
                       tool_paths=args.tool_path, angle=args.angle, poses=args.poses)
-        arts = [a for out in pipeline.EXPORTERS if out in req.outputs for a in pipeline.EXPORTERS[out](cam, req)]
+        found, skip = applicable(cam, [out for out in pipeline.EXPORTERS if out in req.outputs])
+        arts = [a for out in found for a in kind_exporter(cam.spec.cam.kind, out, pipeline.EXPORTERS[out])(cam, req)]
         targets = [inside(folder, a.filename) for a in arts]  # all proved inside -o before any write
         paths = write_all({t: a.data for t, a in zip(targets, arts, strict=True)})  # all files or none
     print(f"{plain(cam.name)}: verdict {cam.verdict}, tolerance {tol:g} mm")
@@ -178,6 +180,8 @@ def cmd_export(args: argparse.Namespace) -> int:
         ents = "-" if a.entities is None else str(a.entities)
         dev = "-" if a.deviation_mm is None else f"{a.deviation_mm:.3g}"
         print(f"  {str(p):<32}{ents:>10}{dev:>22}")
+    for out, why in skip.items():
+        print(f"  skipped {out}: {why}")
     return _exit(cam.verdict)  # forced files of an unacceptable design: written, and still exit 1
 
 
@@ -393,6 +397,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(f"  withheld (verdict unacceptable, use --force): {', '.join(res.withheld)}")
     if res.skipped:
         print(f"  skipped (cadquery is missing: pip install cadquery): {', '.join(res.skipped)}")
+    for out, why in res.not_applicable.items():
+        print(f"  skipped {out}: {why}")
     if res.removed:
         print(f"  removed (an earlier run's shop files; verdict unacceptable): {', '.join(res.removed)}")
     return _exit(Verdict(res.verdict))

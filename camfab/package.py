@@ -190,7 +190,7 @@ def build_cam(job: Job) -> dict:
             files = build_files(cam, req, res, lambda m: None)
         entry.update(status="unacceptable" if res.verdict == Verdict.UNACCEPTABLE else "ok", verdict=str(res.verdict),
                      tolerance_mm=res.tol, withheld=res.withheld, skipped=res.skipped, timings=res.timings,
-                     folder=job.stem, files=[])
+                     not_applicable=res.not_applicable, folder=job.stem, files=[])
         entry.update(cam_summary(spec, cam.geometry, cam.check(), res.deviations.values()))
         entry["output"] = {"files": files, "deviations": res.deviations, "shop": sorted(shop_file_names(cam))}
     except Exception as exc:  # contained: one design's failure must not lose the others

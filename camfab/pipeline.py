@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from .cad.artifact import Artifact, CamShapes, build_artifacts, cam_shapes, validate_tol
+from .cad.kind_exports import applicable, kind_exporter
 from .design.assemble import check_design, mechanism_from_spec
 from .design.mechanisms import geometry_from_spec
 from .design.profile import CamGeometry, ProfileSample
@@ -145,6 +146,7 @@ class RunResult:
     removed: list[str] = field(default_factory=list)
     #: outputs skipped because a library is missing (cadquery: STEP and assembly), with a warning
     skipped: list[str] = field(default_factory=list)
+    not_applicable: dict[str, str] = field(default_factory=dict)  #: outputs the cam's kind lacks, and why
 
 
 # ---------------------------------------------------------------------------
@@ -236,7 +238,7 @@ class Cam:
                tool_paths: bool = False) -> Any:
         """The DXF drawing of the profile(s): an ``ezdxf`` document, or written to ``path`` (returned)."""
         req = Request(frozenset({Output.DXF}), tol=tol, dxf_flavour=flavour, tool_paths=tool_paths)
-        (art,) = _dxf(self, req)
+        (art,) = kind_exporter(self.spec.cam.kind, "dxf", _dxf)(self, req)
         if path is not None:
             return atomic_write(path, art.data)
         import io
@@ -247,7 +249,7 @@ class Cam:
 
     def to_stl(self, path: str | Path | None = None, *, tol: float | None = None) -> Any:
         """The plate as a mesh: a ``trimesh.Trimesh`` (profile 1 of a pair), or written to ``path``."""
-        arts = _stl(self, Request(frozenset({Output.STL}), tol=tol))
+        arts = kind_exporter(self.spec.cam.kind, "stl", _stl)(self, Request(frozenset({Output.STL}), tol=tol))
         if path is not None:
             return atomic_write(path, arts[0].data)
         import io
@@ -258,7 +260,7 @@ class Cam:
 
     def to_step(self, path: str | Path, *, tol: float | None = None) -> Path:
         """The plate as a STEP solid, written to ``path`` (needs cadquery)."""
-        arts = _step(self, Request(frozenset({Output.STEP}), tol=tol))
+        arts = kind_exporter(self.spec.cam.kind, "step", _step)(self, Request(frozenset({Output.STEP}), tol=tol))
         return atomic_write(path, arts[0].data)
 
     def to_assembly(self, path: str | Path, *, angle: float = 0.0, tol: float | None = None) -> Path:
@@ -273,7 +275,7 @@ class Cam:
         its text, or written to ``path``."""
         req = Request(frozenset({Output.GCODE}), post or self.spec.outputs.gcode or "linuxcnc", tol=tol,
                       machining=machining)
-        text = _gcode(self, req)[0].data
+        text = kind_exporter(self.spec.cam.kind, "gcode", _gcode)(self, req)[0].data
         return atomic_write(path, text) if path is not None else text.decode("utf-8")
 
     def to_shapely(self, *, tol: float | None = None, profile: int = 0) -> Any:
@@ -537,7 +539,7 @@ def build_files(cam: Cam, req: Request, res: RunResult, say: Callable[[str], Non
     ``res`` gets the verdict, the withheld and skipped outputs, the deviations and the timings."""
     report = _timed(res, "check", say, cam.check)
     res.verdict = report.verdict
-    wanted = [o for o in EXPORTERS if o in req.outputs]
+    wanted, res.not_applicable = applicable(cam, [o for o in EXPORTERS if o in req.outputs])
     refused = report.verdict == Verdict.UNACCEPTABLE and not req.force
     if refused:
         res.withheld = [str(o) for o in SHOP_OUTPUTS if o in req.outputs]
@@ -546,7 +548,7 @@ def build_files(cam: Cam, req: Request, res: RunResult, say: Callable[[str], Non
     files: dict[str, bytes] = {"check.json": (json.dumps(report.to_dict(), indent=2) + "\n").encode()}
     for out in wanted:
         try:
-            arts = _timed(res, str(out), say, EXPORTERS[out], cam, req)
+            arts = _timed(res, str(out), say, kind_exporter(cam.spec.cam.kind, out, EXPORTERS[out]), cam, req)
         except MissingDependencyError as exc:
             if out not in CAD_OUTPUTS:
                 raise

@@ -509,6 +509,8 @@ class CheckReport:
     initial_arm_angle_deg: float | None = None
     vibration: JsonPart | None = None
     contact_stress: JsonPart | None = None
+    #: cylindrical cams: the radii checked, the roller and its slip (``camfab.design.cylindrical``), JSON-ready
+    cylinder: dict[str, Any] | None = None
 
     @property
     def verdict(self) -> Verdict:
@@ -539,4 +541,5 @@ class CheckReport:
                     "x_unit": self.x_unit, "findings": [f.to_dict() for f in self.findings]})
         out["vibration"] = part(self.vibration)
         out["contact_stress"] = part(self.contact_stress)
+        out["cylinder"] = self.cylinder
         return out

@@ -90,7 +90,8 @@ def test_check_json_keys_are_the_contract(name):
     d = json.loads(json.dumps(rep.to_dict()))
     assert list(d) == ["name", "verdict", "peaks", "junctions", "pressure_angle_deg", "radius_of_curvature_mm",
                        "face_length_mm", "base_radius_mm", "max_radius_mm", "area_mm2", "dynamics",
-                       "initial_arm_angle_deg", "x_unit", "findings", "vibration", "contact_stress"]
+                       "initial_arm_angle_deg", "x_unit", "findings", "vibration", "contact_stress",
+                       "cylinder"]
     assert d["vibration"] is None  # no [vibration] section
     assert list(d["peaks"]) == ["S", "V", "A", "J"] and list(d["peaks"]["V"]) == ["max", "min", "at_max_deg",
                                                                                    "at_min_deg"]

@@ -15,7 +15,8 @@ from ..textsafe import step_string
 from .plate import PlateSpec
 from .stepheader import StepMeta, header_dumps
 
-__all__ = ["plate_solid", "groove_solid", "dumps", "groove_dumps", "stack_dumps", "canonical_reals", "cadquery"]
+__all__ = ["plate_solid", "groove_solid", "dumps", "groove_dumps", "stack_dumps", "solid_dumps", "canonical_reals",
+           "cadquery"]
 
 
 def cadquery():
@@ -83,6 +84,11 @@ def stack_dumps(outlines, plate: PlateSpec, *, gap_mm: float = 2.0, name: str = 
     pitch = plate.thickness_mm + (plate.hub_length_mm or 0.0) + gap_mm
     solids = [plate_solid(o, plate).val().translate(cq.Vector(0, 0, i * pitch)) for i, o in enumerate(outlines)]
     return _export(cq.Workplane("XY").add(cq.Compound.makeCompound(solids)), name, meta)
+
+
+def solid_dumps(solid, *, name: str = "cam", meta: StepMeta | None = None) -> str:
+    """STEP text of any cadquery solid (or Workplane), with camfab's header and canonical reals."""
+    return _export(solid, name, meta)
 
 
 def _export(solid, name: str, meta: StepMeta | None = None) -> str:

@@ -11,6 +11,7 @@ import math
 from ..errors import InputError
 from ..results import CheckReport, DynamicsReport, Finding
 from .checks import check
+from .cylindrical import CylindricalGeometry, cylinder_report
 from .dynamics import ContactDynamics, Loads, PairDynamics, analyse_dynamics, pair_of
 from .mechanisms import geometry_from_spec, mechanism_from_spec
 from .profile import CamGeometry
@@ -32,6 +33,8 @@ def check_design(spec: DesignSpec, *, tool_radius_mm: float | None = None) -> Ch
                    allow_acceleration_jump=spec.cam.kind in ("constant_width", "constant_diameter"),
                    tool_radius_mm=tool_radius_mm, face_margin_mm=spec.face_margin_mm,
                    name=spec.name, speed=spec.speed, strength=strength_input(spec, geom))
+    if isinstance(geom, CylindricalGeometry):
+        report = cylinder_report(report, geom)
     extra = knot_findings(spec)
     if spec.dynamics is not None:
         dyn = dynamics_of(spec, geom)

@@ -43,6 +43,7 @@ class CamKind(StrEnum):
     TRANSLATING = "translating"
     #: a disc with a face groove: one pitch curve, two flanks, one roller driven both ways
     GROOVE = "groove"
+    CYLINDRICAL = "cylindrical"
 
     @property
     def form_closed(self) -> bool:

@@ -24,6 +24,7 @@ from .conjugate import (
     FormClosed,
 )
 from .curved import OscillatingCurved, TranslatingCurved
+from .cylindrical import FAMILIES as CYLINDRICAL_FAMILIES
 from .faces import OscillatingFlat, TranslatingFlat
 from .groove import GrooveOscillatingRoller, GrooveTranslatingRoller
 from .kinds import CamKind, FollowerMotion, FollowerType
@@ -82,6 +83,7 @@ MECHANISMS: dict[tuple[CamKind, FollowerType, FollowerMotion], type[Mechanism]] 
     (_TC, _RO, _T): TranslatingCamRoller,
     (CamKind.GROOVE, _RO, _T): GrooveTranslatingRoller,
     (CamKind.GROOVE, _RO, _O): GrooveOscillatingRoller,
+    **CYLINDRICAL_FAMILIES,
 }
 
 

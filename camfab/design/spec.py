@@ -20,6 +20,7 @@ from typing import Any
 from ..errors import Problem, SpecError
 from ..limits import MAX_LENGTH_MM, MAX_LIFT_MM, MAX_SEGMENTS, data_problems
 from ..units import DEG, RPM
+from .cylindrical import CylinderSpec, cylinder_section
 from .drawing import DrawingSpec, drawing_section
 from .kinds import CamKind, Direction, FollowerMotion, FollowerType, LiftUnit, Rotation
 from .knots import KnotFile, KnotTable, build_knot_table
@@ -63,7 +64,7 @@ __all__ = [
 
 _TOP_KEYS = ("name", "description", "cam", "follower", "motion", "motion_table", "manufacturing", "machining",
              "outputs", "checks", "dynamics", "assembly", "drawing",
-             "vibration", "strength", "materials",
+             "vibration", "strength", "materials", "cylinder",
              "sizing", "optimise")  # camfab size / camfab optimise: design/sizing_plan.py, design/optimise_spec.py
 _CAM_KEYS = ("kind", "rotation", "direction", "speed_rpm", "omega_rad_s", "speed_mm_s")
 _FOLLOWER_FLOATS = ("base_radius_mm", "roller_radius_mm", "offset_mm", "pivot_distance_mm",
@@ -200,6 +201,8 @@ class DesignSpec:
     strength: StrengthSpec | None = None
     sizing: SizingSpec = field(default_factory=SizingSpec)
     optimise: OptimiseSpec | None = None
+    #: ``[cylinder]`` of a cylindrical cam (:class:`~camfab.design.cylindrical.CylinderSpec`), else None
+    cylinder: CylinderSpec | None = None
 
     @property
     def is_translating_cam(self) -> bool:
@@ -338,7 +341,8 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
                       dynamics=dyn, machining=machining, assembly=assembly, drawing=drawing, strength=strength,
                       vibration=vibration_section(v, data, cam.kind, fol.motion),
                       sizing=sizing_section(v, v.table(data, "sizing")),
-                      optimise=optimise_section(v, v.table(data, "optimise")) if "optimise" in data else None)
+                      optimise=optimise_section(v, v.table(data, "optimise")) if "optimise" in data else None,
+                      cylinder=cylinder_section(v, v.table(data, "cylinder"), cam.kind))
 
 
 # ---------------------------------------------------------------------------

@@ -26,6 +26,7 @@ import pytest
 
 from camfab.cad.drawing import build_drawing, dim_value, drawing_sheet
 from camfab.cad.export import cam_shapes
+from camfab.cad.kind_exports import applies
 from camfab.cad.plate import keyway_size
 from camfab.cad.sheet_check import layout_problems
 from camfab.design.assemble import check_design, geometry_from_spec
@@ -36,7 +37,7 @@ from tests.conftest import EXAMPLES
 ezdxf = pytest.importorskip("ezdxf")
 KDTree = pytest.importorskip("scipy.spatial").cKDTree
 
-ALL = sorted(p.stem for p in EXAMPLES.glob("*.toml"))
+ALL = sorted(p.stem for p in EXAMPLES.glob("*.toml") if applies(load_design(p).cam.kind, "drawing"))  # has a sheet
 #: a 1:1 sheet with bore, keyway and fits; a 1:2 disc cam pair; the 1:2 wedge plate
 FAST = ["ejemplo9rt", "ejemplo8da_conjugate", "wedge_translating"]
 PT_MM = 25.4 / 72.0

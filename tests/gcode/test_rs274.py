@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 
 from camfab import pipeline
+from camfab.cad.kind_exports import applies
 from camfab.gcode.cam import verify_cam_program
 from camfab.gcode.distance import CurveDistance
 from camfab.geom2d import TWO_PI
@@ -32,7 +33,7 @@ pytestmark = pytest.mark.skipif(RS274 is None, reason="LinuxCNC's rs274 interpre
                                                       "(Debian package linuxcnc-uspace; .ci/run installs it)")
 
 POSTS = ("linuxcnc", "fanuc", "grbl")
-EXAMPLES = pipeline.examples()
+EXAMPLES = [e for e in pipeline.examples() if applies(pipeline.load(e).spec.cam.kind, "gcode")]  # milled plates
 FAST = ("wedge_translating", "ejemplo11ro")  # the two with near-straight stretches (huge arcs before the limit)
 
 _CALL = re.compile(r"^\s*\d+\s+N\S*\s+([A-Z_]+)\((.*)\)\s*$")

@@ -111,7 +111,7 @@ def check(geometry: CamGeometry, *, pressure_angle_limit_deg: float | None = Non
         if scope is Scope.CAM:
             results = [(r.run(geometry, limits, samples), "") for r in rules]
         else:
-            results = [(r.run(s.contact, limits, s), f"{s.contact.label or f'profile {k + 1}'}: " if multi else "")
+            results = [(r.run(s.contact, limits, s), _tag(s.contact, k) if multi else "")
                        for k, s in enumerate(samples) for r in rules]
         for res, tag in results:
             findings += [dataclasses.replace(f, message=tag + f.message) for f in res.findings] if tag else \
@@ -121,6 +121,11 @@ def check(geometry: CamGeometry, *, pressure_angle_limit_deg: float | None = Non
         fields["motion"] = dataclasses.replace(fields["motion"], name=name)
     return CheckReport(name, tuple(findings), x_unit=geometry.axis.x_unit,
                        initial_arm_angle_deg=geometry.initial_arm_angle_deg, **fields)
+
+
+def _tag(contact: Any, k: int) -> str:
+    """How a finding names profile k of several: ``"profile 2: "``, or the contact's own ``label``."""
+    return f"{getattr(contact, 'label', None) or f'profile {k + 1}'}: "
 
 
 def _merge(fields: dict[str, Any], new: dict[str, Any]) -> None:

@@ -1,0 +1,190 @@
+"""Files of a cylindrical cam: the developed (unrolled) groove as DXF, the grooved cylinder as STEP.
+
+DXF: the development of the pitch cylinder (x = R·θ, y = z, :mod:`camfab.design.cylindrical`), one turn
+(x from 0 to 2πR): the pitch curve on layer ``PITCH_CURVE``, the groove's +z flank on ``PROFILE`` and its −z
+flank on ``PROFILE_2`` (the disc cams' layers), each an arc chain within the tolerance of the exact curve
+(measured), and the developed outline of the cylinder (its ends z = 0 and z = length, the seam x = 0 and
+x = 2πR) on ``OUTLINE``.
+
+STEP: the cylinder (outer radius R + depth/2, length along +Z from z = 0) minus the groove, swept along the
+exact 3D pitch curve (a periodic B-spline through its points, within the tolerance: measured) with the
+follower's roller axis as the sweep's auxiliary spine, through sections (``sweep_multi``): at each of the
+interpolated cam angles the section in the plane normal to the path holds the exact flank points of
+:data:`SECTION_RADII` radii from the groove bottom to past the outer surface (each flank developed on its own
+radius, wrapped, and cut by that plane), so the flanks follow the developed offsets on every radius — not a
+rectangle swept along the pitch curve, whose flanks are right on the pitch cylinder only and pinch a full-depth
+roller by up to w·(1 − (rR + S′²)/(|C_r′||C_R′|)) off it (5 µm in the example).  The groove bottom is the
+straight segment across the two flank points on the bottom radius (flat across, as an end mill's end).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..design.cylindrical import CylindricalGeometry, pitch_3d
+from ..discretize import ParametricCurve, arcs
+from ..errors import ExportError
+from ..textsafe import dxf_string
+from .dxf import LAYERS, ezdxf_module, write_deterministic
+from .step import cadquery, solid_dumps
+
+__all__ = ["developed_curves", "developed_dxf", "grooved_cylinder", "cylinder_step", "SWEEP_POINTS"]
+
+#: points of the 3D pitch curve the STEP's periodic B-spline passes through (per turn) to begin with; doubled
+#: (at most 4 times) until the spline lies within the tolerance (the sweep's cost grows with them: 8 s at 48)
+SWEEP_POINTS = 48
+#: how far past the outer surface the groove tool reaches (mm), so the cut leaves no skin
+CLEARANCE_MM = 1.0
+#: radii (groove bottom to past the outer surface) at which each section holds the exact flank points
+SECTION_RADII = 6
+
+
+def developed_curves(geometry: CylindricalGeometry, tol: float):
+    """The pitch curve and both flanks developed on the pitch cylinder, each as an arc chain within ``tol``:
+    ``(pitch, plus_flank, minus_flank)``."""
+    R = geometry.cylinder.radius_mm
+    out = []
+    for flank, take in ((1, "pitch"), (1, "point"), (-1, "point")):
+        c = geometry.at_radius(R, flank)
+
+        def point(t, c=c, take=take):
+            return getattr(c.evaluate(t), take)
+        curve = ParametricCurve(point, c.breakpoints, c.period, closed=False)
+        out.append(arcs(curve, tol=tol))
+    return tuple(out)
+
+
+def developed_dxf(geometry: CylindricalGeometry, *, tol: float, name: str = "cam") -> tuple[str, float]:
+    """DXF text of the developed groove and its measured largest deviation (mm)."""
+    ezdxf = ezdxf_module()
+    doc = ezdxf.new("R2010", setup=False)
+    doc.header["$INSUNITS"] = 4
+    doc.header["$MEASUREMENT"] = 1
+    doc.header.custom_vars.append("CAMFAB_NAME", dxf_string(name))
+    doc.header.custom_vars.append("CAMFAB_TOL_MM", f"{tol:g}")
+    curves = developed_curves(geometry, tol)
+    dev = max(float(c.max_deviation) for c in curves)
+    doc.header.custom_vars.append("CAMFAB_DEVIATION_MM", f"{dev:.3e}")
+    for layer, colour in {**LAYERS, "OUTLINE": 8}.items():
+        doc.layers.add(layer, color=colour)
+    msp = doc.modelspace()
+    for layer, chain in zip(("PITCH_CURVE", "PROFILE", "PROFILE_2"), curves, strict=True):
+        pts = [(float(p[0]), float(p[1]), 0.0, 0.0, float(b)) for p, b in zip(chain.starts, chain.bulges, strict=True)]
+        end = chain.ends[-1]
+        pts.append((float(end[0]), float(end[1]), 0.0, 0.0, 0.0))
+        msp.add_lwpolyline(pts, format="xyseb", dxfattribs={"layer": layer})
+    cyl = geometry.cylinder
+    w = 2 * math.pi * cyl.radius_mm
+    msp.add_lwpolyline([(0.0, 0.0), (w, 0.0), (w, cyl.length_mm), (0.0, cyl.length_mm)], close=True,
+                       dxfattribs={"layer": "OUTLINE"})
+    return write_deterministic(doc), dev
+
+
+def _vec(cq, p):
+    return cq.Vector(float(p[0]), float(p[1]), float(p[2]))
+
+
+def _wrap(geometry: CylindricalGeometry, r: float, xz: np.ndarray) -> np.ndarray:
+    """Developed points (x, z) of the cylinder r → cam-frame 3D points (polar angle 90° + σ·x/r)."""
+    a = 0.5 * math.pi + geometry.mechanism.sense * xz[:, 0] / r
+    return np.stack([r * np.cos(a), r * np.sin(a), xz[:, 1]], axis=1)
+
+
+def _crossing(geometry: CylindricalGeometry, r: float, flank: int, grid: np.ndarray, plane: tuple) -> np.ndarray:
+    """The point of the exact flank ``flank`` on the cylinder r where it crosses the plane (point, unit normal)
+    near the plane's cam angle: bracketed on ``grid`` (cam angles), then refined by secant steps."""
+    contact = geometry.at_radius(r, flank)
+    p0, normal, theta = plane
+
+    def side(x):
+        return (_wrap(geometry, r, contact.evaluate(np.atleast_1d(x)).point) - p0) @ normal
+
+    d = side(grid)
+    near = np.abs((grid - theta + math.pi) % (2 * math.pi) - math.pi) < 0.6
+    i = int(np.nonzero(near & (np.sign(d) != np.sign(np.roll(d, -1))))[0][0])
+    g0, g1 = grid[i], grid[(i + 1) % grid.size] + (2 * math.pi if i + 1 == grid.size else 0.0)
+    d0, d1 = d[i], d[(i + 1) % grid.size]
+    for _ in range(4):
+        if d1 == d0:
+            break
+        g0, g1, d0 = g1, g1 - d1 * (g1 - g0) / (d1 - d0), d1
+        d1 = float(side(g1)[0])
+    return _wrap(geometry, r, contact.evaluate(np.array([g1])).point)[0]
+
+
+def groove_sections(geometry: CylindricalGeometry, n: int, radii: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The groove's sections in the planes normal to the 3D pitch curve at n equally spaced cam angles: the exact
+    flank points (developed flanks on each of ``radii``, wrapped) that lie in each plane; (n,) angles and
+    (n, 2, len(radii), 3) points (+z flank, −z flank)."""
+    R, sense = geometry.cylinder.radius_mm, geometry.mechanism.sense
+    theta = np.linspace(0.0, geometry.period, n, endpoint=False)
+    C, T = geometry.at_radius(R).pitch(theta)
+    a = 0.5 * math.pi + sense * C[:, 0] / R
+    along = sense * np.stack([-np.sin(a), np.cos(a), 0 * a], axis=1) * T[:, :1] + np.array([0.0, 0.0, 1.0]) * T[:, 1:]
+    along /= np.linalg.norm(along, axis=1)[:, None]
+    points = pitch_3d(geometry, theta)
+    grid = np.linspace(0.0, geometry.period, 20000, endpoint=False)
+    out = np.empty((n, 2, len(radii), 3))
+    for k in range(n):
+        for f, flank in enumerate((1, -1)):
+            for j, r in enumerate(radii):
+                out[k, f, j] = _crossing(geometry, float(r), flank, grid, (points[k], along[k], theta[k]))
+    return theta, out
+
+
+def grooved_cylinder(geometry: CylindricalGeometry, *, n: int = SWEEP_POINTS, bore_mm: float = 0.0):
+    """The grooved cylinder as a cadquery Solid (see the module notes)."""
+    cq = cadquery()
+    cyl = geometry.cylinder
+    r_far = cyl.outer_radius_mm + CLEARANCE_MM
+    radii = np.linspace(cyl.inner_radius_mm, r_far, SECTION_RADII)
+    theta, sections = groove_sections(geometry, n, radii)
+    path = cq.Wire.assembleEdges([cq.Edge.makeSpline([_vec(cq, p) for p in pitch_3d(geometry, theta)],
+                                                     periodic=True)])
+    aux = cq.Wire.assembleEdges([cq.Edge.makeSpline([_vec(cq, p) for p in pitch_3d(geometry, theta, r_far)],
+                                                    periodic=True)])
+    wires = [cq.Wire.makePolygon([_vec(cq, p) for p in (*sec[0], *sec[1][::-1])], close=True) for sec in sections]
+    groove = cq.Solid.sweep_multi([*wires, wires[0]], path, makeSolid=True, mode=aux)
+    body = cq.Solid.makeCylinder(cyl.outer_radius_mm, cyl.length_mm, cq.Vector(0, 0, 0), cq.Vector(0, 0, 1))
+    solid = body.cut(groove)
+    if bore_mm > 0:
+        solid = solid.cut(cq.Solid.makeCylinder(bore_mm / 2, cyl.length_mm, cq.Vector(0, 0, 0), cq.Vector(0, 0, 1)))
+    if not (groove.isValid() and solid.isValid()):
+        raise ExportError(f"the grooved cylinder is not a valid solid (OCC's checker): groove {cyl.groove_depth_mm:g} "
+                          "mm deep swept around the pitch curve. Check the design for an undercut")
+    return solid
+
+
+def path_deviation(geometry: CylindricalGeometry, n: int = SWEEP_POINTS, samples: int = 500) -> float:
+    """Largest distance (mm) from the exact 3D pitch curve to the B-spline the STEP sweeps along, measured at
+    ``samples`` points between the interpolated ones."""
+    cq = cadquery()
+    from OCP.BRep import BRep_Tool
+    from OCP.GeomAPI import GeomAPI_ProjectPointOnCurve
+    from OCP.gp import gp_Pnt
+
+    phi = np.linspace(0.0, geometry.period, n, endpoint=False)
+    edge = cq.Edge.makeSpline([_vec(cq, p) for p in pitch_3d(geometry, phi)], periodic=True)
+    curve = BRep_Tool.Curve_s(edge.wrapped, 0.0, 1.0)
+    test = pitch_3d(geometry, (np.arange(samples) + 0.5) * geometry.period / samples)
+    worst = 0.0
+    for p in test:
+        proj = GeomAPI_ProjectPointOnCurve(gp_Pnt(*map(float, p)), curve)
+        worst = max(worst, proj.LowerDistance())
+    return worst
+
+
+def cylinder_step(geometry: CylindricalGeometry, *, tol: float, name: str = "cam",
+                  bore_mm: float = 0.0) -> tuple[str, float]:
+    """STEP text of the grooved cylinder and the measured deviation of its sweep path (mm); more points when
+    the default ones leave the path farther than ``tol`` from the exact curve."""
+    n = SWEEP_POINTS
+    dev = path_deviation(geometry, n)
+    while dev > tol and n < 16 * SWEEP_POINTS:
+        n *= 2
+        dev = path_deviation(geometry, n)
+    if dev > tol:
+        raise ExportError(f"the STEP sweep path stays {dev:.3g} mm from the exact pitch curve with {n} points, more "
+                          f"than the {tol:g} mm tolerance. Give a larger [manufacturing] tolerance_mm")
+    return solid_dumps(grooved_cylinder(geometry, n=n, bore_mm=bore_mm), name=name), dev

@@ -1,0 +1,75 @@
+"""Exporters of the cam kinds whose files are not the plate's (cylindrical cams), for :mod:`camfab.pipeline`.
+
+:data:`KIND_EXPORTERS` maps a ``[cam] kind`` to its own exporters by output name (``"dxf"``, ``"step"``);
+an output a kind's entry lacks does not apply to it: ``camfab run`` and ``camfab export`` skip it and say why
+(:func:`not_applicable_reason`; the run's ``not_applicable``).  Each exporter takes the pipeline's ``Cam`` and
+``Request`` and returns its :class:`~camfab.cad.export.Artifact` list.
+"""
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from ..errors import ExportError
+from ..io import safe_stem
+from .artifact import Artifact
+
+__all__ = ["KIND_EXPORTERS", "not_applicable_reason", "kind_exporter", "applicable", "applies"]
+
+log = logging.getLogger("camfab.pipeline")
+
+
+def _cylinder_dxf(cam: Any, req: Any) -> list[Artifact]:
+    """``<stem>.dxf``: the developed groove of a cylindrical cam (:mod:`camfab.cad.cylinder`)."""
+    from .cylinder import developed_dxf  # ezdxf and the fitter only when a file is made
+
+    text, dev = developed_dxf(cam.geometry, tol=cam.tolerance(req.tol), name=cam.name)
+    return [Artifact(f"{safe_stem(cam.name)}.dxf", text.encode("utf-8"), "dxf", deviation_mm=dev)]
+
+
+def _cylinder_step(cam: Any, req: Any) -> list[Artifact]:
+    """``<stem>.step``: the grooved cylinder (:mod:`camfab.cad.cylinder`)."""
+    from .cylinder import cylinder_step  # cadquery only when a file is made
+
+    text, dev = cylinder_step(cam.geometry, tol=cam.tolerance(req.tol), name=cam.name,
+                              bore_mm=cam.spec.manufacturing.bore_mm)
+    return [Artifact(f"{safe_stem(cam.name)}.step", text.encode("utf-8"), "step", deviation_mm=dev)]
+
+
+#: cam kinds whose files are made by their own exporters, by output name; an output missing from a kind's
+#: entry does not apply to it (:func:`not_applicable_reason`)
+KIND_EXPORTERS: dict[str, dict[str, Callable[[Any, Any], list[Artifact]]]] = {
+    "cylindrical": {"dxf": _cylinder_dxf, "step": _cylinder_step},
+}
+
+
+def not_applicable_reason(kind: str, output: str) -> str:
+    """Why ``output`` is not made for a cam of ``kind`` (an entry of :data:`KIND_EXPORTERS` lacks it)."""
+    return (f"not yet made for a {kind} cam (its files are the developed-groove DXF and the grooved-cylinder "
+            "STEP; see README, \"Cylindrical cams\")")
+
+
+def kind_exporter(kind: str, out: str, default: Callable[[Any, Any], list[Artifact]]) -> Any:
+    """The function making ``out`` for a cam of ``kind``: its kind's own, else ``default`` (the plate's)."""
+    own = KIND_EXPORTERS.get(kind)
+    if own is not None and out not in own:
+        raise ExportError(f"{out}: {not_applicable_reason(kind, str(out))}")
+    return default if own is None else own[out]
+
+
+def applicable(cam: Any, outputs: Sequence[Any]) -> tuple[list[Any], dict[str, str]]:
+    """``outputs`` split into those that apply to the cam's kind and, for the others, why not (each logged as
+    a warning)."""
+    own = KIND_EXPORTERS.get(cam.spec.cam.kind)
+    keep = [o for o in outputs if own is None or o in own]
+    why = {str(o): not_applicable_reason(cam.spec.cam.kind, str(o)) for o in outputs if o not in keep}
+    for out, reason in why.items():
+        log.warning("%s: %s skipped: %s", cam.name, out, reason)
+    return keep, why
+
+
+def applies(kind: str, output: str) -> bool:
+    """Whether ``output`` is made for a cam of ``kind``."""
+    own = KIND_EXPORTERS.get(kind)
+    return own is None or output in own

@@ -1,0 +1,435 @@
+"""Cylindrical (barrel) cams: a groove around a cylinder drives a roller along the cylinder's axis.
+
+Frame and development convention (``docs/decisions.md``, "Cylindrical cams")
+-------------------------------------------------------------------------------
+The cam axis is Z; at cam angle 0 the follower lies on +Y (as for every disc cam).  A cam turning by θ
+with sense σ (+1 cw, −1 ccw, seen from +Z) brings the fixed-frame point at polar angle 90° to the cam-frame
+polar angle ``90° + σθ``.  A cylinder of radius r is **developed** (unrolled) onto the plane
+
+    x = r·θ   (arc length at which a point of radius r meets the follower),   y = z (axial position, mm)
+
+so the developed plane is the same for both senses (σ only decides the hand of the 3D groove).  On it a
+translating follower's roller axis meets radius r at ``C_r(θ) = (r·θ, z₀ + S(θ))``: the developed pitch
+curve is exactly the motion law, on every radius, and its slope ``S′/r`` (per radian) differs across the
+groove depth.  The groove flanks at radius r are modelled as the parallel curves of ``C_r`` at ± the half
+groove width ``w = R_r(r) + backlash/2``: the roller's section by the cylinder r taken as a circle of radius
+R_r.  That section is in truth ``(r·sin(u/r))² + v² = R_r²`` (u, v developed, about the roller axis), a
+circle stretched along x by at most ``R_r³/(6r²)``; the checks use the circle (documented limitation).
+
+Oscillating follower (pivot perpendicular to the cam axis)
+----------------------------------------------------------
+The pivot axis is parallel to the radial line of the follower at cam angle 0 (the arm swings in the plane
+tangent to the cylinder), at a distance L (``arm_length_mm``) ahead of the roller at rest along the
+developed x (fixed-frame X = −σ·L).  The arm angle φ = S (degrees; 0 = the arm perpendicular to the cam
+axis, positive = towards +z) puts the roller axis at ``X = −σ·e`` with ``e = L·(1 − cos φ)`` and at
+``z = z₀ + L·sin φ``; the roller axis stays parallel to the radial line at 0°, so it meets the cylinder r at
+the polar offset ``asin(e/r)``.  The exact developed pitch curve on radius r is therefore
+
+    x_r(θ) = r·θ + r·asin(e/r),        z(θ) = z₀ + L·sin φ,
+
+with no small-angle approximation: the circumferential shift ``r·asin(e/r)`` differs across the depth.
+
+Rollers and slip
+----------------
+Relative to the roller axis the cam surface at radius r moves with ``−ω·C_r′``, speed ``ω·|C_r′|``.  A
+cylindrical roller has one surface speed along its length, so it rolls without slip on one radius only
+(taken as the pitch radius R) and slips elsewhere by ``ω·(|C_r′| − |C_R′|)``.  A **conical** roller
+(``roller = "conical"``) whose apex lies on the cam axis has the radius ``R_r·r/R`` at radius r and the
+surface speed ``∝ r``: it rolls without slip on a dwell (``|C_r′| = r``) at every radius, and during a rise
+leaves only the slip of the axial part, ``ω·(|C_r′| − |C_R′|·r/R)``.  Its half-angle is ``atan(R_r/R)``.
+:func:`slip_ratio` gives the largest slip over the cycle for either roller.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from enum import StrEnum
+from typing import Any, ClassVar
+
+import numpy as np
+
+from ..errors import Problem
+from ..geom2d import J, cross, dot
+from .kinds import CamKind, FollowerMotion, FollowerType
+from .mechanism import Mechanism, finite_fields, lift_range, require_positive, require_rotation
+from .profile import DEG, CamGeometry, Contact, MotionLike, ProfileSample, inverse, xy
+
+__all__ = ["RollerShape", "CylinderSpec", "cylinder_section", "DevelopedContact", "CylindricalGeometry",
+           "CylindricalTranslating", "CylindricalOscillating", "CYLINDER_KEYS", "slip_ratio", "pitch_3d",
+           "FAMILIES", "cylinder_report", "radius_summary"]
+
+#: ``[cylinder]`` keys
+CYLINDER_KEYS = ("radius_mm", "length_mm", "groove_depth_mm", "backlash_mm", "roller", "zero_position_mm")
+
+
+class RollerShape(StrEnum):
+    """``[cylinder] roller``: the follower roller's shape."""
+
+    CYLINDRICAL = "cylindrical"
+    #: a cone whose apex lies on the cam axis (half-angle atan(R_r/R))
+    CONICAL = "conical"
+
+
+@dataclass(frozen=True, slots=True)
+class CylinderSpec:
+    """``[cylinder]``: the grooved cylinder (mm).
+
+    Attributes
+    ----------
+    radius_mm : float
+        Pitch radius R: the middle of the groove depth, where the roller's section is R_r.
+    length_mm : float
+        Length of the cylinder along its axis; z = 0 at one end.
+    groove_depth_mm : float
+        Depth of the groove; it spans the radii R ± depth/2 (outer surface R + depth/2).
+    backlash_mm : float
+        Groove width minus the roller diameter (at the pitch radius).
+    roller : RollerShape
+        Cylindrical or conical roller.
+    zero_position_mm : float or None
+        Axial position z₀ of the roller at S = 0; default: the travel centred on the length.
+    """
+
+    radius_mm: float
+    length_mm: float
+    groove_depth_mm: float
+    backlash_mm: float = 0.0
+    roller: RollerShape = RollerShape.CYLINDRICAL
+    zero_position_mm: float | None = None
+
+    @property
+    def inner_radius_mm(self) -> float:
+        """Radius of the groove bottom."""
+        return self.radius_mm - 0.5 * self.groove_depth_mm
+
+    @property
+    def outer_radius_mm(self) -> float:
+        """Outer radius of the cylinder (the groove's top edge)."""
+        return self.radius_mm + 0.5 * self.groove_depth_mm
+
+
+def cylinder_section(v: Any, t: Mapping[str, Any], kind: CamKind) -> CylinderSpec | None:
+    """``[cylinder]`` read with the validator ``v``: required for a cylindrical cam, refused for any other."""
+    if kind != CamKind.CYLINDRICAL:
+        if t:
+            v.add("cylinder", dict(t), f"a {kind} cam has no cylinder", 'remove [cylinder] or set kind = "cylindrical"')
+        return None
+    v.keys(t, CYLINDER_KEYS, "cylinder")
+    vals = {k: v.number(t, k, "cylinder", None, lo=0.0, lo_open=True, hi=1e5, fix=f"give {k} as a length > 0 in mm")
+            for k in ("radius_mm", "length_mm", "groove_depth_mm")}
+    for k, val in vals.items():
+        if val is None and k not in t:
+            v.add(f"cylinder.{k}", None, "is required for a cylindrical cam", f"add {k} = <mm> to [cylinder]")
+    backlash = v.number(t, "backlash_mm", "cylinder", 0.0, lo=0.0, hi=1e3)
+    zero = v.number(t, "zero_position_mm", "cylinder", None, lo=-1e5, hi=1e5)
+    roller = v.choice(t, "roller", "cylinder", RollerShape, RollerShape.CYLINDRICAL)
+    if any(val is None for val in vals.values()):
+        return None
+    return CylinderSpec(vals["radius_mm"], vals["length_mm"], vals["groove_depth_mm"], backlash, roller, zero)
+
+
+# ---------------------------------------------------------------------------
+def _path(mech: Any, r: float, phi, S) -> tuple[np.ndarray, ...]:
+    """Developed pitch curve on radius r: C, C′, C″ (per radian of cam angle) and the follower's unit
+    direction of increasing lift v, each (n, 2)."""
+    s0, s1, s2 = S
+    x = np.asarray(phi, dtype=float)
+    if mech.motion is FollowerMotion.TRANSLATING:
+        z = np.zeros_like(s0)
+        return xy(r * x, mech.z0 + s0), xy(r + z, s1), xy(z, s2), xy(z, 1.0 + z)
+    L = mech.arm_length_mm
+    f, f1, f2 = s0 * DEG, s1 * DEG, s2 * DEG
+    c, s = np.cos(f), np.sin(f)
+    e = L * (1.0 - c)
+    e1 = L * s * f1
+    e2 = L * (c * f1**2 + s * f2)
+    k = 1.0 / np.sqrt(1.0 - (e / r) ** 2)
+    g2 = e / r**2 * k**3
+    C = xy(r * x + r * np.arcsin(e / r), mech.z0 + L * s)
+    T = xy(r + k * e1, L * c * f1)
+    A = xy(k * e2 + g2 * e1**2, L * (c * f2 - s * f1**2))
+    v = xy(k * s, c)
+    return C, T, A, v / np.hypot(v[:, 0], v[:, 1])[:, None]
+
+
+class DevelopedContact(Contact):
+    """One flank of the groove on the developed cylinder of radius r.
+
+    ``sense`` is the flank: +1 the flank on the +z side of the roller, −1 the one on the −z side.  Its
+    ``roller_radius`` is the half groove width there (``R_r(r) + backlash/2``).  The pressure angle is the
+    angle from the follower's direction of increasing lift to the developed pitch normal, positive while the
+    roller rises (``tan δ = S′/r`` for a translating follower), the same on both flanks.
+    """
+
+    closed = False
+
+    def __init__(self, mechanism: Any, motion: MotionLike, radius: float, half_width: float, flank: int,
+                 label: str):
+        super().__init__(motion, flank)
+        self.mechanism, self.r, self.roller_radius, self.label = mechanism, float(radius), float(half_width), label
+        self.oscillating = mechanism.motion is FollowerMotion.OSCILLATING
+
+    def _evaluate(self, phi, rotate: bool, S=None) -> ProfileSample:
+        x, s = self._S(phi, S)
+        C, T, A, v = _path(self.mechanism, self.r, x, s)
+        sg, rr = self.sense, self.roller_radius
+        speed = np.hypot(T[:, 0], T[:, 1])
+        t = T / speed[:, None]
+        up = J(t)
+        kp = sg * cross(T, A) / speed**3
+        n = -sg * up
+        point = C - rr * n
+        scale = 1.0 - rr * kp
+        with np.errstate(divide="ignore", invalid="ignore"):
+            k = kp / scale
+        delta = np.arctan2(-cross(up, v), dot(up, v))
+        return ProfileSample(x, point, T * scale[:, None], n, sg * J(n), k, inverse(k), C, kp, inverse(kp), delta,
+                             None, None)
+
+    def pitch(self, phi) -> tuple[np.ndarray, np.ndarray]:
+        """The developed pitch curve on this radius and its derivative per radian, (n, 2) each."""
+        x, s = self._S(phi)
+        C, T, _, _ = _path(self.mechanism, self.r, x, s)
+        return C, T
+
+
+class CylindricalGeometry(CamGeometry):
+    """A cylindrical cam's geometry: both flanks on the groove bottom, the pitch cylinder and the outer
+    cylinder, in that order (six :class:`DevelopedContact`), each checked like a profile."""
+
+    @property
+    def cylinder(self) -> CylinderSpec:
+        return self.mechanism.cylinder
+
+    @property
+    def max_radius(self) -> float:
+        """The outer radius of the cylinder (mm)."""
+        return self.cylinder.outer_radius_mm
+
+    @property
+    def min_radius(self) -> float:
+        """The radius of the groove bottom (mm)."""
+        return self.cylinder.inner_radius_mm
+
+    def at_radius(self, r: float, flank: int = 1) -> DevelopedContact:
+        """The flank ``flank`` (+1: +z side, −1: −z side) on the developed cylinder of radius ``r``."""
+        return self.mechanism.flank(self.program, r, flank)
+
+
+def pitch_3d(geometry: CylindricalGeometry, phi, r: float | None = None) -> np.ndarray:
+    """The roller axis's point on the cylinder of radius ``r`` (default the pitch radius) in the cam frame
+    (cam axis Z, (n, 3) mm) at cam angles ``phi``: developed (x, z) wrapped to the polar angle 90° + σ·x/r."""
+    r = geometry.cylinder.radius_mm if r is None else r
+    C, _ = geometry.at_radius(r).pitch(phi)
+    a = 0.5 * math.pi + geometry.mechanism.sense * C[:, 0] / r
+    return np.stack([r * np.cos(a), r * np.sin(a), C[:, 1]], axis=1)
+
+
+def slip_ratio(geometry: CylindricalGeometry, n: int = 4001) -> float:
+    """The largest slip of the roller over the cycle, as a fraction of the cam surface speed at the pitch
+    radius: ``max |(|C_r′| − |C_R′|·ρ(r)/ρ(R))| / |C_R′|`` over the groove bottom and the outer cylinder, ρ the
+    roller's section (constant for a cylindrical roller, ∝ r for a conical one); the roller rolls without slip
+    at the pitch radius."""
+    cyl = geometry.cylinder
+    phi = np.linspace(0.0, geometry.period, n)
+    R = cyl.radius_mm
+    ref = np.hypot(*geometry.at_radius(R).pitch(phi)[1].T)
+    worst = 0.0
+    for r in (cyl.inner_radius_mm, cyl.outer_radius_mm):
+        speed = np.hypot(*geometry.at_radius(r).pitch(phi)[1].T)
+        ratio = r / R if cyl.roller is RollerShape.CONICAL else 1.0
+        worst = max(worst, float(np.max(np.abs(speed - ref * ratio) / ref)))
+    return worst
+
+
+# ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class _Cylindrical(Mechanism):
+    """Shared by both followers: the cylinder, the roller, the rotation sense."""
+
+    roller_radius_mm: float
+    cylinder: CylinderSpec
+    rotation: str = "cw"
+    cam_kind: ClassVar[CamKind] = CamKind.CYLINDRICAL
+    geometry_class: ClassVar[type[CamGeometry]] = CylindricalGeometry
+
+    @property
+    def z0(self) -> float:
+        """Axial position of the roller at S = 0 (set by :meth:`validate_motion`'s program; see ``_z0``)."""
+        return self._z0 if self._z0 is not None else 0.0
+
+    _z0: float | None = None
+
+    def validate(self) -> list[Problem]:
+        p: list[Problem] = []
+        require_rotation(p, self.rotation)
+        if finite_fields(self, p):
+            require_positive(p, "roller_radius_mm", self.roller_radius_mm)
+        c = self.cylinder
+        if c is None:
+            return [*p, Problem("cylinder", None, "a cylindrical cam needs its cylinder",
+                                "add [cylinder] with radius_mm, length_mm and groove_depth_mm")]
+        if c.groove_depth_mm >= 2 * c.radius_mm:
+            p.append(Problem("cylinder.groove_depth_mm", c.groove_depth_mm,
+                             f"the groove reaches the axis (it must be < 2·radius_mm = {2 * c.radius_mm:g} mm, "
+                             "radius_mm being the pitch radius, the middle of the depth)",
+                             "use a shallower groove or a larger radius_mm"))
+        if self.roller_radius_mm > 0 and c.radius_mm <= self.roller_radius_mm:
+            p.append(Problem("follower.roller_radius_mm", self.roller_radius_mm,
+                             f"the roller is wider than the pitch radius ({c.radius_mm:g} mm)",
+                             "use a smaller roller or a larger [cylinder] radius_mm"))
+        return p
+
+    def axial_travel(self, program: MotionLike) -> tuple[float, float]:
+        """Lowest and highest axial position of the roller axis relative to z₀ (mm)."""
+        lo, hi = lift_range(program)
+        if isinstance(self, CylindricalOscillating):
+            L = self.arm_length_mm
+            return L * math.sin(lo * DEG), L * math.sin(hi * DEG)
+        return lo, hi
+
+    def validate_motion(self, program: MotionLike, *, bore_mm: float | None = None) -> list[Problem]:
+        p = super().validate_motion(program, bore_mm=bore_mm)
+        if p:
+            return p
+        c = self.cylinder
+        lo, hi = self.axial_travel(program)
+        w = self.half_width(c.outer_radius_mm)
+        need = hi - lo + 2 * w
+        if need >= c.length_mm:
+            return [Problem("cylinder.length_mm", c.length_mm,
+                            f"the groove ({hi - lo:.6g} mm of travel plus the {2 * w:.6g} mm groove width) does "
+                            "not fit in the length",
+                            f"give length_mm > {need:.6g} (with walls at both ends) or a smaller lift")]
+        z0 = self.z0_for(program)
+        if z0 + lo - w <= 0 or z0 + hi + w >= c.length_mm:
+            return [Problem("cylinder.zero_position_mm", c.zero_position_mm,
+                            f"puts the groove (z from {z0 + lo - w:.6g} to {z0 + hi + w:.6g} mm) outside the cylinder "
+                            f"(0 to {c.length_mm:g} mm)",
+                            "remove zero_position_mm (the travel is then centred) or move it")]
+        return []
+
+    def z0_for(self, program: MotionLike) -> float:
+        """z₀: ``zero_position_mm``, or the value that centres the travel on the length."""
+        if self.cylinder.zero_position_mm is not None:
+            return self.cylinder.zero_position_mm
+        lo, hi = self.axial_travel(program)
+        return 0.5 * self.cylinder.length_mm - 0.5 * (lo + hi)
+
+    def half_width(self, r: float) -> float:
+        """Half the groove width at radius r: the roller's section there plus half the backlash."""
+        c = self.cylinder
+        rr = self.roller_radius_mm * (r / c.radius_mm if c.roller is RollerShape.CONICAL else 1.0)
+        return rr + 0.5 * c.backlash_mm
+
+    @property
+    def cone_half_angle_deg(self) -> float | None:
+        """A conical roller's half-angle (apex on the cam axis), degrees; None for a cylindrical one."""
+        if self.cylinder.roller is not RollerShape.CONICAL:
+            return None
+        return math.degrees(math.atan2(self.roller_radius_mm, self.cylinder.radius_mm))
+
+    def flank(self, program: MotionLike, r: float, flank: int) -> DevelopedContact:
+        import dataclasses
+
+        me = dataclasses.replace(self, _z0=self.z0_for(program))
+        where = {self.cylinder.inner_radius_mm: "groove bottom", self.cylinder.radius_mm: "pitch cylinder",
+                 self.cylinder.outer_radius_mm: "outer cylinder"}.get(r, "cylinder")
+        side = "+z" if flank > 0 else "-z"
+        return DevelopedContact(me, program, r, self.half_width(r), flank, f"{where} r = {r:.6g} mm, {side} flank")
+
+    def contacts(self, program: MotionLike) -> tuple[Contact, ...]:
+        c = self.cylinder
+        return tuple(self.flank(program, r, f) for r in (c.inner_radius_mm, c.radius_mm, c.outer_radius_mm)
+                     for f in (1, -1))
+
+
+@dataclass(frozen=True)
+class CylindricalTranslating(_Cylindrical):
+    """A cylindrical cam driving a roller follower that translates parallel to the cam axis."""
+
+    required: ClassVar[tuple[str, ...]] = ("roller_radius_mm",)
+
+    @classmethod
+    def from_spec(cls, spec: Any) -> CylindricalTranslating:
+        return cls(spec.follower.roller_radius_mm or 0.0, spec.cylinder, spec.cam.rotation)
+
+
+@dataclass(frozen=True)
+class CylindricalOscillating(_Cylindrical):
+    """A cylindrical cam driving an oscillating roller follower whose pivot is perpendicular to the cam axis
+    (module notes): the roller centre moves on an arc of radius ``arm_length_mm``."""
+
+    arm_length_mm: float = 0.0
+    motion: ClassVar[FollowerMotion] = FollowerMotion.OSCILLATING
+    required: ClassVar[tuple[str, ...]] = ("roller_radius_mm", "arm_length_mm")
+
+    @classmethod
+    def from_spec(cls, spec: Any) -> CylindricalOscillating:
+        f = spec.follower
+        return cls(f.roller_radius_mm or 0.0, spec.cylinder, spec.cam.rotation, None, f.arm_length_mm or 0.0)
+
+    def validate(self) -> list[Problem]:
+        p = super().validate()
+        require_positive(p, "arm_length_mm", self.arm_length_mm)
+        return p
+
+    def validate_motion(self, program: MotionLike, *, bore_mm: float | None = None) -> list[Problem]:
+        lo, hi = lift_range(program)
+        if max(abs(lo), abs(hi)) >= 90.0:
+            return [Problem("motion", max(abs(lo), abs(hi)), "the arm must stay within ±90° of the perpendicular to "
+                            "the cam axis (φ = S, degrees)", "use a smaller swing")]
+        e = self.arm_length_mm * (1.0 - math.cos(max(abs(lo), abs(hi)) * DEG))
+        r_in = self.cylinder.inner_radius_mm
+        if e >= r_in:
+            return [Problem("follower.arm_length_mm", self.arm_length_mm,
+                            f"the roller axis swings {e:.6g} mm aside, off the groove bottom (radius {r_in:.6g} mm)",
+                            "use a shorter arm or a smaller swing")]
+        return super().validate_motion(program, bore_mm=bore_mm)
+
+
+#: the registry entries of :mod:`camfab.design.mechanisms`
+FAMILIES: dict[tuple[CamKind, FollowerType, FollowerMotion], type[Mechanism]] = {
+    (CamKind.CYLINDRICAL, FollowerType.ROLLER, FollowerMotion.TRANSLATING): CylindricalTranslating,
+    (CamKind.CYLINDRICAL, FollowerType.ROLLER, FollowerMotion.OSCILLATING): CylindricalOscillating,
+}
+
+
+def radius_summary(geometry: CylindricalGeometry) -> list[dict[str, Any]]:
+    """Per radius checked (groove bottom, pitch, outer): the half groove width, the exact largest |pressure
+    angle| and where, and the smallest |radius of curvature| of the developed pitch curve and where (user units:
+    degrees of cam angle)."""
+    from .checks.common import ContactSample
+
+    out = []
+    for k in range(0, len(geometry.profiles), 2):
+        c = geometry.profiles[k]
+        assert isinstance(c, DevelopedContact)
+        s = ContactSample(c)
+        (xb, dmin), (xa, dmax) = s.extremes("pressure_angle")
+        (xk0, kmin), (xk1, kmax) = s.extremes("curvature_pitch")
+        worst_d, at_d = (dmax, xa) if abs(dmax) >= abs(dmin) else (dmin, xb)
+        worst_k, at_k = (kmax, xk1) if abs(kmax) >= abs(kmin) else (kmin, xk0)
+        out.append({"radius_mm": c.r, "where": c.label.split(" r =")[0], "half_width_mm": c.roller_radius,
+                    "pressure_angle_max_deg": abs(math.degrees(worst_d)), "at_deg": math.degrees(at_d),
+                    "min_pitch_radius_of_curvature_mm": abs(1.0 / worst_k) if worst_k else None,
+                    "at_curvature_deg": math.degrees(at_k)})
+    return out
+
+
+def cylinder_report(report: Any, geometry: CylindricalGeometry) -> Any:
+    """The check report of a cylindrical cam: its ``cylinder`` summary (radii, roller, slip) and its extent (the
+    outer radius; no profile area: the developed flanks enclose none)."""
+    import dataclasses
+
+    mech = geometry.mechanism
+    cyl = geometry.cylinder
+    summary = {"pitch_radius_mm": cyl.radius_mm, "inner_radius_mm": cyl.inner_radius_mm,
+               "outer_radius_mm": cyl.outer_radius_mm, "length_mm": cyl.length_mm,
+               "groove_depth_mm": cyl.groove_depth_mm, "backlash_mm": cyl.backlash_mm,
+               "zero_position_mm": mech.z0_for(geometry.program), "roller": cyl.roller.value,
+               "cone_half_angle_deg": mech.cone_half_angle_deg, "slip_ratio_max": slip_ratio(geometry),
+               "radii": radius_summary(geometry)}
+    return dataclasses.replace(report, cylinder=summary, area_mm2=None, base_radius_mm=cyl.inner_radius_mm,
+                               max_radius_mm=cyl.outer_radius_mm)
