@@ -265,7 +265,7 @@ def cmd_gcode(args: argparse.Namespace) -> int:
             stack.enter_context(output_folder(folder, lock=False))
         if _refuse_unacceptable(cam, "gcode", args.force):
             return EXIT_CHECKS
-        arts = pipeline.EXPORTERS[Output.GCODE](cam, req)
+        arts = kind_exporter(cam.spec.cam.kind, "gcode", pipeline.EXPORTERS[Output.GCODE])(cam, req)
         names = [out if len(arts) == 1 else out.with_name(f"{out.stem}_cam{i + 1}{out.suffix}")
                  for i in range(len(arts))]
         files: dict[Path, bytes | str] = {n: a.data for n, a in zip(names, arts, strict=True)}

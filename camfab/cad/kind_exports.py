@@ -37,10 +37,21 @@ def _cylinder_step(cam: Any, req: Any) -> list[Artifact]:
     return [Artifact(f"{safe_stem(cam.name)}.step", text.encode("utf-8"), "step", deviation_mm=dev)]
 
 
+def _cylinder_gcode(cam: Any, req: Any) -> list[Artifact]:
+    """``<stem>.nc``: the 4-axis program of the groove (:mod:`camfab.gcode.rotary`)."""
+    from ..gcode.model import design_job
+    from ..gcode.rotary import cylinder_job, rotary_gcode
+
+    tol = cam.tolerance(req.tol)
+    job = cylinder_job(design_job(cam.spec, tol=tol, overrides=req.machining), cam.geometry)
+    data, moves, dev = rotary_gcode(cam.geometry, job, tol, req.post)
+    return [Artifact(f"{safe_stem(cam.name)}.nc", data, "gcode", moves, dev, req.post)]
+
+
 #: cam kinds whose files are made by their own exporters, by output name; an output missing from a kind's
 #: entry does not apply to it (:func:`not_applicable_reason`)
 KIND_EXPORTERS: dict[str, dict[str, Callable[[Any, Any], list[Artifact]]]] = {
-    "cylindrical": {"dxf": _cylinder_dxf, "step": _cylinder_step},
+    "cylindrical": {"dxf": _cylinder_dxf, "step": _cylinder_step, "gcode": _cylinder_gcode},
 }
 
 

@@ -33,7 +33,8 @@ pytestmark = pytest.mark.skipif(RS274 is None, reason="LinuxCNC's rs274 interpre
                                                       "(Debian package linuxcnc-uspace; .ci/run installs it)")
 
 POSTS = ("linuxcnc", "fanuc", "grbl")
-EXAMPLES = [e for e in pipeline.examples() if applies(pipeline.load(e).spec.cam.kind, "gcode")]  # milled plates
+EXAMPLES = [e for e in pipeline.examples() if applies(pipeline.load(e).spec.cam.kind, "gcode")  # milled plates
+            and pipeline.load(e).spec.cam.kind != "cylindrical"]  # the 4-axis program: tests/gcode/test_rotary.py
 FAST = ("wedge_translating", "ejemplo11ro")  # the two with near-straight stretches (huge arcs before the limit)
 
 _CALL = re.compile(r"^\s*\d+\s+N\S*\s+([A-Z_]+)\((.*)\)\s*$")

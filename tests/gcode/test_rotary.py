@@ -1,0 +1,131 @@
+"""The 4-axis program of a cylindrical cam (camfab.gcode.rotary): back-plotted on the cylinder against the exact
+motion law written out here (the example's cycloidal rise and return), read by LinuxCNC's ``rs274``, refused on
+GRBL and with a tool as wide as the groove."""
+from __future__ import annotations
+
+import math
+import re
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from camfab import pipeline
+from camfab.cli import main
+from camfab.errors import ExportError, SpecError
+from camfab.gcode.model import design_job
+from camfab.gcode.rotary import cylinder_job, rotary_gcode
+
+EXAMPLE = Path(pipeline.__file__).parent / "examples" / "cylindrical_translating.toml"
+RS274 = shutil.which("rs274")
+_WORD = re.compile(r"([A-Z])([+-]?\d+\.?\d*)")
+
+
+def _law(theta: np.ndarray) -> np.ndarray:
+    """The example's axial position (mm) at cam angle θ (rad): z₀ = 20 (the 20 mm travel centred on 60 mm),
+    cycloidal rise 20 mm over 140°, dwell 40°, cycloidal return over 140°, dwell 40°."""
+    t = np.mod(np.degrees(theta), 360.0)
+    cyc = lambda u: u - np.sin(2 * np.pi * u) / (2 * np.pi)  # noqa: E731
+    s = np.where(t < 140, 20 * cyc(t / 140), 20.0)
+    s = np.where((t >= 180) & (t < 320), 20 - 20 * cyc((t - 180) / 140), s)
+    s = np.where(t >= 320, 0.0, s)
+    return 20.0 + s
+
+
+def _program(post: str = "linuxcnc", **machining) -> tuple[bytes, float]:
+    cam = pipeline.load(str(EXAMPLE))
+    tol = cam.tolerance()
+    job = cylinder_job(design_job(cam.spec, tol=tol, overrides=machining), cam.geometry)
+    data, _, _ = rotary_gcode(cam.geometry, job, tol, post)
+    return data, tol
+
+
+def _passes(text: str) -> list[tuple[float, np.ndarray]]:
+    """Each inverse-time pass as (Z, array of (X, A, F)), read with a tiny modal reader (camfab's parser has no
+    A axis); the start point of each pass (the plunge's X, A) comes first with F = nan."""
+    out, pos, g93, cur = [], {"X": math.nan, "A": math.nan, "Z": math.nan}, False, None
+    for line in text.splitlines():
+        if line.startswith("(") or line == "%" or line.startswith("O"):
+            continue
+        words = dict(_WORD.findall(line.split("(")[0]))
+        words.pop("N", None)
+        if words.get("G") == "93":
+            g93, cur = True, [(pos["X"], pos["A"], math.nan)]
+        elif words.get("G") == "94" and g93:
+            g93 = False
+            out.append((pos["Z"], np.array(cur)))
+        for k in "XAZ":
+            if k in words:
+                pos[k] = float(words[k])
+        if g93 and words.get("G") == "1":
+            assert "F" in words, f"an inverse-time move without F: {line}"
+            assert "Z" not in words
+            cur.append((pos["X"], pos["A"], float(words["F"])))
+    return out
+
+
+@pytest.mark.parametrize("post", ["linuxcnc", "fanuc"])
+def test_backplot_lies_on_the_exact_pitch_curve(post):
+    data, tol = _program(post)
+    passes = _passes(data.decode())
+    assert len(passes) == 4  # 10 mm deep, step-down 3 mm: four levels
+    zs = [z for z, _ in passes]
+    assert zs[-1] == pytest.approx(35.0, abs=1e-9)  # the last level on the groove bottom radius
+    assert np.all(np.diff([45.0, *zs]) < 0) and np.all(-np.diff([45.0, *zs]) <= 3.0 + 1e-9)
+    feed = 644.6  # the cutting data of the example (header)
+    for r, P in passes:
+        X, A, F = P.T
+        theta = -np.radians(A)  # cw: A = −θ
+        assert theta[0] == pytest.approx(0.0) and theta[-1] == pytest.approx(2 * np.pi)
+        assert np.all(np.diff(theta) > 0)
+        assert np.max(np.abs(X - _law(theta))) <= tol  # every programmed point on the exact law
+        # every chord within tol of the exact curve between its ends, on the developed cylinder of radius r
+        t = np.linspace(0.0, 1.0, 9)[1:-1, None]
+        th = theta[:-1] + t * np.diff(theta)
+        q = np.stack([r * th, _law(th)], axis=-1)
+        a = np.stack([r * theta[:-1], X[:-1]], axis=-1)
+        b = np.stack([r * theta[1:], X[1:]], axis=-1)
+        d = b - a
+        u = np.clip(np.sum((q - a) * d, axis=-1) / np.sum(d * d, axis=-1), 0, 1)
+        dev = np.hypot(*(q - a - u[..., None] * d).transpose(2, 0, 1))
+        assert dev.max() <= tol, f"chord {dev.max():.5f} mm off the exact pitch curve at r = {r}"
+        # inverse time: each move's minutes (1/F) are its length on the tool tip's cylinder at the feed
+        length = np.hypot(np.diff(X), r * np.diff(theta))
+        assert np.allclose(1.0 / F[1:], length / feed, rtol=2e-3)
+
+
+@pytest.mark.skipif(RS274 is None, reason="LinuxCNC's rs274 interpreter is not installed (linuxcnc-uspace)")
+@pytest.mark.parametrize("post", ["linuxcnc", "fanuc"])
+def test_rs274_runs_the_4_axis_program(post, tmp_path):
+    """rs274's default configuration has the A axis: it runs the program and its feeds end on the groove bottom,
+    every fed point on the exact law."""
+    data, tol = _program(post)
+    (tmp_path / "p.ngc").write_bytes(data)
+    proc = subprocess.run([str(RS274), "-g", str(tmp_path / "p.ngc")], capture_output=True, text=True, timeout=120,
+                          stdin=subprocess.DEVNULL)
+    assert proc.returncode == 0, proc.stdout[-600:]
+    feeds = np.array([[float(v) for v in m.group(1).split(",")[:4]] for m in
+                      re.finditer(r"STRAIGHT_FEED\(([^)]*)\)", proc.stdout)])
+    assert "PROGRAM_END" in proc.stdout
+    cut = feeds[np.abs(feeds[:, 3]) > 0]  # the moves that turn the table
+    assert np.allclose(cut[:, 1], 0.0) and cut[-1, 2] == pytest.approx(35.0)
+    assert np.max(np.abs(cut[:, 0] - _law(-np.radians(cut[:, 3])))) <= tol
+
+
+def test_grbl_and_a_wide_tool_are_refused(tmp_path):
+    with pytest.raises(ExportError, match="--post grbl.*rotary"):
+        _program("grbl")
+    with pytest.raises(SpecError, match="manufacturing.tool_diameter_mm"):
+        _program(tool_diameter_mm=12.05)
+    out = tmp_path / "g.nc"
+    assert main(["gcode", str(EXAMPLE), "-o", str(out), "--post", "grbl"]) == 2
+    assert main(["gcode", str(EXAMPLE), "-o", str(out), "--tool-diameter", "12.5"]) == 2
+    assert not out.exists()
+
+
+def test_run_writes_the_program(tmp_path):
+    assert main(["run", str(EXAMPLE), "-o", str(tmp_path), "--outputs", "gcode"]) in (0, 1)
+    text = (tmp_path / "BarrelCam.nc").read_text()
+    assert "G93" in text and "A-360.0000" in text and "Z0 on the rotary axis" in text
