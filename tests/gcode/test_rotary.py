@@ -129,3 +129,40 @@ def test_run_writes_the_program(tmp_path):
     assert main(["run", str(EXAMPLE), "-o", str(tmp_path), "--outputs", "gcode"]) in (0, 1)
     text = (tmp_path / "BarrelCam.nc").read_text()
     assert "G93" in text and "A-360.0000" in text and "Z0 on the rotary axis" in text
+
+
+@pytest.mark.parametrize("rotation,follower", [
+    ("ccw", {}),
+    ("cw", {"motion": "oscillating", "arm_length_mm": 60.0}),
+    ("ccw", {"motion": "oscillating", "arm_length_mm": 60.0}),
+])
+def test_tool_tip_lies_on_the_3d_pitch_curve(rotation, follower):
+    """The work offset and the sign of A, in 3D: each programmed tool tip (X, A, Z) taken back into the cam frame
+    (machine (Y, Z, X) = cam (X_c, Y_c, Z_c), the part turned back by −A about X) lies on the 3D pitch curve of its
+    radius (``pitch_3d``) within the tolerance, for either sense and the oscillating follower's exact arc."""
+    from scipy.spatial import cKDTree
+
+    from camfab.design.cylindrical import pitch_3d
+    from camfab.design.mechanisms import geometry_from_spec
+    from camfab.design.spec import design_from_dict
+    from camfab.gcode.model import Job
+
+    f = {"type": "roller", "motion": "translating", "roller_radius_mm": 6.0} | follower
+    lift = 15.0 if follower else 20.0
+    spec = design_from_dict({"name": "b", "cam": {"kind": "cylindrical", "rotation": rotation}, "follower": f,
+                             "cylinder": {"radius_mm": 40.0, "length_mm": 80.0, "groove_depth_mm": 10.0},
+                             "motion": [{"law": "cycloidal", "lift": lift, "angle_deg": 150.0},
+                                        {"law": "cycloidal", "lift": -lift, "angle_deg": 210.0}]})
+    geom = geometry_from_spec(spec)
+    tol = 0.01
+    data, _, _ = rotary_gcode(geom, Job(tool_diameter_mm=8.0, depth_mm=10.0, tolerance_mm=tol), tol, "linuxcnc")
+    passes = _passes(data.decode())
+    assert [z for z, _ in passes][-1] == pytest.approx(35.0)
+    for r, P in passes:
+        X, A, _ = P.T
+        a = np.radians(A)
+        # the tool tip is at machine (X, 0, r); in the part frame (turned back by A): Y = r·sin A, Z = r·cos A
+        tip = np.stack([r * np.sin(a), r * np.cos(a), X], axis=1)
+        dense = pitch_3d(geom, np.linspace(0.0, 2 * np.pi, 400_001), r)
+        dist, _ = cKDTree(dense).query(tip)
+        assert dist.max() <= tol, f"{rotation} {follower}: tool tip {dist.max():.5f} mm off the 3D pitch curve"
