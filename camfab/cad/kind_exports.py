@@ -37,21 +37,16 @@ def _cylinder_step(cam: Any, req: Any) -> list[Artifact]:
     return [Artifact(f"{safe_stem(cam.name)}.step", text.encode("utf-8"), "step", deviation_mm=dev)]
 
 
-def _cylinder_gcode(cam: Any, req: Any) -> list[Artifact]:
-    """``<stem>.nc``: the 4-axis program of the groove (:mod:`camfab.gcode.rotary`)."""
-    from ..gcode.model import design_job
-    from ..gcode.rotary import cylinder_job, rotary_gcode
-
-    tol = cam.tolerance(req.tol)
-    job = cylinder_job(design_job(cam.spec, tol=tol, overrides=req.machining), cam.geometry)
-    data, moves, dev = rotary_gcode(cam.geometry, job, tol, req.post)
-    return [Artifact(f"{safe_stem(cam.name)}.nc", data, "gcode", moves, dev, req.post)]
+def _by_pipeline(cam: Any, req: Any) -> list[Artifact]:
+    """Marker of an output the pipeline's own exporter makes for the kind, from a layer above ``camfab.cad``
+    (the cylindrical cam's 4-axis program: :mod:`camfab.gcode.rotary`, dispatched in ``pipeline._gcode``)."""
+    raise ExportError("made by the pipeline's own exporter")  # kind_exporter never returns it
 
 
 #: cam kinds whose files are made by their own exporters, by output name; an output missing from a kind's
 #: entry does not apply to it (:func:`not_applicable_reason`)
 KIND_EXPORTERS: dict[str, dict[str, Callable[[Any, Any], list[Artifact]]]] = {
-    "cylindrical": {"dxf": _cylinder_dxf, "step": _cylinder_step, "gcode": _cylinder_gcode},
+    "cylindrical": {"dxf": _cylinder_dxf, "step": _cylinder_step, "gcode": _by_pipeline},
 }
 
 
@@ -66,7 +61,7 @@ def kind_exporter(kind: str, out: str, default: Callable[[Any, Any], list[Artifa
     own = KIND_EXPORTERS.get(kind)
     if own is not None and out not in own:
         raise ExportError(f"{out}: {not_applicable_reason(kind, str(out))}")
-    return default if own is None else own[out]
+    return default if own is None or own[out] is _by_pipeline else own[out]
 
 
 def applicable(cam: Any, outputs: Sequence[Any]) -> tuple[list[Any], dict[str, str]]:
