@@ -168,6 +168,8 @@ def rotary_gcode(geometry: Any, job: Job, tol: float, post: str | Post = "linuxc
                  f"groove: bottom Z{L(cyl.inner_radius_mm)}, outer Z{L(cyl.outer_radius_mm)}, "
                  f"width {L(2 * geometry.mechanism.half_width(cyl.inner_radius_mm))} {u} at the bottom",
                  f"tolerance: {tol:.6f} mm, output resolution {10.0 ** -d:.{d}f} {u} and {10.0 ** -d:.{d}f} deg",
+                 f"flanks: centre pass only, "
+                 f"{L(geometry.mechanism.half_width(cyl.inner_radius_mm) - job.tool_radius_mm)} {u} left on each",
                  f"depth levels: {len(levels)}, safe Z{L(safe)}",
                  f"spindle: {round(job.spindle_rpm)} rpm cw",
                  f"feed: {job.feed_mm_min * k:.{fd}f} {u}/min at the tool tip as inverse time G93, "
