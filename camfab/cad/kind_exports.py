@@ -38,16 +38,16 @@ def _cylinder_step(cam: Any, req: Any) -> list[Artifact]:
 
 
 #: cam kinds whose files are made by their own exporters, by output name; an output missing from a kind's
-#: entry does not apply to it (:func:`not_applicable_reason`)
-KIND_EXPORTERS: dict[str, dict[str, Callable[[Any, Any], list[Artifact]]]] = {
-    "cylindrical": {"dxf": _cylinder_dxf, "step": _cylinder_step},
+#: entry does not apply to it (:func:`not_applicable_reason`); None: the pipeline's own stage, which handles the kind
+KIND_EXPORTERS: dict[str, dict[str, Callable[[Any, Any], list[Artifact]] | None]] = {
+    "cylindrical": {"dxf": _cylinder_dxf, "step": _cylinder_step, "xlsx": None},
 }
 
 
 def not_applicable_reason(kind: str, output: str) -> str:
     """Why ``output`` is not made for a cam of ``kind`` (an entry of :data:`KIND_EXPORTERS` lacks it)."""
-    return (f"not yet made for a {kind} cam (its files are the developed-groove DXF and the grooved-cylinder "
-            "STEP; see README, \"Cylindrical cams\")")
+    made = ", ".join(sorted(KIND_EXPORTERS.get(kind, {})))
+    return f"not yet made for a {kind} cam (it gets {made}; see README, \"Cylindrical cams\")"
 
 
 def kind_exporter(kind: str, out: str, default: Callable[[Any, Any], list[Artifact]]) -> Any:
@@ -55,7 +55,7 @@ def kind_exporter(kind: str, out: str, default: Callable[[Any, Any], list[Artifa
     own = KIND_EXPORTERS.get(kind)
     if own is not None and out not in own:
         raise ExportError(f"{out}: {not_applicable_reason(kind, str(out))}")
-    return default if own is None else own[out]
+    return default if own is None or own[out] is None else own[out]
 
 
 def applicable(cam: Any, outputs: Sequence[Any]) -> tuple[list[Any], dict[str, str]]:

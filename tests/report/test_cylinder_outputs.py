@@ -1,0 +1,70 @@
+"""A cylindrical cam's workbook and report: the ``Cylinder`` sheet read back with openpyxl against the closed-form
+development (cycloidal rise: x = r·θ, z = z₀ + S, the flanks at ± the half width along the developed normal,
+tan δ = S′/r), and the report's unrolled-profile plot against the exact developed curves."""
+from __future__ import annotations
+
+import io
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from camfab.pipeline import Output, Request, load, run
+
+openpyxl = pytest.importorskip("openpyxl")
+
+EXAMPLE = Path(__file__).parents[2] / "camfab" / "examples" / "cylindrical_translating.toml"
+H, BETA, RR, BACKLASH, Z0 = 20.0, math.radians(140.0), 6.0, 0.05, 20.0  # the example's rise, roller, groove
+
+
+def exact(theta: np.ndarray, r: float) -> dict[str, np.ndarray]:
+    """The example's developed pitch curve and flanks on radius r, from the cycloidal law in closed form."""
+    s0 = np.zeros_like(theta)
+    s1 = np.zeros_like(theta)
+    up = theta <= BETA
+    t = theta[up] / BETA
+    s0[up] = H * (t - np.sin(2 * np.pi * t) / (2 * np.pi))
+    s1[up] = H / BETA * (1 - np.cos(2 * np.pi * t))
+    down = (theta >= BETA + math.radians(40)) & (theta <= 2 * BETA + math.radians(40))
+    t = (theta[down] - BETA - math.radians(40)) / BETA
+    s0[down] = H - H * (t - np.sin(2 * np.pi * t) / (2 * np.pi))
+    s1[down] = -H / BETA * (1 - np.cos(2 * np.pi * t))
+    s0[(theta > BETA) & ~down] = np.where(theta[(theta > BETA) & ~down] < math.pi, H, 0.0)
+    pitch = np.stack([r * theta, Z0 + s0], axis=1)
+    n = np.stack([-s1, np.full_like(s1, r)], axis=1) / np.hypot(r, s1)[:, None]  # developed normal towards +z
+    w = RR + BACKLASH / 2
+    return {"S": s0, "pitch": pitch, "plus": pitch + w * n, "minus": pitch - w * n,
+            "delta": np.degrees(np.arctan2(s1, r))}
+
+
+@pytest.fixture(scope="module")
+def cam():
+    return load(EXAMPLE)
+
+
+def test_workbook_cylinder_sheet_is_the_exact_development(cam, tmp_path):
+    res = run(cam, tmp_path, Request(frozenset({Output.XLSX})))
+    assert "xlsx" not in res.not_applicable
+    wb = openpyxl.load_workbook(io.BytesIO((tmp_path / "BarrelCam.xlsx").read_bytes()), data_only=True)
+    assert wb.sheetnames == ["Cylinder", "Checks"]
+    ws = wb["Cylinder"]
+    assert ws["A2"].value == "BarrelCam" and ws["B4"].value == 40.0 and ws["B10"].value == Z0
+    head = [c.value for c in ws[13]]
+    rows = np.array([[np.nan if v is None else v for v in row] for row in ws.iter_rows(min_row=14, values_only=True)],
+                    dtype=float)
+    assert rows.shape == (361, 5 + 3 * 8)
+    theta = np.radians(rows[:, 0])
+    np.testing.assert_allclose(rows[:, 0], np.arange(361.0))
+    np.testing.assert_allclose(rows[:, 1], exact(theta, 40.0)["S"], atol=1e-9)
+    for k, r in enumerate((35.0, 40.0, 45.0)):
+        c = 5 + 8 * k
+        assert head[c] == f"r = {r:g} mm pitch x (mm)"
+        ex = exact(theta, r)
+        np.testing.assert_allclose(rows[:, c:c + 2], ex["pitch"], atol=1e-9)
+        np.testing.assert_allclose(rows[:, c + 2:c + 4], ex["plus"], atol=1e-9)
+        np.testing.assert_allclose(rows[:, c + 4:c + 6], ex["minus"], atol=1e-9)
+        np.testing.assert_allclose(rows[:, c + 6], ex["delta"], atol=1e-9)
+        # the groove is the roller diameter plus the backlash wide everywhere
+        width = np.hypot(*(rows[:, c + 2:c + 4] - rows[:, c + 4:c + 6]).T)
+        np.testing.assert_allclose(width, 2 * RR + BACKLASH, atol=1e-9)
