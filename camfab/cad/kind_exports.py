@@ -40,7 +40,7 @@ def _cylinder_step(cam: Any, req: Any) -> list[Artifact]:
 #: cam kinds whose files are made by their own exporters, by output name; an output missing from a kind's
 #: entry does not apply to it (:func:`not_applicable_reason`); None: the pipeline's own stage, which handles the kind
 KIND_EXPORTERS: dict[str, dict[str, Callable[[Any, Any], list[Artifact]] | None]] = {
-    "cylindrical": {"dxf": _cylinder_dxf, "step": _cylinder_step, "xlsx": None},
+    "cylindrical": {"dxf": _cylinder_dxf, "step": _cylinder_step, "xlsx": None, "report": None},
 }
 
 

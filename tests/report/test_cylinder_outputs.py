@@ -68,3 +68,27 @@ def test_workbook_cylinder_sheet_is_the_exact_development(cam, tmp_path):
         # the groove is the roller diameter plus the backlash wide everywhere
         width = np.hypot(*(rows[:, c + 2:c + 4] - rows[:, c + 4:c + 6]).T)
         np.testing.assert_allclose(width, 2 * RR + BACKLASH, atol=1e-9)
+
+
+def test_unrolled_plot_is_the_exact_development(cam):
+    from camfab.report.cylinder_plot import unrolled_figure
+
+    fig = unrolled_figure(cam.spec, cam.geometry)
+    lines = {ln.get_label(): np.asarray(ln.get_xydata()) for ln in fig.axes[0].get_lines()}
+    pitch = lines["pitch curve"]
+    theta = pitch[:, 0] / 40.0
+    assert theta.min() == 0.0 and theta.max() == pytest.approx(2 * math.pi) and len(theta) > 1000
+    ex = exact(theta, 40.0)
+    np.testing.assert_allclose(pitch, ex["pitch"], atol=1e-9)
+    np.testing.assert_allclose(lines["+z flank"], ex["plus"], atol=1e-9)
+    np.testing.assert_allclose(lines["-z flank"], ex["minus"], atol=1e-9)
+
+
+def test_run_writes_the_report_with_the_unrolled_plot(cam, tmp_path):
+    res = run(cam, tmp_path, Request(frozenset({Output.REPORT})))
+    assert "report" not in res.not_applicable
+    html = (tmp_path / "report.html").read_text(encoding="utf-8")
+    for name in ("unrolled", "svaj", "pressure_angle"):
+        assert f'src="plots/{name}.svg"' in html
+        assert (tmp_path / "plots" / f"{name}.svg").read_bytes().startswith(b"<?xml")
+    assert html.count('src="plots/unrolled.svg"') == 1 and "Unrolled groove" in html
