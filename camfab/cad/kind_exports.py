@@ -37,10 +37,20 @@ def _cylinder_step(cam: Any, req: Any) -> list[Artifact]:
     return [Artifact(f"{safe_stem(cam.name)}.step", text.encode("utf-8"), "step", deviation_mm=dev)]
 
 
+def _cylinder_stl(cam: Any, req: Any) -> list[Artifact]:
+    """``<stem>.stl``: the grooved cylinder's solid tessellated by OpenCascade (:mod:`camfab.cad.cylinder`)."""
+    from .cylinder import cylinder_stl  # cadquery only when a file is made
+
+    data, dev = cylinder_stl(cam.geometry, tol=cam.tolerance(req.tol), name=cam.name,
+                             bore_mm=cam.spec.manufacturing.bore_mm)
+    return [Artifact(f"{safe_stem(cam.name)}.stl", data, "stl", deviation_mm=dev)]
+
+
 #: cam kinds whose files are made by their own exporters, by output name; an output missing from a kind's
 #: entry does not apply to it (:func:`not_applicable_reason`); None: the pipeline's own stage, which handles the kind
 KIND_EXPORTERS: dict[str, dict[str, Callable[[Any, Any], list[Artifact]] | None]] = {
-    "cylindrical": {"dxf": _cylinder_dxf, "step": _cylinder_step, "xlsx": None, "report": None},
+    "cylindrical": {"dxf": _cylinder_dxf, "step": _cylinder_step, "xlsx": None, "report": None,
+                    "stl": _cylinder_stl},
 }
 
 
