@@ -15,7 +15,7 @@ from ..errors import ExportError
 from ..io import safe_stem
 from .artifact import Artifact
 
-__all__ = ["KIND_EXPORTERS", "not_applicable_reason", "kind_exporter", "applicable", "applies"]
+__all__ = ["KIND_EXPORTERS", "KIND_CAD_OUTPUTS", "not_applicable_reason", "kind_exporter", "applicable", "applies"]
 
 log = logging.getLogger("camfab.pipeline")
 
@@ -52,6 +52,9 @@ KIND_EXPORTERS: dict[str, dict[str, Callable[[Any, Any], list[Artifact]] | None]
     "cylindrical": {"dxf": _cylinder_dxf, "step": _cylinder_step, "xlsx": None, "report": None,
                     "stl": _cylinder_stl},
 }
+
+#: a kind's own outputs that need cadquery: a run skips them with a warning when it is missing, as the STEP
+KIND_CAD_OUTPUTS: dict[str, frozenset[str]] = {"cylindrical": frozenset({"step", "stl"})}
 
 
 def not_applicable_reason(kind: str, output: str) -> str:
