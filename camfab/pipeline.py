@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from .cad.artifact import Artifact, CamShapes, build_artifacts, cam_shapes, validate_tol
-from .cad.kind_exports import applicable, kind_exporter
+from .cad.kind_exports import KIND_CAD_OUTPUTS, applicable, kind_exporter
 from .design.assemble import check_design, mechanism_from_spec
 from .design.mechanisms import geometry_from_spec
 from .design.profile import CamGeometry, ProfileSample
@@ -555,7 +555,7 @@ def build_files(cam: Cam, req: Request, res: RunResult, say: Callable[[str], Non
         try:
             arts = _timed(res, str(out), say, kind_exporter(cam.spec.cam.kind, out, EXPORTERS[out]), cam, req)
         except MissingDependencyError as exc:
-            if out not in CAD_OUTPUTS:
+            if out not in CAD_OUTPUTS and out not in KIND_CAD_OUTPUTS.get(cam.spec.cam.kind, ()):
                 raise
             log.warning("%s: %s skipped: %s; the other files are written", cam.name, out, exc)
             res.skipped.append(str(out))

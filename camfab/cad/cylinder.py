@@ -25,11 +25,12 @@ import numpy as np
 from ..design.cylindrical import CylindricalGeometry, pitch_3d
 from ..discretize import ParametricCurve, arcs
 from ..errors import ExportError
-from ..textsafe import dxf_string
+from ..textsafe import dxf_string, plain
 from .dxf import LAYERS, ezdxf_module, write_deterministic
 from .step import cadquery, solid_dumps
 
-__all__ = ["developed_curves", "developed_dxf", "grooved_cylinder", "cylinder_step", "SWEEP_POINTS"]
+__all__ = ["developed_curves", "developed_dxf", "grooved_cylinder", "cylinder_step", "cylinder_stl", "solid_mesh",
+           "sweep_points", "SWEEP_POINTS"]
 
 #: points of the 3D pitch curve the STEP's periodic B-spline passes through (per turn) to begin with; doubled
 #: (at most 4 times) until the spline lies within the tolerance (the sweep's cost grows with them: 8 s at 48)
@@ -179,6 +180,13 @@ def cylinder_step(geometry: CylindricalGeometry, *, tol: float, name: str = "cam
                   bore_mm: float = 0.0) -> tuple[str, float]:
     """STEP text of the grooved cylinder and the measured deviation of its sweep path (mm); more points when
     the default ones leave the path farther than ``tol`` from the exact curve."""
+    n, dev = sweep_points(geometry, tol)
+    return solid_dumps(grooved_cylinder(geometry, n=n, bore_mm=bore_mm), name=name), dev
+
+
+def sweep_points(geometry: CylindricalGeometry, tol: float) -> tuple[int, float]:
+    """The points of the sweep path (:data:`SWEEP_POINTS`, doubled while the path lies farther than ``tol`` from
+    the exact pitch curve) and the path's measured deviation (mm)."""
     n = SWEEP_POINTS
     dev = path_deviation(geometry, n)
     while dev > tol and n < 16 * SWEEP_POINTS:
@@ -187,4 +195,31 @@ def cylinder_step(geometry: CylindricalGeometry, *, tol: float, name: str = "cam
     if dev > tol:
         raise ExportError(f"the STEP sweep path stays {dev:.3g} mm from the exact pitch curve with {n} points, more "
                           f"than the {tol:g} mm tolerance. Give a larger [manufacturing] tolerance_mm")
-    return solid_dumps(grooved_cylinder(geometry, n=n, bore_mm=bore_mm), name=name), dev
+    return n, dev
+
+
+def solid_mesh(solid, tol: float):
+    """The cadquery solid tessellated by OpenCascade (linear deflection ``tol`` mm, 0.2 rad angular), as a
+    trimesh with the faces' shared edge points merged; refused unless watertight."""
+    import trimesh
+    from OCP.BRepMesh import BRepMesh_IncrementalMesh
+
+    BRepMesh_IncrementalMesh(solid.wrapped, tol, False, 0.2, True)  # absolute deflection (cadquery's is relative)
+    verts, tris = solid.tessellate(tol, 0.2)  # reads that triangulation (fine enough: not meshed again)
+    mesh = trimesh.Trimesh(np.array([v.toTuple() for v in verts]), np.array(tris, dtype=np.int64), process=False)
+    mesh.merge_vertices()
+    if not mesh.is_watertight:
+        raise ExportError("the grooved cylinder's mesh is not watertight (OpenCascade's tessellation left a gap). "
+                          "Give another [manufacturing] tolerance_mm")
+    return mesh
+
+
+def cylinder_stl(geometry: CylindricalGeometry, *, tol: float, name: str = "cam",
+                 bore_mm: float = 0.0) -> tuple[bytes, float]:
+    """Binary STL of the grooved cylinder (the STEP's solid, :func:`solid_mesh` within ``tol``) and the sweep
+    path's measured deviation (mm; the mesh adds at most ``tol``, OCC's linear deflection)."""
+    n, dev = sweep_points(geometry, tol)
+    mesh = solid_mesh(grooved_cylinder(geometry, n=n, bore_mm=bore_mm), tol)
+    data = mesh.export(file_type="stl")
+    head = f"camfab {plain(name)} units=mm tol={tol:g} grooved cylinder".encode("ascii", "replace")[:80]
+    return head.ljust(80, b" ") + data[80:], dev

@@ -15,7 +15,7 @@ from ..errors import ExportError
 from ..io import safe_stem
 from .artifact import Artifact
 
-__all__ = ["KIND_EXPORTERS", "not_applicable_reason", "kind_exporter", "applicable", "applies"]
+__all__ = ["KIND_EXPORTERS", "KIND_CAD_OUTPUTS", "not_applicable_reason", "kind_exporter", "applicable", "applies"]
 
 log = logging.getLogger("camfab.pipeline")
 
@@ -37,23 +37,31 @@ def _cylinder_step(cam: Any, req: Any) -> list[Artifact]:
     return [Artifact(f"{safe_stem(cam.name)}.step", text.encode("utf-8"), "step", deviation_mm=dev)]
 
 
-def _by_pipeline(cam: Any, req: Any) -> list[Artifact]:
-    """Marker of an output the pipeline's own exporter makes for the kind, from a layer above ``camfab.cad``
-    (the cylindrical cam's 4-axis program: :mod:`camfab.gcode.rotary`, dispatched in ``pipeline._gcode``)."""
-    raise ExportError("made by the pipeline's own exporter")  # kind_exporter never returns it
+def _cylinder_stl(cam: Any, req: Any) -> list[Artifact]:
+    """``<stem>.stl``: the grooved cylinder's solid tessellated by OpenCascade (:mod:`camfab.cad.cylinder`)."""
+    from .cylinder import cylinder_stl  # cadquery only when a file is made
+
+    data, dev = cylinder_stl(cam.geometry, tol=cam.tolerance(req.tol), name=cam.name,
+                             bore_mm=cam.spec.manufacturing.bore_mm)
+    return [Artifact(f"{safe_stem(cam.name)}.stl", data, "stl", deviation_mm=dev)]
 
 
 #: cam kinds whose files are made by their own exporters, by output name; an output missing from a kind's
-#: entry does not apply to it (:func:`not_applicable_reason`)
-KIND_EXPORTERS: dict[str, dict[str, Callable[[Any, Any], list[Artifact]]]] = {
-    "cylindrical": {"dxf": _cylinder_dxf, "step": _cylinder_step, "gcode": _by_pipeline},
+#: entry does not apply to it (:func:`not_applicable_reason`); None: the pipeline's own stage, which handles the kind
+#: (the report and workbook; the 4-axis program of :mod:`camfab.gcode.rotary`, dispatched in ``pipeline._gcode``)
+KIND_EXPORTERS: dict[str, dict[str, Callable[[Any, Any], list[Artifact]] | None]] = {
+    "cylindrical": {"dxf": _cylinder_dxf, "step": _cylinder_step, "xlsx": None, "report": None,
+                    "stl": _cylinder_stl, "gcode": None},
 }
+
+#: a kind's own outputs that need cadquery: a run skips them with a warning when it is missing, as the STEP
+KIND_CAD_OUTPUTS: dict[str, frozenset[str]] = {"cylindrical": frozenset({"step", "stl"})}
 
 
 def not_applicable_reason(kind: str, output: str) -> str:
     """Why ``output`` is not made for a cam of ``kind`` (an entry of :data:`KIND_EXPORTERS` lacks it)."""
-    return (f"not yet made for a {kind} cam (its files are the developed-groove DXF and the grooved-cylinder "
-            "STEP; see README, \"Cylindrical cams\")")
+    made = ", ".join(sorted(KIND_EXPORTERS.get(kind, {})))
+    return f"not yet made for a {kind} cam (it gets {made}; see README, \"Cylindrical cams\")"
 
 
 def kind_exporter(kind: str, out: str, default: Callable[[Any, Any], list[Artifact]]) -> Any:
@@ -61,7 +69,7 @@ def kind_exporter(kind: str, out: str, default: Callable[[Any, Any], list[Artifa
     own = KIND_EXPORTERS.get(kind)
     if own is not None and out not in own:
         raise ExportError(f"{out}: {not_applicable_reason(kind, str(out))}")
-    return default if own is None or own[out] is _by_pipeline else own[out]
+    return default if own is None or own[out] is None else own[out]
 
 
 def applicable(cam: Any, outputs: Sequence[Any]) -> tuple[list[Any], dict[str, str]]:

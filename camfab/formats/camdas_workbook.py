@@ -364,12 +364,21 @@ def camdas_workbook(spec, geometry, report, *, step_deg: float = 1.0, lift_step_
     intervals(lift_step_deg, "lift_step_deg")
     wb = Workbook()
     wb.remove(wb.active)
-    for k in range(len(geometry.profiles)):
+    cylindrical = spec.cam.kind == "cylindrical"  # developed coordinates, no plate: camfab.formats.cylinder_sheet
+    for k in range(0 if cylindrical else len(geometry.profiles)):
         _camdas_sheet(wb.create_sheet("CAM-DAS" if k == 0 else f"CAM-DAS {k + 1}"), spec, geometry, report,
                       step_deg, k)
+    if cylindrical:
+        from .cylinder_sheet import write_cylinder_sheet
+
+        ws = wb.create_sheet("Cylinder")
+        write_cylinder_sheet(ws, spec, geometry, title=type_text(spec), verdict=verdict_sentence(report),
+                             step_deg=step_deg)
+        xlsx_put(ws["A2"], spec.name)
     _checks_sheet(wb.create_sheet("Checks"), spec, report)
-    _lift_sheet(wb.create_sheet("Lift table"), lift_table(geometry, lift_step_deg), geometry)
-    if spec.dynamics is not None:
+    if not cylindrical:
+        _lift_sheet(wb.create_sheet("Lift table"), lift_table(geometry, lift_step_deg), geometry)
+    if spec.dynamics is not None and not cylindrical:
         _dynamics_sheet(wb.create_sheet("Dynamics"), *dynamics_columns(spec, geometry, step_deg=step_deg))
     wb.properties.creator = "camfab"
     wb.properties.title = xlsx_text(spec.name)

@@ -375,11 +375,13 @@ def render_report(spec, geometry, report, *, standalone: bool = False, frames: i
         ``{"report.html": ..., "plots/svaj.svg": ..., ...}`` (and ``"plots/svaj.png"``… with ``png``).
     """
     from .animation import animation_data
+    from .cylinder_plot import UNROLLED_PLOT_TEXT
     from .plots import report_figures
     from .vibration_plot import VIBRATION_PLOT_TEXT, vibration_figures
 
     files, plots = plot_files({**report_figures(spec, geometry, report), **vibration_figures(spec, geometry, report)},
-                              standalone=standalone, png=png, text={**plot_text(geometry), **VIBRATION_PLOT_TEXT})
+                              standalone=standalone, png=png,
+                              text={**plot_text(geometry), **VIBRATION_PLOT_TEXT, **UNROLLED_PLOT_TEXT})
     anim = animation_data(spec, geometry, report, frames=frames)
     html = template_environment().get_template("report.html.j2").render(
         report_context(spec, geometry, report, plots, anim))

@@ -540,6 +540,10 @@ def report_figures(spec, geometry, report) -> dict[str, Any]:
     curved: :attr:`~camfab.design.profile.Contact.has_face`); ``dynamics`` when the design has a
     ``[dynamics]`` section.
     """
+    if spec.cam.kind == "cylindrical":  # no plate: the unrolled groove (report/cylinder_plot.py), δ on each radius
+        from .cylinder_plot import unrolled_figure
+        return {"svaj": svaj_figure(spec, spec.program()), "unrolled": unrolled_figure(spec, geometry),
+                "pressure_angle": pressure_angle_figure(spec, geometry, report)}
     figs: dict[str, Any] = {"svaj": svaj_figure(spec, spec.program()),
                             "profile": profile_figure(spec, geometry, report),
                             "curvature": curvature_figure(spec, geometry, report)}
