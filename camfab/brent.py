@@ -11,6 +11,8 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
+from .errors import InputError, InternalError
+
 __all__ = ["brentq"]
 
 _EPS = 2.220446049250313e-16
@@ -21,7 +23,7 @@ XTOL, RTOL, MAXITER = 2e-12, 4 * _EPS, 100
 def _value(f: Callable[[float], float], x: float) -> float:
     v = float(f(x))
     if math.isnan(v):
-        raise ValueError(f"The function value at x={x} is NaN; solver cannot continue.")
+        raise InputError(f"The function value at x={x} is NaN; solver cannot continue.")
     return v
 
 
@@ -30,17 +32,18 @@ def brentq(f: Callable[[float], float], a: float, b: float, *, xtol: float = XTO
     """A root of ``f`` in ``[a, b]`` (``f(a)`` and ``f(b)`` of opposite signs), to within
     ``xtol + rtol·|x|``, as ``scipy.optimize.brentq(f, a, b, xtol=, rtol=, maxiter=)`` returns it.
 
-    Raises ``ValueError`` when the ends do not bracket a sign change or ``f`` gives NaN, and
-    ``RuntimeError`` when ``maxiter`` steps do not converge (as scipy does).
+    Raises :class:`~camfab.errors.InputError` (a ``ValueError``, as scipy raises) when the ends do not bracket a
+    sign change or ``f`` gives NaN, and :class:`~camfab.errors.InternalError` (a ``RuntimeError``) when
+    ``maxiter`` steps do not converge.
     """
     if xtol <= 0:
-        raise ValueError(f"xtol too small ({xtol:g} <= 0)")
+        raise InputError(f"xtol too small ({xtol:g} <= 0)")
     if rtol < RTOL:
-        raise ValueError(f"rtol too small ({rtol:g} < {RTOL:g})")
+        raise InputError(f"rtol too small ({rtol:g} < {RTOL:g})")
     x_prev, x_cur = float(a), float(b)
     f_prev, f_cur = _value(f, x_prev), _value(f, x_cur)
     if f_prev * f_cur > 0:
-        raise ValueError("f(a) and f(b) must have different signs")
+        raise InputError("f(a) and f(b) must have different signs")
     if f_prev == 0:
         return x_prev
     if f_cur == 0:
@@ -61,7 +64,7 @@ def brentq(f: Callable[[float], float], a: float, b: float, *, xtol: float = XTO
         x_prev, f_prev = x_cur, f_cur
         x_cur += s_cur if abs(s_cur) > delta else (delta if s_bis > 0 else -delta)
         f_cur = _value(f, x_cur)
-    raise RuntimeError(f"brentq: failed to converge after {maxiter} iterations, value is {x_cur}")
+    raise InternalError(f"brentq: failed to converge after {maxiter} iterations, value is {x_cur}")
 
 
 def _step(x_prev: float, x_cur: float, x_blk: float, f_prev: float, f_cur: float, f_blk: float,

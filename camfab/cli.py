@@ -20,7 +20,7 @@ from typing import Any
 
 from . import pipeline
 from .cad.kind_exports import applicable, kind_exporter
-from .errors import ApiError, CamfabError, InternalError, MissingDependencyError, SpecError
+from .errors import ApiError, CamfabError, InternalError, MissingDependencyError, SpecError, UnreachableError
 from .io import atomic_write, inside, output_folder, write_all
 from .pipeline import Cam, Output, Request
 from .results import Severity, Verdict
@@ -560,7 +560,7 @@ def _guarded(args: argparse.Namespace) -> int:
     token = _ALLOW_OUTSIDE.set(bool(getattr(args, "allow_outside_files", False)))
     try:
         return int(fn(args))
-    except MissingDependencyError as exc:
+    except (MissingDependencyError, UnreachableError) as exc:  # the environment lacks something: exit 3
         print(f"camfab {args.command}: error: {exc}", file=sys.stderr)
         return EXIT_IO
     except BrokenPipeError:  # stdout closed by its reader: stop quietly, as a command killed by SIGPIPE does

@@ -8,7 +8,7 @@ Every error camfab raises on purpose derives from :class:`CamfabError`; a class 
 replaced a builtin exception also derives from that builtin (``InputError`` is a
 ``ValueError``, ``ApiError`` a ``TypeError``, ...), so ``except ValueError`` keeps
 working.  The command line maps them to its exit codes: ``MissingDependencyError``
-→ 3; ``ApiError`` and ``InternalError`` are bugs and keep their traceback; every
+and ``UnreachableError`` → 3; ``ApiError`` and ``InternalError`` are bugs and keep their traceback; every
 other ``CamfabError`` → 2 (invalid input, nothing written).  ``tests/test_errors.py``
 fails on a ``raise`` of a builtin exception anywhere in the package.
 """
@@ -27,6 +27,7 @@ __all__ = [
     "GeometryError",
     "ExportError",
     "MissingDependencyError",
+    "UnreachableError",
     "InputError",
     "ApiError",
     "InternalError",
@@ -87,6 +88,11 @@ class ExportError(CamfabError):
 
 class MissingDependencyError(CamfabError, ImportError):
     """An optional dependency needed for the requested job is not installed."""
+
+
+class UnreachableError(CamfabError, OSError):
+    """An outside service the job needs (a Dask scheduler, its workers) cannot be reached: an I/O fault of the
+    environment, not of the input (exit 3); the message names the address and what to start or check."""
 
 
 class InputError(CamfabError, ValueError):

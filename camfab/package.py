@@ -54,7 +54,7 @@ from typing import Any
 
 from .assets import templates_hash
 from .design.spec import DesignSpec
-from .errors import ApiError, CamfabError, ExportError, InternalError, MissingDependencyError
+from .errors import ApiError, CamfabError, ExportError, InputError, InternalError, MissingDependencyError
 from .formats import load_design
 from .io import atomic_write, hold_sigint, inside, leftover_name, output_folder, safe_stem, swap_dir, write_all
 from .pipeline import Cam, Output, Request, RunResult, build_files, shop_file_names
@@ -326,7 +326,7 @@ def package(paths: Iterable[str | Path], out: str | Path, *, jobs: int = 1, outp
     processes (:mod:`camfab.package_dask`; ``dask_config``: Dask settings over camfab's).  Dask is connected to
     before ``out`` is touched."""
     if executor not in EXECUTORS:
-        raise ValueError(f"executor {executor!r}: must be one of {', '.join(EXECUTORS)}")
+        raise InputError(f"executor {executor!r}: must be one of {', '.join(EXECUTORS)}")
     with contextlib.ExitStack() as stack:
         if executor == "builtin":
             def runner(items: list[Job]) -> Generator[dict, None, None]:

@@ -23,7 +23,7 @@ import uuid
 from collections.abc import Callable, Generator, Iterator, Mapping
 from typing import Any
 
-from .errors import InputError, MissingDependencyError
+from .errors import InputError, MissingDependencyError, UnreachableError
 
 __all__ = ["dask_executor", "LOCAL_CONFIG", "NO_DASHBOARD", "CONNECT_TIMEOUT_S", "parse_config", "executor_options"]
 
@@ -138,14 +138,14 @@ def _connect(distributed: Any, address: str) -> Any:
         raise InputError(f"--scheduler {address!r}: not a scheduler address ({exc}); give HOST:PORT or "
                          "tcp://HOST:PORT, as `dask scheduler` prints it") from None
     except (OSError, TimeoutError) as exc:
-        raise OSError(f"cannot reach the Dask scheduler at {address} within {CONNECT_TIMEOUT_S:g} s ({exc}); check "
-                      "the address and that `dask scheduler` runs there") from None
+        raise UnreachableError(f"cannot reach the Dask scheduler at {address} within {CONNECT_TIMEOUT_S:g} s "
+                               f"({exc}); check the address and that `dask scheduler` runs there") from None
     try:
         client.wait_for_workers(1, timeout=CONNECT_TIMEOUT_S)
     except (OSError, TimeoutError) as exc:
         client.close()
-        raise OSError(f"the Dask scheduler at {address} has no worker after {CONNECT_TIMEOUT_S:g} s ({exc}); start "
-                      f"one with `dask worker {address}`") from None
+        raise UnreachableError(f"the Dask scheduler at {address} has no worker after {CONNECT_TIMEOUT_S:g} s "
+                               f"({exc}); start one with `dask worker {address}`") from None
     return client
 
 

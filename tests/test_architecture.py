@@ -30,7 +30,7 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "camfab.results": ("camfab.errors",),
     "camfab.numeric": ("camfab.errors", "camfab.quadrature"),
     "camfab.quadrature": (),
-    "camfab.brent": (),
+    "camfab.brent": ("camfab.errors", "camfab.textsafe"),  # InputError / InternalError, as numeric
     "camfab.sets": (),
     "camfab.geom2d": ("camfab.errors", "camfab.tolerances"),
     "camfab.design": BASE + ("camfab.design",),

@@ -14,7 +14,7 @@ from camfab.cli import main
 
 PACKAGE = Path(camfab.__file__).resolve().parent
 #: modules whose job is to talk to the user on stdout/stderr
-PRINTING = {"cli.py"}
+PRINTING = {"cli.py", "cli_design.py"}  # the command line's presentation modules
 #: module-level logging calls that would log to (or configure) the root logger
 ROOT_CALLS = {"basicConfig", "debug", "info", "warning", "warn", "error", "exception", "critical", "log"}
 
@@ -71,10 +71,10 @@ def test_arc_spline_fallback_is_logged(caplog):
     from camfab.discretize import arcs
     from camfab.offset.cutter import profile_curve
 
-    c = camfab.load("constant_width").geometry.profiles[0]  # its anchored spline misses: clamped spans
+    c = camfab.load("constant_width").geometry.profiles[0]  # its SHM rise cannot keep the dwell's curvature
     with caplog.at_level(logging.INFO, logger="camfab"):
         assert arcs(profile_curve(c), tol=0.001).max_deviation <= 0.001
-    assert any(r.name == "camfab.discretize.fit" and "clamped at every breakpoint" in r.getMessage()
+    assert any(r.name == "camfab.discretize.arcspline" and "free end curvatures" in r.getMessage()
                for r in _records(caplog))
 
 
@@ -92,7 +92,7 @@ def test_unreadable_package_manifest_is_logged(tmp_path, caplog):
 def test_cli_verbose_shows_the_fallbacks_on_stderr(tmp_path, capsys):
     assert main(["export", "constant_width", "--dxf", "-o", str(tmp_path), "-v"]) == 0
     err = capsys.readouterr().err
-    assert "camfab: INFO: arcs:" in err and "[camfab.discretize.fit]" in err
+    assert "camfab: INFO: arcs:" in err and "[camfab.discretize.arcspline]" in err
     assert main(["-v", "check", "ejemplo9rt"]) in (0, 1)  # the flag also goes before the command
     assert main(["export", "constant_width", "--dxf", "-o", str(tmp_path / "quiet")]) == 0
     assert "INFO" not in capsys.readouterr().err  # without -v: warnings only

@@ -12,6 +12,7 @@ the chain is measured on the exact curve, and only the spans that exceed ``tol``
 """
 from __future__ import annotations
 
+import logging
 import math
 
 import numpy as np
@@ -25,6 +26,8 @@ from .spanmodel import SpanModel, cumtrapz, equioscillate
 from .spans import Span, cut_spans, span_density, span_ends, span_shape
 from .surrogate import HermiteSurrogate
 from .tolerance import within
+
+log = logging.getLogger(__name__)
 
 __all__ = ["fit_spline"]
 
@@ -180,6 +183,8 @@ def _fit_span(sur: HermiteSurrogate, span: Span, target: float):
     fit = _SpanFit(sur, span, target)
     best = fit.search()
     if best is None and fit.n_fixed and len(fit.tried) == 1:
+        log.info("arcs: span %s cannot keep its neighbour's end curvature (misses by more than %gx at its first "
+                 "arc count); fitted with free end curvatures", span.label, _FIXED_HOPELESS)
         free = Span(span.segs, (None, None), span.exact, span.label, span.shape)
         fit = _SpanFit(sur, free, target)
         best = fit.search()
