@@ -311,6 +311,9 @@ def cmd_verify(args: argparse.Namespace) -> int:
     from .gcode.cam import verify_cam_program
 
     cam = _cam(args.design)
+    if cam.spec.cam.kind == "cylindrical":  # a 4-axis program: the back-plot knows X, Y, Z only (README)
+        raise UsageError(f"--design {args.design}: verify does not back-plot the 4-axis (A) program of a cylindrical "
+                         "cam yet; check it with LinuxCNC's rs274 or the machine's simulator")
     tol = _tol(cam, args.tol)
     if args.comp_radius is not None and not (math.isfinite(args.comp_radius) and args.comp_radius > 0):
         raise UsageError(f"--comp-radius {args.comp_radius:g}: must be a positive radius in mm")
