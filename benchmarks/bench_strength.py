@@ -12,12 +12,10 @@ import argparse
 import math
 
 import numpy as np
+from bench_dynamics import cases
 from bench_profile import OSC_ROWS, ROWS, best
 
-from camfab.design.dynamics import ContactDynamics, Loads, pair_of
 from camfab.design.materials import MATERIALS
-from camfab.design.mechanisms import ConjugateTranslatingRoller, OscillatingRoller, TranslatingFlat, TranslatingRoller
-from camfab.design.profile import CamGeometry
 from camfab.design.program import MotionProgram
 from camfab.design.strength import StrengthInput, StressModel, analyse_strength, effective_modulus
 from camfab.units import RPM
@@ -34,17 +32,10 @@ def main() -> None:
     w = 600 * RPM
     cam, roller = MATERIALS["C45"], MATERIALS["100Cr6"]
     e = effective_modulus(cam.e_mpa, cam.poisson, roller.e_mpa, roller.poisson)
-    cams = (("translating roller", CamGeometry(TranslatingRoller(40.0, 8.0, 5.0), prog),
-             Loads(0.3, 20000.0, 400.0, damping=20.0)),
-            ("oscillating roller", CamGeometry(OscillatingRoller(50.0, 8.0, 120.0, 90.0), osc),
-             Loads(0.02, 30.0, 20.0)),
-            ("translating flat", CamGeometry(TranslatingFlat(80.0), prog), Loads(0.3, 20000.0, 400.0, damping=20.0)),
-            ("conjugate roller pair", ConjugateTranslatingRoller(40.0, 8.0, 110.0).geometry(prog),
-             Loads(0.3, damping=20.0)))
+    cams = cases(prog, osc, w)
     print(f"12-segment cam, {a.n:,} angles, 600 rpm")
     print(f"{'mechanism':<24}{'forces ms':>11}{'stress ms':>11}{'ratio':>8}{'analysis ms':>13}")
-    for name, geom, loads in cams:
-        dyn = pair_of(geom, loads, w) if len(geom.profiles) > 1 else ContactDynamics(geom.profiles[0], loads, w)
+    for name, geom, _, dyn in cams:
         model = StressModel(dyn, e, 10.0)
         t_force = best(lambda dyn=dyn: dyn.evaluate(phi), a.repeat)
         t_stress = best(lambda model=model: model.evaluate(phi), a.repeat)

@@ -75,8 +75,7 @@ def kind_exporter(kind: str, out: str, default: Callable[[Any, Any], list[Artifa
 def applicable(cam: Any, outputs: Sequence[Any]) -> tuple[list[Any], dict[str, str]]:
     """``outputs`` split into those that apply to the cam's kind and, for the others, why not (each logged as
     a warning)."""
-    own = KIND_EXPORTERS.get(cam.spec.cam.kind)
-    keep = [o for o in outputs if own is None or o in own]
+    keep = [o for o in outputs if applies(cam.spec.cam.kind, str(o))]
     why = {str(o): not_applicable_reason(cam.spec.cam.kind, str(o)) for o in outputs if o not in keep}
     for out, reason in why.items():
         log.warning("%s: %s skipped: %s", cam.name, out, reason)

@@ -125,7 +125,7 @@ def check(geometry: CamGeometry, *, pressure_angle_limit_deg: float | None = Non
 
 def _tag(contact: Any, k: int) -> str:
     """How a finding names profile k of several: ``"profile 2: "``, or the contact's own ``label``."""
-    return f"{getattr(contact, 'label', None) or f'profile {k + 1}'}: "
+    return f"{contact.label or f'profile {k + 1}'}: "
 
 
 def _merge(fields: dict[str, Any], new: dict[str, Any]) -> None:
