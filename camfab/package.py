@@ -56,6 +56,7 @@ from .assets import templates_hash
 from .design.spec import DesignSpec
 from .errors import ApiError, CamfabError, ExportError, InputError, InternalError, MissingDependencyError
 from .formats import load_design
+from .formats.knot_files import relocated
 from .io import atomic_write, hold_sigint, inside, leftover_name, output_folder, safe_stem, swap_dir, write_all
 from .pipeline import Cam, Output, Request, RunResult, build_files, shop_file_names
 from .report.overview import cam_summary, index_html
@@ -176,8 +177,9 @@ def build_cam(job: Job) -> dict:
         with contextlib.ExitStack() as stack:
             spec = job.spec
             if spec is None:  # the design read again from its bytes, its knot files beside it as on the disk
-                design, back = _unpack(job.inputs, Path(stack.enter_context(tempfile.TemporaryDirectory(
+                design, back, base = _unpack(job.inputs, Path(stack.enter_context(tempfile.TemporaryDirectory(
                     prefix="camfab-design-"))))
+                stack.enter_context(relocated(*base))
                 spec = load_design(design, allow_outside_files=bool(job.options.get("allow_outside_files")))
             entry["name"] = spec.name
             outputs = job.options.get("outputs")
@@ -201,9 +203,10 @@ def build_cam(job: Job) -> dict:
     return entry
 
 
-def _unpack(inputs: Sequence[tuple[str, bytes]], root: Path) -> tuple[Path, Callable[[str], str]]:
+def _unpack(inputs: Sequence[tuple[str, bytes]], root: Path) -> tuple[Path, Callable[[str], str], tuple[Path, Path]]:
     """Write the design and its knot files under ``root``, in the same places relative to each other; returns
-    the design's path there and a function putting its real folder back into a message."""
+    the design's path there, a function putting its real folder back into a message, and (the files' common
+    folder as the parent knows it, ``root``) for :func:`~camfab.formats.knot_files.relocated`."""
     where = [Path(os.path.abspath(p)) for p, _ in inputs]
     base = Path(os.path.commonpath([w.parent for w in where]))
     for w, (_, data) in zip(where, inputs, strict=True):
@@ -216,7 +219,7 @@ def _unpack(inputs: Sequence[tuple[str, bytes]], root: Path) -> tuple[Path, Call
     def back(text: str) -> str:
         return text.replace(here + os.sep, "" if there == "." else there + os.sep).replace(here, there)
 
-    return design, back
+    return design, back, (base, root)
 
 
 def _commit(entry: dict, out: Path, recorded: frozenset[str]) -> dict:

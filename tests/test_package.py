@@ -181,3 +181,37 @@ def test_input_key_hashes_the_knot_file_a_design_names(tmp_path):
     csv.write_text(csv.read_text().replace("0.0005,0.4744", "0.00051,0.4744"))
     new = [input_key(load_design(p).sources, {}, "t") for p in (toml, book)]
     assert new[0] != keys[0] and new[1] != keys[1] and len(set(keys)) == 2
+
+
+# ---------------------------------------------------------------------------
+# a worker reads the files it was sent, also when the design names its knot file by an absolute path
+@pytest.mark.parametrize("knot_dir, allow", [("d", False), ("elsewhere", True)])
+def test_a_worker_reads_the_sent_copy_of_an_absolute_knot_file(knot_dir, allow):
+    """The design and its knot file as the parent sent them, under a folder this machine does not have (a remote
+    worker's view): an absolute knot-file name is read from the copy sent, judged inside or outside the design's
+    folder as on the parent — a knot file in the design's folder named absolutely was refused as lying outside
+    the worker's temporary folder (and a remote worker would have had no such file)."""
+    import camfab.package
+
+    design, csv = "/nonexistent-camfab/d/valve.toml", f"/nonexistent-camfab/{knot_dir}/valve_recon_ej1.csv"
+    text = (EXAMPLES / "valve_exhaust_ej1.toml").read_text().replace('file = "valve_recon_ej1.csv"', f'file = "{csv}"')
+    assert csv in text and not Path(csv).exists()
+    job = camfab.package.Job(design, "V", "V", "k", {"outputs": ["xlsx"], "allow_outside_files": allow},
+                             ((design, text.encode()), (csv, (EXAMPLES / "valve_recon_ej1.csv").read_bytes())))
+    entry = camfab.package.build_cam(job)
+    assert entry["status"] == "ok", entry.get("error")
+    assert any(name.endswith(".xlsx") for name in entry["output"]["files"])
+
+
+def test_a_worker_still_refuses_an_absolute_knot_file_outside_the_design_folder():
+    """Without allow_outside_files, the sent copy of a knot file outside the design's folder is refused on the
+    worker as on the parent, naming the field and the path the user wrote."""
+    import camfab.package
+
+    design, csv = "/nonexistent-camfab/d/valve.toml", "/nonexistent-camfab/other/valve_recon_ej1.csv"
+    text = (EXAMPLES / "valve_exhaust_ej1.toml").read_text().replace('file = "valve_recon_ej1.csv"', f'file = "{csv}"')
+    job = camfab.package.Job(design, "V", "V", "k", {"outputs": ["xlsx"]},
+                             ((design, text.encode()), (csv, (EXAMPLES / "valve_recon_ej1.csv").read_bytes())))
+    entry = camfab.package.build_cam(job)
+    assert entry["status"] == "error" and "motion_table.file" in entry["error"] and csv in entry["error"]
+    assert "outside the design's folder" in entry["error"] and "camfab-design-" not in entry["error"]

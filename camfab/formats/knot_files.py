@@ -42,7 +42,10 @@ field (``motion_table.file``), the file, and the line or cells at fault.
 """
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+import contextlib
+import contextvars
+import os
+from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any, cast
 
@@ -60,11 +63,41 @@ __all__ = [
     "read_knots",
     "read_knots_csv",
     "read_knots_xlsx",
+    "relocated",
     "resolve_knot_file",
 ]
 
 TEXT_SUFFIXES = (".csv", ".txt", ".dat", ".tsv")
 XLSX_SUFFIXES = (".xlsx", ".xlsm")
+
+
+#: (folder as the design's sender knew it, the local folder holding copies of its files), while a package worker
+#: reads a design it received as bytes (:func:`relocated`)
+_RELOCATION: contextvars.ContextVar[tuple[Path, Path] | None] = contextvars.ContextVar("camfab_relocation",
+                                                                                      default=None)
+
+
+@contextlib.contextmanager
+def relocated(original: str | Path, local: str | Path) -> Iterator[None]:
+    """Within the block, an absolute knot-file name under the folder ``original`` is read from the same place
+    under ``local``: a package worker unpacks a design and its files (sent as bytes) into a temporary folder,
+    and a design naming its knot file by an absolute path must read that copy — not a file of the worker's own
+    disk, which a remote worker does not have — and be judged inside or outside its folder as on the sender's."""
+    token = _RELOCATION.set((Path(os.path.abspath(original)), Path(local)))
+    try:
+        yield
+    finally:
+        _RELOCATION.reset(token)
+
+
+def _relocate(file: Path) -> Path:
+    """``file`` (absolute) as the current :func:`relocated` block maps it; unchanged outside one."""
+    where = _RELOCATION.get()
+    if where is None:
+        return file
+    original, local = where
+    absolute = Path(os.path.abspath(file))
+    return local / absolute.relative_to(original) if absolute.is_relative_to(original) else file
 
 
 # ---------------------------------------------------------------------------
@@ -114,6 +147,8 @@ def read_knot_file(name: str | Path, base_dir: str | Path | None = None, *,
     folder = None if base_dir is None else Path(base_dir)
     if folder is not None and not file.is_absolute():
         file = folder / file
+    elif file.is_absolute():
+        file = _relocate(file)
     try:
         target = file.resolve()
         outside = folder is not None and not target.is_relative_to(folder.resolve())
