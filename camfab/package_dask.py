@@ -45,6 +45,8 @@ LOCAL_CONFIG: dict[str, Any] = {
     "distributed.admin.tick.interval": "1s",
     "distributed.worker.memory.monitor-interval": "1s",
     "distributed.admin.system-monitor.interval": "5s",
+    # the local workers share the terminal's process group: they ignore Ctrl-C, which camfab handles itself
+    "distributed.worker.preload": ["camfab.dask_worker"],
     # a cam whose worker dies is retried once; a worker holds only the cam it runs (a death loses only it)
     "distributed.scheduler.allowed-failures": 1,
     "distributed.scheduler.worker-saturation": 1.0,

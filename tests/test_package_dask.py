@@ -239,3 +239,37 @@ def test_the_builtin_pool_does_not_import_dask(tmp_path):
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300,
                        env={**os.environ, "PYTHONPATH": str(ROOT)})
     assert r.stdout.splitlines()[-1] == "0 False False", r.stdout + r.stderr
+
+
+# ---------------------------------------------------------------------------
+# Ctrl-C of dask-local: the command reports it; the local workers, in the terminal's process group, stay quiet
+@pytest.mark.slow
+def test_ctrl_c_of_dask_local_prints_no_worker_traceback(tmp_path):
+    """SIGINT to the whole process group (what a terminal's Ctrl-C does) once the first cam is written: exit 130
+    (or death by SIGINT after the clean-up), camfab's one-line message, no traceback from Dask's worker processes
+    (they ignore SIGINT: ``camfab.dask_worker``), and no process of the group left a few seconds later."""
+    pytest.importorskip("distributed", reason="Dask distributed is not installed (pip install camfab[dask])")
+    import signal
+
+    out = tmp_path / "out"
+    env = dict(os.environ, PYTHONPATH=str(Path(camfab.package.__file__).parents[1]))
+    p = subprocess.Popen([sys.executable, "-m", "camfab", "package", str(EXAMPLES), "--executor", "dask-local",
+                          "--dask-workers", "2", "--outputs", "dxf", "-o", str(out)], env=env, text=True,
+                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 240
+        while not any(d.is_dir() and not d.name.startswith(".") for d in out.glob("*")) and p.poll() is None:
+            assert time.monotonic() < deadline, "no cam was written within 240 s"
+            time.sleep(0.05)
+        assert p.poll() is None, "the package ended before the interrupt: give it more cams"
+        os.killpg(p.pid, signal.SIGINT)
+        err = p.communicate(timeout=120)[1]
+    finally:
+        if p.poll() is None:
+            os.killpg(p.pid, signal.SIGKILL)
+    assert p.returncode in (130, -signal.SIGINT), err
+    assert "interrupted" in err and "Traceback" not in err and "KeyboardInterrupt" not in err, err
+    deadline = time.monotonic() + 15
+    while subprocess.run(["pgrep", "-g", str(p.pid)], capture_output=True).returncode == 0:
+        assert time.monotonic() < deadline, "a process of the command's group is still running"
+        time.sleep(0.2)
