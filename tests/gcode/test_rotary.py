@@ -259,15 +259,3 @@ def test_tool_tip_lies_on_the_3d_pitch_curve(rotation, follower):
         dense = pitch_3d(geom, np.linspace(0.0, 2 * np.pi, 400_001), r)
         dist, _ = cKDTree(dense).query(tip)
         assert dist.max() <= tol, f"{rotation} {follower}: tool tip {dist.max():.5f} mm off the 3D pitch curve"
-
-
-def test_verify_refuses_the_4_axis_program_clearly(tmp_path, capsys):
-    """`camfab verify` does not back-plot an A axis yet: exit 2 naming the design and what to use instead (it
-    raised an AttributeError from the plate's outline before; found by the golden manifest's run)."""
-    from camfab.cli import main
-    prog = tmp_path / "b.nc"
-    assert main(["gcode", "cylindrical_translating", "-o", str(prog)]) in (0, 1)
-    capsys.readouterr()
-    assert main(["verify", str(prog), "--design", "cylindrical_translating"]) == 2
-    err = capsys.readouterr().err
-    assert "4-axis" in err and "rs274" in err and "Traceback" not in err
