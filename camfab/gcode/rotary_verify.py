@@ -42,6 +42,8 @@ from .verify import VerifyReport
 
 __all__ = ["RotaryVerifyReport", "verify_rotary_program"]
 
+#: sampling step of a move on its developed cylinder (mm), the coverage probes per target, and the radii (fractions
+#: from the tip to the outer surface) on which the radial cutter's section is checked
 _STEP = 0.1
 _PROBES = 4096
 _RADII = np.linspace(0.0, 1.0, 6)
