@@ -309,11 +309,12 @@ def _verify_args(p: argparse.ArgumentParser) -> None:
 @register("verify", "back-plot a G-code program and check it against the exact design and its job", _verify_args)
 def cmd_verify(args: argparse.Namespace) -> int:
     from .gcode.cam import verify_cam_program
+    from .gcode.verify import VerifyReport
 
     cam = _cam(args.design)
-    if cam.spec.cam.kind == "cylindrical":  # a 4-axis program: the back-plot knows X, Y, Z only (README)
-        raise UsageError(f"--design {args.design}: verify does not back-plot the 4-axis (A) program of a cylindrical "
-                         "cam yet; check it with LinuxCNC's rs274 or the machine's simulator")
+    if cam.spec.cam.kind == "cylindrical" and args.post == "grbl":  # a 4-axis program (README)
+        raise UsageError("--post grbl: the grbl controller has no rotary (A) axis, so it cannot run a cylindrical "
+                         "cam's 4-axis program; choose --post linuxcnc or --post fanuc")
     tol = _tol(cam, args.tol)
     if args.comp_radius is not None and not (math.isfinite(args.comp_radius) and args.comp_radius > 0):
         raise UsageError(f"--comp-radius {args.comp_radius:g}: must be a positive radius in mm")
@@ -322,7 +323,13 @@ def cmd_verify(args: argparse.Namespace) -> int:
         raise UsageError(f"--profile {args.profile}: the design has {len(profiles)} profile(s)")
     job = pipeline.gcode_job(cam.spec, tol=tol, overrides=_job_overrides(args))
     data = Path(args.program).read_bytes()  # a missing file is an I/O error (3); an unreadable one a finding
-    if cam.spec.cam.kind == "groove":  # both flanks are the targets (camfab.gcode.groove)
+    rep: VerifyReport
+    if cam.spec.cam.kind == "cylindrical":  # the 4-axis program on the cylinder (camfab.gcode.rotary_verify)
+        from .gcode.rotary import cylinder_job
+        from .gcode.rotary_verify import verify_rotary_program
+
+        rep = verify_rotary_program(data, cam.geometry, cylinder_job(job, cam.geometry), tol=tol)
+    elif cam.spec.cam.kind == "groove":  # both flanks are the targets (camfab.gcode.groove)
         from .gcode.groove import verify_groove_program
 
         rep = verify_groove_program(data, profiles[0], profiles[1], job, tol=tol, post=args.post,

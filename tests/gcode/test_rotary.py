@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 
 from camfab import pipeline
 from camfab.cli import main
@@ -42,11 +43,14 @@ def _program(post: str = "linuxcnc", **machining) -> tuple[bytes, float]:
     return data, tol
 
 
-def _passes(text: str) -> list[tuple[float, np.ndarray]]:
-    """Each inverse-time pass as (Z, array of (X, A, F)), read with a tiny modal reader (camfab's parser has no
-    A axis); the start point of each pass (the plunge's X, A) comes first with F = nan."""
-    out, pos, g93, cur = [], {"X": math.nan, "A": math.nan, "Z": math.nan}, False, None
+def _passes(text: str) -> list[tuple[str, float, np.ndarray]]:
+    """Each inverse-time pass as (the comment naming it, Z, array of (X, A, F)), read with a tiny modal reader
+    (independent of camfab's readers); the start point of each pass (the plunge's X, A) comes first with
+    F = nan."""
+    out, pos, g93, cur, label = [], {"X": math.nan, "A": math.nan, "Z": math.nan}, False, None, ""
     for line in text.splitlines():
+        if line.startswith("(") and "pass" in line.lower():
+            label = line.strip("()").lower()
         if line.startswith("(") or line == "%" or line.startswith("O"):
             continue
         words = dict(_WORD.findall(line.split("(")[0]))
@@ -55,7 +59,7 @@ def _passes(text: str) -> list[tuple[float, np.ndarray]]:
             g93, cur = True, [(pos["X"], pos["A"], math.nan)]
         elif words.get("G") == "94" and g93:
             g93 = False
-            out.append((pos["Z"], np.array(cur)))
+            out.append((label, pos["Z"], np.array(cur)))
         for k in "XAZ":
             if k in words:
                 pos[k] = float(words[k])
@@ -66,15 +70,19 @@ def _passes(text: str) -> list[tuple[float, np.ndarray]]:
     return out
 
 
+def _centre(passes):
+    return [(z, P) for label, z, P in passes if label.startswith("centre pass")]
+
+
 @pytest.mark.parametrize("post", ["linuxcnc", "fanuc"])
 def test_backplot_lies_on_the_exact_pitch_curve(post):
     data, tol = _program(post)
-    passes = _passes(data.decode())
+    passes = _centre(_passes(data.decode()))
     assert len(passes) == 4  # 10 mm deep, step-down 3 mm: four levels
     zs = [z for z, _ in passes]
     assert zs[-1] == pytest.approx(35.0, abs=1e-9)  # the last level on the groove bottom radius
     assert np.all(np.diff([45.0, *zs]) < 0) and np.all(-np.diff([45.0, *zs]) <= 3.0 + 1e-9)
-    feed = 644.6  # the cutting data of the example (header)
+    feed = 546.2  # the cutting data of the example (header)
     for r, P in passes:
         X, A, F = P.T
         theta = -np.radians(A)  # cw: A = −θ
@@ -110,8 +118,61 @@ def test_rs274_runs_the_4_axis_program(post, tmp_path):
                       re.finditer(r"STRAIGHT_FEED\(([^)]*)\)", proc.stdout)])
     assert "PROGRAM_END" in proc.stdout
     cut = feeds[np.abs(feeds[:, 3]) > 0]  # the moves that turn the table
-    assert np.allclose(cut[:, 1], 0.0) and cut[-1, 2] == pytest.approx(35.0)
-    assert np.max(np.abs(cut[:, 0] - _law(-np.radians(cut[:, 3])))) <= tol
+    n_centre = sum(len(P) - 1 for _, P in _centre(_passes(data.decode())))
+    centre, finish = cut[:n_centre], cut[n_centre:]
+    assert np.allclose(cut[:, 1], 0.0) and centre[-1, 2] == pytest.approx(35.0)
+    assert np.max(np.abs(centre[:, 0] - _law(-np.radians(centre[:, 3])))) <= tol
+    # the finishing passes (on the groove bottom): every fed point w − r_c from the pitch curve, but the two
+    # lead-outs' ends, back on it
+    assert np.allclose(finish[:, 2], 35.0)
+    C, _ = _pitch_dense(35.0)
+    d, _ = cKDTree(C).query(np.stack([35.0 * -np.radians(finish[:, 3]), finish[:, 0]], axis=1))
+    off = np.abs(d - (6.025 - 5.9)) <= tol
+    assert np.sum(~off) == 2 and np.all(d[~off] <= tol)
+
+
+def _pitch_dense(r: float, n: int = 600_001) -> tuple[np.ndarray, np.ndarray]:
+    """The exact developed pitch curve (r·θ, law(θ)) on radius r over θ in [−2π − 0.2, 2π + 0.2], and its unit
+    normal towards +z (from the analytic law; derivative by central differences on the dense grid)."""
+    th = np.linspace(-2 * np.pi - 0.2, 2 * np.pi + 0.2, n)
+    C = np.stack([r * th, _law(th)], axis=1)
+    T = np.gradient(C, th, axis=0)
+    return C, np.stack([-T[:, 1], T[:, 0]], axis=1) / np.hypot(T[:, 0], T[:, 1])[:, None]
+
+
+def _dense_chords(pts: np.ndarray, k: int = 64) -> np.ndarray:
+    t = np.linspace(0.0, 1.0, k + 1)[:-1, None, None]
+    return (pts[:-1] + t * np.diff(pts, axis=0)).reshape(-1, 2)
+
+
+def test_finishing_passes_lie_on_the_flank_offsets_and_cut_the_groove_width():
+    """Each flank's finishing pass, back-plotted on the developed groove bottom (x = r·θ, θ = −A for a cw cam),
+    lies within tol of the exact flank offset by the cutter radius (the law's pitch curve offset by
+    ±(R_r + b/2 − r_c)), runs once round, and the slot the passes cut is 2·R_r + backlash wide along the whole
+    track: on the bottom within the tolerance, on the outer radius (the twist) at most the tolerance wider."""
+    data, tol = _program()
+    fin = [(label, z, P) for label, z, P in _passes(data.decode()) if label.startswith("finishing pass")]
+    assert len(fin) == 2 and {("+z" in label) for label, _, _ in fin} == {True, False}
+    w, r_c, r_b = 6.025, 5.9, 35.0
+    C, up = _pitch_dense(r_b)
+    cut = {}
+    for label, z, P in fin:
+        assert z == pytest.approx(r_b)
+        f = 1.0 if "+z" in label else -1.0
+        pts = np.stack([r_b * -np.radians(P[:, 1]), P[:, 0]], axis=1)
+        path = pts[1:-1]  # between the lead-in from and the lead-out to the pitch curve
+        dist, _ = cKDTree(C + f * (w - r_c) * up).query(_dense_chords(path))
+        assert dist.max() <= tol, f"{label}: {dist.max():.5f} mm off the exact flank offset"
+        assert abs(path[-1, 0] - path[0, 0]) == pytest.approx(2 * np.pi * r_b, abs=tol)
+        assert cKDTree(C).query(pts[[0, -1]])[0].max() <= tol
+        cut[f] = path if path[-1, 0] > 0 else path + [2 * np.pi * r_b, 0.0]  # the backwards pass, one turn on
+    for r, slack in ((r_b, tol), (45.0, 2 * tol)):
+        C_r, _ = _pitch_dense(r)
+        on = C_r[(C_r[:, 0] >= 0) & (C_r[:, 0] < 2 * np.pi * r)][::50]
+        width = 2 * r_c
+        for path in cut.values():
+            width = width + cKDTree(_dense_chords(path * [r / r_b, 1.0])).query(on)[0]
+        assert width.min() >= 12.05 - slack and width.max() <= 12.05 + slack, (r, width.min(), width.max())
 
 
 def test_grbl_and_a_wide_tool_are_refused(tmp_path):
@@ -125,6 +186,40 @@ def test_grbl_and_a_wide_tool_are_refused(tmp_path):
     assert not out.exists()
 
 
+def test_a_cutter_that_cannot_finish_the_flanks_is_refused(tmp_path, capsys):
+    """A 10 mm end mill in the 12.05 mm groove would cut past the flanks higher up (the twist): refused with exit 2
+    naming the field and the diameter that fits, which is then accepted; an undercut flank refuses every cutter."""
+    out = tmp_path / "g.nc"
+    assert main(["gcode", str(EXAMPLE), "-o", str(out), "--tool-diameter", "10"]) == 2
+    err = capsys.readouterr().err
+    assert "manufacturing.tool_diameter_mm" in err and "past the flank" in err and not out.exists()
+    fits = float(re.search(r"diameter at least ([0-9.]+) mm", err).group(1))
+    assert 10.0 < fits < 12.05
+    _program(tool_diameter_mm=fits)  # the diameter it names is accepted
+    from camfab.design.mechanisms import geometry_from_spec
+    from camfab.design.spec import design_from_dict
+    from camfab.gcode.model import Job
+
+    spec = design_from_dict({"name": "b", "cam": {"kind": "cylindrical"},
+                             "follower": {"type": "roller", "motion": "translating", "roller_radius_mm": 6.0},
+                             "cylinder": {"radius_mm": 20.0, "length_mm": 80.0, "groove_depth_mm": 10.0},
+                             "motion": [{"law": "cycloidal", "lift": 25.0, "angle_deg": 60.0},
+                                        {"law": "dwell", "lift": 0.0, "angle_deg": 120.0},
+                                        {"law": "cycloidal", "lift": -25.0, "angle_deg": 60.0},
+                                        {"law": "dwell", "lift": 0.0, "angle_deg": 120.0}]})
+    with pytest.raises(SpecError, match=r"(?s)manufacturing.tool_diameter_mm.*concave radius.*undercut"):
+        rotary_gcode(geometry_from_spec(spec), Job(tool_diameter_mm=11.0, depth_mm=10.0), 0.01, "linuxcnc")
+    # an oscillating roller swung 15° on a 60 mm arm: its axis 2 mm off the radial line, no radial cutter follows it
+    spec = design_from_dict({"name": "b", "cam": {"kind": "cylindrical"},
+                             "follower": {"type": "roller", "motion": "oscillating", "roller_radius_mm": 6.0,
+                                          "arm_length_mm": 60.0},
+                             "cylinder": {"radius_mm": 40.0, "length_mm": 80.0, "groove_depth_mm": 10.0},
+                             "motion": [{"law": "cycloidal", "lift": 15.0, "angle_deg": 150.0},
+                                        {"law": "cycloidal", "lift": -15.0, "angle_deg": 210.0}]})
+    with pytest.raises(SpecError, match=r"(?s)follower.arm_length_mm.*radial.*tolerance of at least 0\.1"):
+        rotary_gcode(geometry_from_spec(spec), Job(tool_diameter_mm=11.9, depth_mm=10.0), 0.01, "linuxcnc")
+
+
 def test_run_writes_the_program(tmp_path):
     assert main(["run", str(EXAMPLE), "-o", str(tmp_path), "--outputs", "gcode"]) in (0, 1)
     text = (tmp_path / "BarrelCam.nc").read_text()
@@ -133,30 +228,28 @@ def test_run_writes_the_program(tmp_path):
 
 @pytest.mark.parametrize("rotation,follower", [
     ("ccw", {}),
-    ("cw", {"motion": "oscillating", "arm_length_mm": 60.0}),
+    ("cw", {"motion": "oscillating", "arm_length_mm": 60.0}),  # a 5° swing: the axis swings 0.23 mm aside
     ("ccw", {"motion": "oscillating", "arm_length_mm": 60.0}),
 ])
 def test_tool_tip_lies_on_the_3d_pitch_curve(rotation, follower):
     """The work offset and the sign of A, in 3D: each programmed tool tip (X, A, Z) taken back into the cam frame
     (machine (Y, Z, X) = cam (X_c, Y_c, Z_c), the part turned back by −A about X) lies on the 3D pitch curve of its
     radius (``pitch_3d``) within the tolerance, for either sense and the oscillating follower's exact arc."""
-    from scipy.spatial import cKDTree
-
     from camfab.design.cylindrical import pitch_3d
     from camfab.design.mechanisms import geometry_from_spec
     from camfab.design.spec import design_from_dict
     from camfab.gcode.model import Job
 
     f = {"type": "roller", "motion": "translating", "roller_radius_mm": 6.0} | follower
-    lift = 15.0 if follower else 20.0
+    lift = 5.0 if follower else 20.0
     spec = design_from_dict({"name": "b", "cam": {"kind": "cylindrical", "rotation": rotation}, "follower": f,
                              "cylinder": {"radius_mm": 40.0, "length_mm": 80.0, "groove_depth_mm": 10.0},
                              "motion": [{"law": "cycloidal", "lift": lift, "angle_deg": 150.0},
                                         {"law": "cycloidal", "lift": -lift, "angle_deg": 210.0}]})
     geom = geometry_from_spec(spec)
     tol = 0.01
-    data, _, _ = rotary_gcode(geom, Job(tool_diameter_mm=8.0, depth_mm=10.0, tolerance_mm=tol), tol, "linuxcnc")
-    passes = _passes(data.decode())
+    data, _, _ = rotary_gcode(geom, Job(tool_diameter_mm=11.9, depth_mm=10.0, tolerance_mm=tol), tol, "linuxcnc")
+    passes = _centre(_passes(data.decode()))
     assert [z for z, _ in passes][-1] == pytest.approx(35.0)
     for r, P in passes:
         X, A, _ = P.T
@@ -166,15 +259,3 @@ def test_tool_tip_lies_on_the_3d_pitch_curve(rotation, follower):
         dense = pitch_3d(geom, np.linspace(0.0, 2 * np.pi, 400_001), r)
         dist, _ = cKDTree(dense).query(tip)
         assert dist.max() <= tol, f"{rotation} {follower}: tool tip {dist.max():.5f} mm off the 3D pitch curve"
-
-
-def test_verify_refuses_the_4_axis_program_clearly(tmp_path, capsys):
-    """`camfab verify` does not back-plot an A axis yet: exit 2 naming the design and what to use instead (it
-    raised an AttributeError from the plate's outline before; found by the golden manifest's run)."""
-    from camfab.cli import main
-    prog = tmp_path / "b.nc"
-    assert main(["gcode", "cylindrical_translating", "-o", str(prog)]) in (0, 1)
-    capsys.readouterr()
-    assert main(["verify", str(prog), "--design", "cylindrical_translating"]) == 2
-    err = capsys.readouterr().err
-    assert "4-axis" in err and "rs274" in err and "Traceback" not in err
