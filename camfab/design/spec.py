@@ -336,8 +336,11 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
     pa = v.number(checks, "pressure_angle_limit_deg", "checks", None, lo=0.0, hi=90.0, lo_open=True, hi_open=True)
     margin = v.number(checks, "face_margin_mm", "checks", 0.0, lo=0.0, hi=1e4)
     dyn = _dynamics(v, data, cam, fol)
-    strength = strength_section(v, data, thickness_mm=mfg.thickness_mm, manufacturing_material=mfg.material,
-                                assembly_roller_width_mm=assembly.roller_width_mm, applies="dynamics" in data)
+    groove = fol.groove_depth_mm if cam.kind == CamKind.GROOVE else None  # the flanks: as high as the groove
+    strength = strength_section(v, data, thickness_mm=groove or mfg.thickness_mm,
+                                manufacturing_material=mfg.material, assembly_roller_width_mm=assembly.roller_width_mm,
+                                applies="dynamics" in data,
+                                face="the groove depth" if groove else "the plate thickness")
     return DesignSpec(name.strip(), cam, fol, motion, table, mfg, out, pressure_angle_limit_deg=pa,
                       description=str(data.get("description", "")), source=source, face_margin_mm=margin,
                       dynamics=dyn, machining=machining, assembly=assembly, drawing=drawing, strength=strength,
@@ -511,9 +514,6 @@ def _dynamics(v: Validator, data: Mapping[str, Any], cam: CamSpec, fol: Follower
     osc = fol.motion == FollowerMotion.OSCILLATING and cam.kind != CamKind.TRANSLATING
     own = _DYN_OSCILLATING if osc else _DYN_TRANSLATING
     _dynamics_keys(v, t, osc)
-    if cam.kind == CamKind.GROOVE:
-        v.add("dynamics", None, "the force model of a groove cam (which flank carries the roller when) is not "
-              "built yet", "remove [dynamics] from a groove design")
     if cam.kind.form_closed:
         for k in (own[1], own[2], "safety_force_n"):
             if k in t:

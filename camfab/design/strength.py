@@ -50,7 +50,7 @@ import numpy as np
 from .. import numeric
 from ..errors import InputError
 from ..results import Finding, IssueCode, Severity
-from .dynamics import ContactDynamics, DynamicsSample, PairDynamics
+from .dynamics import ContactDynamics, DynamicsSample, GrooveDynamics, PairDynamics
 from .kinds import ContactKind
 from .materials import Material
 from .profile import CamGeometry, Contact
@@ -126,6 +126,9 @@ class StrengthInput:
         p of ISO 281: 10/3 roller bearings, 3 ball bearings.
     notes : tuple of str
         Assumptions stated with the result (a material assumed, the width taken from the plate …).
+    roller_radius_mm : float, optional
+        R₂ of both contacts where the contacts carry another radius: a groove cam's flanks are contacts of the
+        groove half-width R_r + b/2, its roller is R_r.
     """
 
     dynamics: ContactDynamics | PairDynamics | None
@@ -136,6 +139,7 @@ class StrengthInput:
     dynamic_rating_n: float | None = None
     life_exponent: float = ROLLER
     notes: tuple[str, ...] = ()
+    roller_radius_mm: float | None = None
 
 
 @dataclass(frozen=True)
@@ -152,12 +156,14 @@ class StressSample:
 class StressModel:
     """p_max(φ) along the cycle from one force evaluation (:meth:`evaluate`)."""
 
-    def __init__(self, dynamics: ContactDynamics | PairDynamics, e_star: float, width_mm: float):
+    def __init__(self, dynamics: ContactDynamics | PairDynamics, e_star: float, width_mm: float,
+                 roller_radius_mm: float | None = None):
         self.dynamics, self.e_star, self.width = dynamics, float(e_star), float(width_mm)
         self.pair = isinstance(dynamics, PairDynamics)
         first = dynamics.first.contact if isinstance(dynamics, PairDynamics) else dynamics.contact
-        self.radius = follower_radius(first)
-        self.radius_2 = follower_radius(dynamics.second.contact) if isinstance(dynamics, PairDynamics) else None
+        self.radius = follower_radius(first) if roller_radius_mm is None else float(roller_radius_mm)
+        self.radius_2 = None if not isinstance(dynamics, PairDynamics) else \
+            follower_radius(dynamics.second.contact) if roller_radius_mm is None else float(roller_radius_mm)
 
     def evaluate(self, x) -> StressSample:
         """The stress at parameters x (radians, or mm of travel)."""
@@ -281,7 +287,7 @@ def analyse_strength(geometry: CamGeometry, inp: StrengthInput) -> tuple[Contact
     if inp.dynamics is None:
         raise InputError("contact stress needs the contact force: add a [dynamics] section (mass, spring, speed)")
     model = StressModel(inp.dynamics, effective_modulus(inp.cam.e_mpa, inp.cam.poisson, inp.follower.e_mpa,
-                                                        inp.follower.poisson), inp.width_mm)
+                                                        inp.follower.poisson), inp.width_mm, inp.roller_radius_mm)
     pair = inp.dynamics if isinstance(inp.dynamics, PairDynamics) else None
     c = geometry.profiles[0]
     edges = _edges(geometry, pair)
@@ -368,6 +374,10 @@ def _roller_life(model: StressModel, inp: StrengthInput, edges: np.ndarray, cycl
                      "roller_dynamic_rating_n)")
         return None
     dyn = model.dynamics
+    if isinstance(dyn, GrooveDynamics):
+        notes.append("roller life not computed for a groove cam: its one roller is loaded by both flanks in turn, "
+                     "rolling one way on each (not modelled yet)")
+        return None
     sides = [(dyn.first.contact, dyn.shift if k == 2 else 0.0, k) for k in (1, 2)] \
         if isinstance(dyn, PairDynamics) else [(dyn.contact, 0.0, 1)]
     out = [_one_roller(dyn, contact, shift, who, inp, edges, cycle_s) for contact, shift, who in sides]
