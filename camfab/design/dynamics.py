@@ -441,6 +441,9 @@ def _reversals(first, second, c, names=("follower 1", "follower 2")) -> list[tup
     """LOAD_REVERSAL (info) between consecutive stretches where different followers carry the load
     (``first``/``second``: the ranges where G > 0 / G < 0): ``(from, to, finding)`` in order."""
     unit = c.axis.x_unit
+    # a stretch whose |G| is rounding noise (the end of a law whose S″ falls to 0, a dwell without load) is none
+    top = max((gw for *_, gw in first + second if math.isfinite(gw)), default=0.0)
+    first, second = ([r for r in rs if r[3] > 1e-9 * top] for rs in (first, second))
     runs = sorted([(lo, hi, 1) for lo, hi, _, _ in first] + [(lo, hi, 2) for lo, hi, _, _ in second])
     out: list[tuple[float, float, Finding]] = []
     if len({k for _, _, k in runs}) < 2:
