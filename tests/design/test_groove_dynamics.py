@@ -11,10 +11,10 @@ import pytest
 
 from camfab.design.assemble import check_design, geometry_from_spec, strength_input
 from camfab.design.dynamics import ContactDynamics, GrooveDynamics, Loads, analyse_dynamics, pair_of
-from camfab.design.groove import GrooveTranslatingRoller
+from camfab.design.groove import GrooveOscillatingRoller, GrooveTranslatingRoller
 from camfab.design.profile import CamGeometry
 from camfab.design.program import MotionProgram
-from camfab.design.rollers import TranslatingRoller
+from camfab.design.rollers import OscillatingRoller, TranslatingRoller
 from camfab.design.spec import design_from_dict
 from camfab.design.strength import effective_modulus, hertz_line, relative_curvature
 from camfab.errors import SpecError
@@ -33,6 +33,27 @@ SPEED = 300 * RPM
 
 def _groove():
     return GrooveTranslatingRoller(RB, RR, 6.0, BACKLASH).geometry(PROGRAM)
+
+
+OSC_PROGRAM = MotionProgram.from_segments([("cycloidal", 15, 120), ("dwell", 0, 60), ("cycloidal", -15, 120),
+                                           ("dwell", 0, 60)], lift_unit="deg")
+
+
+def test_oscillating_groove_against_the_open_arm():
+    """The same for an oscillating roller (the arm's coordinate in radians, an inertia about the pivot): the
+    carrying flank's force is the open arm's N or −N, by the sign of G."""
+    geom = GrooveOscillatingRoller(RB, RR, 90.0, 70.0, 6.0, BACKLASH).geometry(OSC_PROGRAM)
+    loads = Loads(0.01, 0.0, 0.0, external=0.5)
+    groove = pair_of(geom, loads, SPEED)
+    open_arm = ContactDynamics(CamGeometry(OscillatingRoller(RB, W, 90.0, 70.0), OSC_PROGRAM).profiles[0], loads,
+                               SPEED)
+    x = np.linspace(0, 2 * np.pi, 2001)
+    g, o = groove.evaluate(x), open_arm.evaluate(x)
+    up, down = o.required > 1e-9, o.required < -1e-9
+    assert up.any() and down.any()
+    np.testing.assert_allclose(g.contact_force[up], o.contact_force[up], rtol=1e-11)
+    np.testing.assert_allclose(g.contact_force_2[down], -o.contact_force[down], rtol=1e-11)
+    assert np.all(g.lever > 0)
 
 
 def test_groove_forces_match_the_open_cam_without_spring():
