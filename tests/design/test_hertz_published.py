@@ -3,9 +3,10 @@
 Source: A. P. Boresi and R. J. Schmidt, *Advanced Mechanics of Materials* (Wiley), chapter 17 "Contact stresses",
 the worked example on two parallel cylinders on p. 621 (Ex. 3 of chapter 17 in the FOSSEE Python Textbook
 Companion for this book, which carries the book's printed answers: https://tbc-python.fossee.in/convert-notebook/
-Advanced_Mechanics_of_Materials_by_A._P._Boresi_and_R._J._Schmidt/Chapter17.ipynb, "Ex3-pg621").  Data: two steel cylinders, E = 200 GPa,
-ν = 0.29, both of radius R = 40 mm, contact length h = 20 mm, load P = 24.1 kN.  Printed results:
-σ_max = −1445 MPa (the surface pressure p_max, compressive), τ_max = 433 MPa, τ_oct,max = 361 MPa.
+Advanced_Mechanics_of_Materials_by_A._P._Boresi_and_R._J._Schmidt/Chapter17.ipynb, "Ex3-pg621").
+Data: two steel cylinders, E = 200 GPa, ν = 0.29, both of radius R = 40 mm, contact length h = 20 mm,
+load P = 24.1 kN.  Printed results: σ_max = −1445 MPa (the surface pressure p_max, compressive),
+τ_max = 433 MPa, τ_oct,max = 361 MPa.
 
 Boresi's convention: b is the HALF-width of the contact band (width 2b), the load P is the total force on the length
 h (not per unit length), and with ``A + B = (1/R₁ + 1/R₂)/2`` and ``Δ = [(1 − ν₁²)/E₁ + (1 − ν₂²)/E₂]/(A + B)``::
