@@ -130,7 +130,27 @@ def test_groove_contact_stress_on_each_flank():
     assert p1.max() > 0 and p2.max() > 0
     assert max(p1.max(), p2.max()) == pytest.approx(cs.max_mpa, rel=1e-6)
     assert cs.second[0] == pytest.approx(p2.max(), rel=1e-6)
-    assert cs.roller_life is None
+    assert cs.roller_life is None  # no bearing rating given
+
+
+def test_groove_roller_life_follows_the_carrying_flank():
+    """One roller: P = (Σ∫N^p ds / Σ∫ds)^(1/p), s along the flank that carries it (the inner where G > 0, the
+    outer where G < 0), turns Σ∫ds/(2π·R_r) — against dense sampling of the same sums; L10 = (C/P)^(10/3)."""
+    spec = design_from_dict(_design(dynamics={"mass_kg": 2.0}, strength={"roller_dynamic_rating_n": 9000.0}))
+    geom = geometry_from_spec(spec)
+    life = check_design(spec).contact_stress.roller_life
+    assert life is not None
+    x = np.linspace(0, 2 * np.pi, 400_001)
+    sm = strength_input(spec, geom).dynamics.evaluate(x)
+    d1, d2 = (np.hypot(*geom.profiles[k].evaluate(x).point_d1.T) for k in (0, 1))
+    p = 10 / 3
+    load = np.trapezoid(np.maximum(sm.contact_force, 0) ** p * d1 + np.maximum(sm.contact_force_2, 0) ** p * d2, x)
+    length = np.trapezoid(d1 * (sm.required > 0) + d2 * (sm.required < 0), x)
+    assert life.equivalent_load_n == pytest.approx((load / length) ** (1 / p), rel=1e-5)
+    assert life.roller_revolutions_per_cycle == pytest.approx(length / (2 * math.pi * RR), rel=1e-5)
+    assert life.l10_million_revolutions == pytest.approx((9000.0 / life.equivalent_load_n) ** p, rel=1e-12)
+    assert life.cam_cycles == pytest.approx(life.l10_million_revolutions * 1e6 / life.roller_revolutions_per_cycle,
+                                            rel=1e-12)
 
 
 def test_groove_refuses_a_spring_and_vibration():
