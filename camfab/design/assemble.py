@@ -61,8 +61,8 @@ def loads_from_spec(d: DynamicsSpec) -> Loads:
 
 
 def is_form_closed(spec: DesignSpec) -> bool:
-    """Conjugate, constant-width and constant-diameter cams drive their follower both ways."""
-    return spec.cam.kind in ("conjugate", "constant_width", "constant_diameter")
+    """Conjugate, constant-width, constant-diameter and groove cams drive their follower both ways."""
+    return spec.cam.kind.form_closed
 
 
 def dynamics_model(spec: DesignSpec, geometry: CamGeometry) -> ContactDynamics | PairDynamics:
@@ -95,7 +95,8 @@ def strength_input(spec: DesignSpec, geometry: CamGeometry) -> StrengthInput | N
         return None
     dyn = dynamics_model(spec, geometry) if spec.dynamics is not None else None
     return StrengthInput(dyn, st.cam, st.follower, st.width_mm, st.allowable_mpa, st.dynamic_rating_n,
-                         BALL if st.ball_bearing else ROLLER, st.notes)
+                         BALL if st.ball_bearing else ROLLER, st.notes,
+                         spec.follower.roller_radius_mm if spec.cam.kind == "groove" else None)
 
 
 def knot_findings(spec: DesignSpec) -> list[Finding]:

@@ -63,9 +63,11 @@ from ..results import (
 from ..sets import sorted_unique
 from ..units import DEG, RPM
 from .conjugate import DesmodromicGeometry
+from .groove import GrooveGeometry
 from .profile import CamGeometry, Contact
 
-__all__ = ["Loads", "DynamicsSample", "ContactDynamics", "PairDynamics", "pair_of", "analyse_dynamics"]
+__all__ = ["Loads", "DynamicsSample", "ContactDynamics", "PairDynamics", "GrooveDynamics", "pair_of",
+           "analyse_dynamics"]
 
 
 @dataclass(frozen=True)
@@ -278,10 +280,40 @@ class PairDynamics:
                               s1.curvature, s2.curvature)
 
 
+class GrooveDynamics(PairDynamics):
+    """Forces on a groove cam's one roller (:mod:`camfab.design.groove`): one follower and one coordinate, two
+    flanks.  The inner flank (``first``) pushes the roller the way S grows, the outer (``second``) pushes it back,
+    so the flank that carries the load is the sign of G: N₁ = G/D₁ where G > 0, N₂ = G/D₂ where G < 0.  The outer
+    flank's normal (into the groove) is the inner's reversed on the same line through the roller centre, so
+    D₂ = −D₁ and N₂ = |G|/D₁; the force acts at the outer flank's point (its own torque).  The nominal pitch
+    curve drives the roller (the backlash is not crossed: the knock is the ``LOAD_REVERSAL`` finding); no jump.
+    ``lever`` is the carrying flank's D, signed so that it is > 0 unless wedged."""
+
+    names = ("the inner flank", "the outer flank")
+
+    def __init__(self, first: ContactDynamics, second: ContactDynamics):
+        super().__init__(first, second, 0.0)
+
+    def evaluate(self, x) -> DynamicsSample:
+        x, S, qd, s1, D1, v1, u1 = self.first._lever(x)
+        _, _, _, s2, D2, v2, u2 = self.second._lever(x)
+        G = self.first.required(S)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            N1 = np.where(G > 0, G / D1, 0.0)
+            N2 = np.where(G < 0, G / D2, 0.0)
+        f1, b1, d1, p1 = self.first._transmit(N1, s1, v1, u1)
+        f2, b2, d2, p2 = self.second._transmit(N2, s2, v2, u2)
+        return DynamicsSample(x, G, np.where(G < 0, -D2, D1), N1, f1 + f2, b1 + b2, d1 + d2, p1 + p2, S, N2,
+                              s1.curvature, s2.curvature)
+
+
 def pair_of(geometry: CamGeometry, loads: Loads, speed: float) -> PairDynamics:
-    """The :class:`PairDynamics` of a desmodromic geometry (two profiles, or one touched twice)."""
+    """The :class:`PairDynamics` of a desmodromic geometry (two profiles, or one touched twice), or the
+    :class:`GrooveDynamics` of a groove cam."""
     profs = geometry.profiles
     first = ContactDynamics(profs[0], loads, speed)
+    if isinstance(geometry, GrooveGeometry):
+        return GrooveDynamics(first, ContactDynamics(profs[1], loads, speed))
     if len(profs) == 2:  # conjugate: follower 2 is the mirror image of a plain follower on a mirrored cam,
         # and every scalar (N, D, G, torque, power) is the same computed in that mirrored world
         return PairDynamics(first, ContactDynamics(getattr(profs[1], "_inner", profs[1]), loads, speed))
@@ -354,7 +386,7 @@ def analyse_dynamics(geometry: CamGeometry, loads: Loads, speed: float, *, prelo
     root refinement.  ``speed`` is ω (rad/s), or mm/s for a translating cam.
     """
     if form_closed is None:
-        form_closed = isinstance(geometry, DesmodromicGeometry)
+        form_closed = isinstance(geometry, (DesmodromicGeometry, GrooveGeometry))
     if not form_closed and len(geometry.profiles) != 1:
         raise InputError(f"form_closed=False needs one profile, the geometry has {len(geometry.profiles)}: "
                          "a force-closed cam has one follower; pass form_closed=True for a conjugate pair")
@@ -382,7 +414,7 @@ def analyse_dynamics(geometry: CamGeometry, loads: Loads, speed: float, *, prelo
         bearing_force=Maximum(float(bmax), _user(c, at_b)), work_per_cycle_j=work, mean_power_w=work / cycle_s)
     findings = _self_locking(ranges[0], c)
     if form_closed:
-        rev = _reversals(ranges[1], ranges[2], c)
+        rev = _reversals(ranges[1], ranges[2], c, getattr(dyn, "names", ("follower 1", "follower 2")))
         summary = DynamicsSummary(safety_force_n=None, second_contact_force=extreme("contact_force_2"),
                                   load_reversals=tuple((a, b) for a, b, _ in rev), **common)
         return DynamicsReport(summary, tuple(findings + [f for _, _, f in rev]))
@@ -405,10 +437,13 @@ def _self_locking(ranges, c) -> list[Finding]:
             for lo, hi, _, gw in ranges]
 
 
-def _reversals(first, second, c) -> list[tuple[float, float, Finding]]:
+def _reversals(first, second, c, names=("follower 1", "follower 2")) -> list[tuple[float, float, Finding]]:
     """LOAD_REVERSAL (info) between consecutive stretches where different followers carry the load
     (``first``/``second``: the ranges where G > 0 / G < 0): ``(from, to, finding)`` in order."""
     unit = c.axis.x_unit
+    # a stretch whose |G| is rounding noise (the end of a law whose S″ falls to 0, a dwell without load) is none
+    top = max((gw for *_, gw in first + second if math.isfinite(gw)), default=0.0)
+    first, second = ([r for r in rs if r[3] > 1e-9 * top] for rs in (first, second))
     runs = sorted([(lo, hi, 1) for lo, hi, _, _ in first] + [(lo, hi, 2) for lo, hi, _, _ in second])
     out: list[tuple[float, float, Finding]] = []
     if len({k for _, _, k in runs}) < 2:
@@ -419,7 +454,7 @@ def _reversals(first, second, c) -> list[tuple[float, float, Finding]]:
             where = f"at {a:.2f} {unit}" if abs(b - a) < 1e-9 else f"between {a:.2f} and {b:.2f} {unit}"
             out.append((a, b, Finding(
                 IssueCode.LOAD_REVERSAL, Severity.INFO, a, b, None, None,
-                f"the load passes from follower {k} to follower {k2} {where}: across a clearance the follower "
+                f"the load passes from {names[k - 1]} to {names[k2 - 1]} {where}: across a clearance the follower "
                 "knocks there — keep the clearance small (or preload the pair)")))
     return sorted(out, key=lambda t: t[0])
 

@@ -47,8 +47,8 @@ class CamKind(StrEnum):
 
     @property
     def form_closed(self) -> bool:
-        """Conjugate, constant-width and constant-diameter cams drive their follower both ways."""
-        return self in (CamKind.CONJUGATE, CamKind.CONSTANT_WIDTH, CamKind.CONSTANT_DIAMETER)
+        """Conjugate, constant-width, constant-diameter and (disc) groove cams drive their follower both ways."""
+        return self in (CamKind.CONJUGATE, CamKind.CONSTANT_WIDTH, CamKind.CONSTANT_DIAMETER, CamKind.GROOVE)
 
     @property
     def symmetric(self) -> bool:

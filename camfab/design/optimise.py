@@ -32,6 +32,7 @@ from .dynamics import ContactDynamics, pair_of
 from .kinds import CamKind, ContactKind, FollowerMotion
 from .mechanisms import geometry_from_spec, mechanism_from_spec
 from .optimise_spec import Method, OptimiseSpec, VariableSpec
+from .resolve import END_KEYS
 from .spec import DesignSpec, design_from_dict
 
 __all__ = ["Objective", "Constraint", "OBJECTIVES", "CONSTRAINTS", "Variable", "OptimisationProblem", "OptimiseResult",
@@ -148,7 +149,13 @@ class Variable:
             return dataclasses.replace(spec, follower=fol)
         if head == "motion":
             segs = list(spec.motion or ())
-            segs[self.where[1]] = dataclasses.replace(segs[self.where[1]], span=value)
+            seg, key = segs[self.where[1]], self.where[2]
+            if key in END_KEYS:
+                ends = list(seg.ends)
+                ends[END_KEYS.index(key)] = value
+                segs[self.where[1]] = dataclasses.replace(seg, ends=tuple(ends))  # type: ignore[arg-type]
+            else:
+                segs[self.where[1]] = dataclasses.replace(seg, span=value)
             return dataclasses.replace(spec, motion=tuple(segs))
         mt = dict(spec.motion_table or {})
         rows = [list(r) for r in mt.get("rows", ())]
@@ -164,6 +171,7 @@ class Variable:
 
 
 _SEGMENT = re.compile(r"motion\[(\d+)\]\.(angle_deg|length_mm)")
+_END = re.compile(r"motion\[(\d+)\]\.(end_v|end_a|end_j)")
 _KNOT = re.compile(r"motion_table\.rows\[(\d+)\]\.(s|v|a)")
 _FOLLOWER = ("base_radius_mm", "offset_mm", "pivot_distance_mm", "arm_length_mm", "roller_radius_mm")
 
@@ -173,13 +181,17 @@ def _variable(vs: VariableSpec, data: Mapping[str, Any], spec: DesignSpec) -> Va
     m = _SEGMENT.fullmatch(vs.name)
     if m:
         return _segment_variable(vs, data, int(m.group(1)), m.group(2))
+    m = _END.fullmatch(vs.name)
+    if m:
+        return _end_variable(vs, data, int(m.group(1)), m.group(2))
     m = _KNOT.fullmatch(vs.name)
     if m:
         return _knot_variable(vs, data, int(m.group(1)), "sva".index(m.group(2)) + 1)
     if vs.name.startswith("follower.") and vs.name.split(".", 1)[1] in _FOLLOWER:
         return _follower_variable(vs, data, spec, vs.name.split(".", 1)[1])
     raise _problem(f"{vs.path}.name", vs.name, "unknown optimisation variable",
-                   "name motion[i].angle_deg (or length_mm), motion_table.rows[i].s|v|a, or follower."
+                   "name motion[i].angle_deg (or length_mm), motion[i].end_v|end_a|end_j (a generic polynomial's "
+                   "joint values), motion_table.rows[i].s|v|a, or follower."
                    + "|".join(_FOLLOWER))
 
 
@@ -197,6 +209,17 @@ def _segment_variable(vs: VariableSpec, data: Mapping[str, Any], i: int, key: st
         raise _problem(f"{p}.lo", [vs.lo, vs.hi], "a segment span must stay in (0, 360]°",
                        "give 0 < lo < hi <= 360")
     return _within(Variable(name, ("motion", i, key), vs.lo, vs.hi, float(start), angle=True), p)
+
+
+def _end_variable(vs: VariableSpec, data: Mapping[str, Any], i: int, key: str) -> Variable:
+    """A generic polynomial's joint value with a generic next segment (the design gives its start)."""
+    segs = data.get("motion")
+    start = segs[i].get(key) if isinstance(segs, list) and i < len(segs) else None
+    if not isinstance(start, (int, float)) or isinstance(start, bool):
+        raise _problem(f"{vs.path}.name", vs.name, f"the design gives no {key} on segment {i} (a joint value of "
+                       "two adjacent generic polynomials, the start of the search)",
+                       f"write {key} on motion[{i}] (a poly5/poly7 followed by another), or free another value")
+    return _within(Variable(vs.name, ("motion", i, key), vs.lo, vs.hi, float(start)), vs.path)
 
 
 def _knot_variable(vs: VariableSpec, data: Mapping[str, Any], i: int, col: int) -> Variable:

@@ -69,7 +69,8 @@ class MotionProgram:
     @classmethod
     def from_segments(cls, rows: Iterable[Sequence], *, unit: str = "deg",
                       period: float | None = None, lift_unit: str = "mm") -> MotionProgram:
-        """Build from ``(law, lift, span[, shape])`` rows; span in degrees by default.
+        """Build from ``(law, lift, span[, shape[, ends]])`` rows; span in degrees by default (``ends``: a generic
+        polynomial's joint values S′, S″, S‴ per radian, see :class:`SegmentInput`).
 
         ``unit="rad"`` takes spans in radians; ``unit="mm"`` builds a
         translating-cam program whose period is the sum of the spans (or
@@ -81,7 +82,7 @@ class MotionProgram:
         for row in rows:
             law, lift, span, *rest = row
             inputs.append(SegmentInput(law, float(lift), None if span is None else float(span) * scale,
-                                       rest[0] if rest else None))
+                                       rest[0] if rest else None, *rest[1:2]))
         if period is None:
             period = TWO_PI if unit != "mm" else sum(i.span or 0.0 for i in inputs)
         return build_program(inputs, period=period, unit=unit, lift_unit=lift_unit)

@@ -8,8 +8,10 @@ involves are valid); rule 4 needs the resolved motion, so it waits for 1–3 to 
 0. at most :data:`~camfab.limits.MAX_SEGMENTS` segments (``docs/decisions.md``, "Input limits");
 1. each segment alone: a known law, a finite and sensible lift (0 for a dwell), a positive span (or
    ``"auto"`` for a half-period law with a lift), a double-harmonic ``shape``;
-2. the chain: the first segment is not a return; two generic polynomials are never
-   adjacent (cyclically), since each is solved from its neighbours' S, S′, S″ (S‴);
+2. the chain: the first segment is not a return; two generic polynomials are adjacent
+   (cyclically) only when the first gives the joint's free values ``end_v``, ``end_a`` (and
+   ``end_j`` where a poly7 meets the joint), since each is solved from its neighbours' S, S′, S″
+   (S‴); those keys are refused where the next segment is a standard law (its values rule);
    a half-period law's moving end matches its neighbour's slope — its span is solved from
    it (``"auto"``) or must agree with it;
 3. closure: the spans sum to the period (to 1e-9° or 1e-9 mm) and the lifts to 0;
@@ -31,7 +33,10 @@ from .extrema import segment_candidates
 from .laws import GENERIC, HALF_PERIOD, LAWS, get_law, law_names
 from .segment import Segment, solve_generic
 
-__all__ = ["SegmentInput", "resolve_segments"]
+__all__ = ["SegmentInput", "resolve_segments", "END_KEYS"]
+
+#: a generic polynomial's joint values with a generic next segment: S′, S″, S‴ at its end
+END_KEYS = ("end_v", "end_a", "end_j")
 
 
 @dataclass(frozen=True, slots=True)
@@ -50,12 +55,17 @@ class SegmentInput:
         its neighbour's slope.
     shape : str or None
         Double-harmonic shape override ("rise" or "return").
+    ends : tuple of 3 (float or None)
+        A generic polynomial's S′, S″, S‴ at its end (per unit x: per radian, or per mm of a translating cam),
+        given where the next segment is a generic polynomial too (``end_v``, ``end_a``, ``end_j``); None: not
+        given, NaN: given but already reported.
     """
 
     law: str
     lift: float
     span: float | None
     shape: str | None = None
+    ends: tuple[float | None, float | None, float | None] = (None, None, None)
 
 
 @dataclass(frozen=True)
@@ -123,7 +133,29 @@ def _shape_problems(i: int, s: SegmentInput, ctx: _Context) -> list[Problem]:
     return []
 
 
-_INPUT_RULES = (_law_problems, _lift_problems, _span_problems, _shape_problems)
+def _end_problems(i: int, s: SegmentInput, ctx: _Context) -> list[Problem]:
+    """The joint values are a generic polynomial's, and each alone moves the follower at most
+    :data:`~camfab.limits.MAX_LIFT_MM` over the segment: |S⁽ᵏ⁾|·spanᵏ/k! (as a knot table's)."""
+    given = [(k, e) for k, e in zip(END_KEYS, s.ends, strict=True) if e is not None]
+    if not given:
+        return []
+    out = [Problem(f"{ctx.path}[{i}].{k}", e, "must be a finite number", "give S′, S″ or S‴ per radian")
+           for k, e in given if not math.isfinite(e)]  # reported by the design's reading already: merged there
+    given = [(k, e) for k, e in given if math.isfinite(e)]
+    if s.law not in GENERIC:
+        return [Problem(f"{ctx.path}[{i}].{k}", e, f"joint values belong to a generic polynomial (poly5, poly7), not "
+                        f"to '{s.law}', whose end is fixed by its law", f"remove {k}") for k, e in given] + out
+    for k, e in given:
+        n = END_KEYS.index(k) + 1
+        move = abs(e) * (s.span or 0.0) ** n / math.factorial(n) if s.span and math.isfinite(s.span) else 0.0
+        if move > MAX_LIFT_MM:
+            out.append(Problem(f"{ctx.path}[{i}].{k}", e, f"alone it would move the follower {move:.3g} over the "
+                               f"segment, beyond the input limit of {MAX_LIFT_MM:g}",
+                               "check the value and its unit (the lift's unit per radian, or per mm of travel)"))
+    return out
+
+
+_INPUT_RULES = (_law_problems, _lift_problems, _span_problems, _shape_problems, _end_problems)
 
 
 # ---- 2. the chain
@@ -134,14 +166,40 @@ def _first_problems(inputs: Sequence[SegmentInput], ctx: _Context) -> list[Probl
     return []
 
 
+_POWER = {"end_v": "", "end_a": "²", "end_j": "³"}
+
+
+def _joint_keys(a: str, b: str) -> tuple[str, ...]:
+    """The keys a joint of two generic polynomials needs: S′, S″, and S‴ where a poly7 meets it."""
+    return END_KEYS if 7 in (GENERIC[a], GENERIC[b]) else END_KEYS[:2]
+
+
 def _adjacent_generic_problems(inputs: Sequence[SegmentInput], laws: list[str], ctx: _Context) -> list[Problem]:
     n, out = len(inputs), []
     for i in range(n):
         j = (i + 1) % n
-        if laws[i] in GENERIC and laws[j] in GENERIC:
+        if laws[i] not in GENERIC or laws[j] is None:
+            continue
+        given = {k for k, e in zip(END_KEYS, inputs[i].ends, strict=True) if e is not None}
+        p = f"{ctx.path}[{i}]"
+        if laws[j] not in GENERIC:
+            out += [Problem(f"{p}.{k}", inputs[i].ends[END_KEYS.index(k)], f"the next segment {ctx.path}[{j}] "
+                            f"('{inputs[j].law}') fixes the joint's values", f"remove {k}")
+                    for k in END_KEYS if k in given]
+            continue
+        need = _joint_keys(laws[i], laws[j])
+        if not given:
             out.append(Problem(f"{ctx.path}[{j}].law", inputs[j].law,
-                               f"two generic polynomials may not be adjacent ({ctx.path}[{i}] and {ctx.path}[{j}], "
-                               "cyclically)", "put a standard law between them"))
+                               f"two generic polynomials may not be adjacent ({p} and {ctx.path}[{j}], "
+                               "cyclically) unless the joint's values are given",
+                               f"give {', '.join(need)} on {p} (the lift's unit per radian, per mm on a translating "
+                               "cam), or put a standard law between them"))
+            continue
+        out += [Problem(f"{p}.{k}", None, f"is required: {p} and {ctx.path}[{j}] are generic polynomials "
+                        "meeting there", f"give {k} (the lift's unit per radian{_POWER[k]}, "
+                        f"per mm{_POWER[k]} on a translating cam)") for k in need if k not in given]
+        out += [Problem(f"{p}.{k}", inputs[i].ends[END_KEYS.index(k)], "S‴ is free only where a poly7 meets the "
+                        "joint", f"remove {k}") for k in END_KEYS if k in given and k not in need]
     return out
 
 
@@ -233,13 +291,15 @@ def _segments(inputs: Sequence[SegmentInput], laws: list[str], spans: list[float
         Segment(laws[i], inputs[i].lift, spans[i], float(starts[i]), float(s0[i]), None, LAWS[laws[i]].title)
         for i in range(n)
     ]
+    def joint(i: int) -> np.ndarray:  # S, S′, S″, S‴ where segment i ends (S unused)
+        j = (i + 1) % n
+        if laws[i] in GENERIC and laws[j] in GENERIC:
+            return np.array([0.0, *(0.0 if e is None else e for e in inputs[i].ends)])
+        return segs[i].end_values(True) if laws[i] not in GENERIC else segs[j].end_values(False)  # type: ignore
+
     for i in range(n):
         if laws[i] in GENERIC:
-            if n == 1:
-                prev_end = next_start = np.zeros(4)
-            else:
-                prev_end = segs[(i - 1) % n].end_values(True)  # type: ignore[union-attr]
-                next_start = segs[(i + 1) % n].end_values(False)  # type: ignore[union-attr]
+            prev_end, next_start = joint((i - 1) % n), joint(i)
             c = solve_generic(GENERIC[laws[i]], float(s0[i]), inputs[i].lift, spans[i], prev_end, next_start)
             segs[i] = Segment(laws[i], inputs[i].lift, spans[i], float(starts[i]), float(s0[i]), c,
                               f"Generic {GENERIC[laws[i]]}th-degree polynomial")

@@ -28,6 +28,7 @@ from .laws import law_names
 from .mechanisms import MECHANISMS, mechanism_class, mechanism_from_spec
 from .optimise_spec import OptimiseSpec, optimise_section
 from .program import TWO_PI, MotionProgram, SegmentInput, build_program
+from .resolve import END_KEYS
 from .shop import (
     POSTS,
     AssemblySpec,
@@ -76,7 +77,7 @@ _FOLLOWER_KEYS = ("type", "motion", *_FOLLOWER_FLOATS)
 _POSITIVE = ("base_radius_mm", "arm_length_mm", "cam_length_mm", "follower_distance_mm", "width_mm",
              "face_radius_mm", "groove_depth_mm")
 _NON_NEGATIVE = ("roller_radius_mm", "pivot_distance_mm", "second_roller_radius_mm", "base_height_mm", "backlash_mm")
-_SEGMENT_KEYS = ("law", "lift", "angle_deg", "length_mm", "shape")
+_SEGMENT_KEYS = ("law", "lift", "angle_deg", "length_mm", "shape", *END_KEYS)
 _CHECK_KEYS = ("pressure_angle_limit_deg", "face_margin_mm")
 #: [dynamics] keys by follower motion (the units are in the names) and for both
 _DYN_TRANSLATING = ("mass_kg", "spring_rate_n_per_mm", "spring_preload_n", "damping_n_s_per_m", "external_force_n")
@@ -141,6 +142,7 @@ class SegmentSpec:
     lift: float
     span: float | None  # degrees, or mm for translating cams
     shape: str | None = None
+    ends: tuple[float | None, float | None, float | None] = (None, None, None)  # end_v, end_a, end_j per rad (mm)
 
 
 @dataclass(frozen=True, slots=True)
@@ -334,8 +336,11 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
     pa = v.number(checks, "pressure_angle_limit_deg", "checks", None, lo=0.0, hi=90.0, lo_open=True, hi_open=True)
     margin = v.number(checks, "face_margin_mm", "checks", 0.0, lo=0.0, hi=1e4)
     dyn = _dynamics(v, data, cam, fol)
-    strength = strength_section(v, data, thickness_mm=mfg.thickness_mm, manufacturing_material=mfg.material,
-                                assembly_roller_width_mm=assembly.roller_width_mm, applies="dynamics" in data)
+    groove = fol.groove_depth_mm if cam.kind == CamKind.GROOVE else None  # the flanks: as high as the groove
+    strength = strength_section(v, data, thickness_mm=groove or mfg.thickness_mm,
+                                manufacturing_material=mfg.material, assembly_roller_width_mm=assembly.roller_width_mm,
+                                applies="dynamics" in data,
+                                face="the groove depth" if groove else "the plate thickness")
     return DesignSpec(name.strip(), cam, fol, motion, table, mfg, out, pressure_angle_limit_deg=pa,
                       description=str(data.get("description", "")), source=source, face_margin_mm=margin,
                       dynamics=dyn, machining=machining, assembly=assembly, drawing=drawing, strength=strength,
@@ -496,7 +501,8 @@ def _segment(v: Validator, r: Mapping[str, Any], p: str, span_key: str) -> Segme
                         hi=360.0 if span_key == "angle_deg" else MAX_LENGTH_MM)
         if span is None:
             span = math.nan  # already reported
-    return SegmentSpec("" if law is None else str(law), lift, span, r.get("shape"))
+    ends = tuple(v.number(r, k, p, math.nan) if k in r else None for k in END_KEYS)  # NaN: reported
+    return SegmentSpec("" if law is None else str(law), lift, span, r.get("shape"), ends)  # type: ignore[arg-type]
 
 
 # ---------------------------------------------------------------------------
@@ -508,9 +514,6 @@ def _dynamics(v: Validator, data: Mapping[str, Any], cam: CamSpec, fol: Follower
     osc = fol.motion == FollowerMotion.OSCILLATING and cam.kind != CamKind.TRANSLATING
     own = _DYN_OSCILLATING if osc else _DYN_TRANSLATING
     _dynamics_keys(v, t, osc)
-    if cam.kind == CamKind.GROOVE:
-        v.add("dynamics", None, "the force model of a groove cam (which flank carries the roller when) is not "
-              "built yet", "remove [dynamics] from a groove design")
     if cam.kind.form_closed:
         for k in (own[1], own[2], "safety_force_n"):
             if k in t:
@@ -581,7 +584,8 @@ def _build_motion(spec: DesignSpec) -> MotionProgram:
                                 "add [[motion]] segments"), spec.source)
     if spec.is_translating_cam:
         length = spec.follower.cam_length_mm or sum(s.span or 0.0 for s in spec.motion)
-        inputs = [SegmentInput(s.law, s.lift, s.span, s.shape) for s in spec.motion]
+        inputs = [SegmentInput(s.law, s.lift, s.span, s.shape, s.ends) for s in spec.motion]
         return build_program(inputs, period=length, unit="mm", source=spec.source)
-    inputs = [SegmentInput(s.law, s.lift, None if s.span is None else s.span * DEG, s.shape) for s in spec.motion]
+    inputs = [SegmentInput(s.law, s.lift, None if s.span is None else s.span * DEG, s.shape, s.ends)
+              for s in spec.motion]
     return build_program(inputs, period=TWO_PI, unit="rad", source=spec.source, lift_unit=spec.follower.lift_unit)

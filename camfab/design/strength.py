@@ -50,7 +50,7 @@ import numpy as np
 from .. import numeric
 from ..errors import InputError
 from ..results import Finding, IssueCode, Severity
-from .dynamics import ContactDynamics, DynamicsSample, PairDynamics
+from .dynamics import ContactDynamics, DynamicsSample, GrooveDynamics, PairDynamics
 from .kinds import ContactKind
 from .materials import Material
 from .profile import CamGeometry, Contact
@@ -126,6 +126,9 @@ class StrengthInput:
         p of ISO 281: 10/3 roller bearings, 3 ball bearings.
     notes : tuple of str
         Assumptions stated with the result (a material assumed, the width taken from the plate …).
+    roller_radius_mm : float, optional
+        R₂ of both contacts where the contacts carry another radius: a groove cam's flanks are contacts of the
+        groove half-width R_r + b/2, its roller is R_r.
     """
 
     dynamics: ContactDynamics | PairDynamics | None
@@ -136,6 +139,7 @@ class StrengthInput:
     dynamic_rating_n: float | None = None
     life_exponent: float = ROLLER
     notes: tuple[str, ...] = ()
+    roller_radius_mm: float | None = None
 
 
 @dataclass(frozen=True)
@@ -152,12 +156,14 @@ class StressSample:
 class StressModel:
     """p_max(φ) along the cycle from one force evaluation (:meth:`evaluate`)."""
 
-    def __init__(self, dynamics: ContactDynamics | PairDynamics, e_star: float, width_mm: float):
+    def __init__(self, dynamics: ContactDynamics | PairDynamics, e_star: float, width_mm: float,
+                 roller_radius_mm: float | None = None):
         self.dynamics, self.e_star, self.width = dynamics, float(e_star), float(width_mm)
         self.pair = isinstance(dynamics, PairDynamics)
         first = dynamics.first.contact if isinstance(dynamics, PairDynamics) else dynamics.contact
-        self.radius = follower_radius(first)
-        self.radius_2 = follower_radius(dynamics.second.contact) if isinstance(dynamics, PairDynamics) else None
+        self.radius = follower_radius(first) if roller_radius_mm is None else float(roller_radius_mm)
+        self.radius_2 = None if not isinstance(dynamics, PairDynamics) else \
+            follower_radius(dynamics.second.contact) if roller_radius_mm is None else float(roller_radius_mm)
 
     def evaluate(self, x) -> StressSample:
         """The stress at parameters x (radians, or mm of travel)."""
@@ -281,7 +287,7 @@ def analyse_strength(geometry: CamGeometry, inp: StrengthInput) -> tuple[Contact
     if inp.dynamics is None:
         raise InputError("contact stress needs the contact force: add a [dynamics] section (mass, spring, speed)")
     model = StressModel(inp.dynamics, effective_modulus(inp.cam.e_mpa, inp.cam.poisson, inp.follower.e_mpa,
-                                                        inp.follower.poisson), inp.width_mm)
+                                                        inp.follower.poisson), inp.width_mm, inp.roller_radius_mm)
     pair = inp.dynamics if isinstance(inp.dynamics, PairDynamics) else None
     c = geometry.profiles[0]
     edges = _edges(geometry, pair)
@@ -368,10 +374,45 @@ def _roller_life(model: StressModel, inp: StrengthInput, edges: np.ndarray, cycl
                      "roller_dynamic_rating_n)")
         return None
     dyn = model.dynamics
+    if isinstance(dyn, GrooveDynamics):
+        notes.append("groove cam: one roller, loaded by the inner flank where the follower force is positive and by "
+                     "the outer flank where it is negative; its turns counted where a flank carries it")
+        return _groove_roller(dyn, inp, edges, cycle_s, model.radius)
     sides = [(dyn.first.contact, dyn.shift if k == 2 else 0.0, k) for k in (1, 2)] \
         if isinstance(dyn, PairDynamics) else [(dyn.contact, 0.0, 1)]
     out = [_one_roller(dyn, contact, shift, who, inp, edges, cycle_s) for contact, shift, who in sides]
     return min(out, key=lambda r: math.inf if r.cam_cycles is None else r.cam_cycles)
+
+
+def _groove_roller(dyn: GrooveDynamics, inp: StrengthInput, edges: np.ndarray, cycle_s: float,
+                   radius: float) -> RollerLife:
+    """A groove's one roller: P = (Σ∫N^p ds / Σ∫ds)^(1/p) over the stretches where each flank carries it (s along
+    that flank: the inner where G > 0, the outer where G < 0), its turns Σ∫ds/(2π·R_r); the integrals split at
+    the load reversals (the roots of G)."""
+    p = inp.life_exponent
+    inner, outer = dyn.first.contact, dyn.second.contact
+
+    def required(x: np.ndarray) -> np.ndarray:
+        g = dyn.first.required(np.asarray(inner.motion.evaluate(x, (0, 1, 2)), dtype=float))
+        return np.stack([g, -g])
+
+    cuts = [r[k] for rs in numeric.positive_ranges(required, edges, closed=inner.closed) for r in rs for k in (0, 1)]
+    split = np.unique(np.concatenate([edges, np.clip(cuts, edges[0], edges[-1])]))
+
+    def rows(x: np.ndarray) -> np.ndarray:
+        sm = dyn.evaluate(x)
+        d1, d2 = (np.hypot(*c.evaluate(x).point_d1.T) for c in (inner, outer))
+        n1, n2 = np.maximum(sm.contact_force, 0.0), np.maximum(sm.contact_force_2, 0.0)  # type: ignore[arg-type]
+        return np.stack([n1 ** p * d1 + n2 ** p * d2, d1 * (sm.required > 0) + d2 * (sm.required < 0)])
+
+    load_ds = numeric.integrate(lambda x: rows(x)[0], split, rtol=1e-9)
+    length = numeric.integrate(lambda x: rows(x)[1], split, rtol=1e-9)
+    P = (load_ds / length) ** (1.0 / p) if length > 0 else 0.0
+    turns = length / (2 * math.pi * radius)
+    L = rating_life(inp.dynamic_rating_n or 0.0, P, p)
+    cycles = None if math.isinf(L) or turns <= 0 else L * 1e6 / turns
+    return RollerLife(None if math.isinf(L) else L, cycles, None if cycles is None else cycles * cycle_s / 3600,
+                      P, inp.dynamic_rating_n or 0.0, p, turns, 1)
 
 
 def _one_roller(dyn: ContactDynamics | PairDynamics, contact: Contact, shift: float, who: int, inp: StrengthInput,

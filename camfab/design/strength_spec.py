@@ -105,7 +105,8 @@ def _named(v: Validator, t: Mapping[str, Any], key: str, own: Mapping[str, Mater
 
 
 def strength_section(v: Validator, data: Mapping[str, Any], *, thickness_mm: float, manufacturing_material: str,
-                     assembly_roller_width_mm: float | None, applies: bool) -> StrengthSpec | None:
+                     assembly_roller_width_mm: float | None, applies: bool,
+                     face: str = "the plate thickness") -> StrengthSpec | None:
     """``[strength]`` and ``[materials.*]`` read into a :class:`StrengthSpec`; None when the check does not
     apply (no ``[dynamics]`` and no ``[strength]``).  Problems go to ``v``."""
     tables: list[tuple[str, tuple[tuple[str, float], ...]]] = []
@@ -133,7 +134,7 @@ def strength_section(v: Validator, data: Mapping[str, Any], *, thickness_mm: flo
     if width is None:
         width = assembly_roller_width_mm
     if width is None:
-        notes.append(f"face width = the plate thickness {thickness_mm:g} mm (no roller width given)")
+        notes.append(f"face width = {face} {thickness_mm:g} mm (no roller width given)")
         width = thickness_mm
     width = min(width, thickness_mm)
     allow = v.number(t, "allowable_contact_stress_mpa", "strength", None, lo=0.0, lo_open=True, hi=1e5)

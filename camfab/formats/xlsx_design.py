@@ -49,6 +49,7 @@ from pathlib import Path
 from typing import Any
 
 from ..design.knots import KnotFile
+from ..design.resolve import END_KEYS
 from ..design.shop import MachiningSpec
 from ..design.spec import CamSpec, DesignSpec, FollowerSpec, ManufacturingSpec, OutputsSpec, dynamics_items
 from ..errors import Problem, SpecError
@@ -60,7 +61,7 @@ from .toml_design import design_from_data
 
 __all__ = ["load_design_xlsx", "design_to_xlsx", "design_rows", "SEGMENT_COLUMNS", "KNOT_COLUMNS"]
 
-SEGMENT_COLUMNS = ("law", "lift", "angle_deg", "length_mm", "shape")
+SEGMENT_COLUMNS = ("law", "lift", "angle_deg", "length_mm", "shape", *END_KEYS)
 KNOT_COLUMNS = ("angle", "s", "v", "a", "j")
 _TEXT_KEYS = {"name", "description", "manufacturing.material", "motion_table.file", "strength.cam_material",
               "strength.follower_material"}
@@ -452,6 +453,7 @@ def _segment_rows(spec: DesignSpec) -> list[dict[str, Any]]:
         seg: dict[str, Any] = {"law": s.law, "lift": _num(s.lift), span: "auto" if s.span is None else _num(s.span)}
         if s.shape is not None:
             seg["shape"] = s.shape
+        seg.update({k: _num(e) for k, e in zip(END_KEYS, s.ends, strict=True) if e is not None})
         segs.append(seg)
     return segs
 
