@@ -113,3 +113,62 @@ def test_bad_rib_designs_name_their_field(cyl, follower, path):
     with pytest.raises(SpecError) as exc:
         check_design(rib(follower=follower, **cyl))
     assert path in {p.path for p in exc.value.problems}
+
+
+RIB_TOML = """name = "Ribbed"
+[cam]
+kind = "cylindrical"
+[cylinder]
+radius_mm = 40.0
+length_mm = 80.0
+feature = "rib"
+rib_width_mm = 8.0
+rib_height_mm = 10.0
+backlash_mm = 0.1
+[follower]
+type = "roller"
+motion = "translating"
+roller_radius_mm = 6.0
+[[motion]]
+law = "cycloidal"
+lift = 20.0
+angle_deg = 140.0
+[[motion]]
+law = "dwell"
+lift = 0.0
+angle_deg = 40.0
+[[motion]]
+law = "cycloidal"
+lift = -20.0
+angle_deg = 180.0
+[manufacturing]
+tolerance_mm = 0.01
+tool_diameter_mm = 6.0
+"""
+
+
+def test_rib_files_dxf_and_refused_solid(tmp_path, capsys):
+    """``run`` writes the developed rib (DXF: both rib flanks exactly ``rib_width_mm`` apart where it runs round,
+    read back with ezdxf) and the workbook, and skips the STEP with the reason naming ``[cylinder] feature``;
+    ``camfab gcode`` exits 2 with that reason."""
+    ezdxf = pytest.importorskip("ezdxf")
+    from camfab.cli import main
+    from camfab.pipeline import Output, Request, load, run
+
+    src = tmp_path / "rib.toml"
+    src.write_text(RIB_TOML, encoding="utf-8")
+    cam = load(src)
+    res = run(cam, tmp_path / "out", Request(frozenset({Output.DXF, Output.STEP, Output.XLSX})))
+    assert "[cylinder] feature" in res.not_applicable["step"]
+    assert sorted(p.name for p in (tmp_path / "out").iterdir() if p.suffix != ".lock") == [
+        "Ribbed.dxf", "Ribbed.xlsx", "check.json"]
+    doc = ezdxf.readfile(tmp_path / "out" / "Ribbed.dxf")
+    z0 = cam.geometry.mechanism.z0_for(cam.geometry.program)
+    x_dwell = 40.0 * np.radians([140.0, 180.0])
+    for layer, side in (("PROFILE", 1), ("PROFILE_2", -1)):
+        (pl,) = [e for e in doc.modelspace() if e.dxf.layer == layer]
+        pts = np.array([(x, y) for x, y, *_ in pl.get_points("xyseb")])
+        on = pts[np.abs(pts[:, 1] - (z0 + 20.0 + side * W / 2)) < 1e-9, 0]  # the dwell's straight segment's ends
+        assert on.min() <= x_dwell[0] and on.max() >= x_dwell[1]
+    assert main(["gcode", str(src), "-o", str(tmp_path / "nc")]) == 2
+    assert 'feature = "rib"' in capsys.readouterr().err
