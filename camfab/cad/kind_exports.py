@@ -39,22 +39,22 @@ def refuse_feature(cam: Any, output: str) -> None:
 
 
 def _cylinder_step(cam: Any, req: Any) -> list[Artifact]:
-    """``<stem>.step``: the grooved cylinder (:mod:`camfab.cad.cylinder`)."""
+    """``<stem>.step``: the grooved cylinder (:mod:`camfab.cad.cylinder`) or the ribbed one (:mod:`.rib`)."""
     from .cylinder import cylinder_step  # cadquery only when a file is made
+    from .rib import rib_step
 
-    refuse_feature(cam, "step")
-    text, dev = cylinder_step(cam.geometry, tol=cam.tolerance(req.tol), name=cam.name,
-                              bore_mm=cam.spec.manufacturing.bore_mm)
+    make = rib_step if cam.spec.cylinder.rib_width_mm is not None else cylinder_step
+    text, dev = make(cam.geometry, tol=cam.tolerance(req.tol), name=cam.name, bore_mm=cam.spec.manufacturing.bore_mm)
     return [Artifact(f"{safe_stem(cam.name)}.step", text.encode("utf-8"), "step", deviation_mm=dev)]
 
 
 def _cylinder_stl(cam: Any, req: Any) -> list[Artifact]:
-    """``<stem>.stl``: the grooved cylinder's solid tessellated by OpenCascade (:mod:`camfab.cad.cylinder`)."""
+    """``<stem>.stl``: the grooved (or ribbed) cylinder's solid tessellated by OpenCascade."""
     from .cylinder import cylinder_stl  # cadquery only when a file is made
+    from .rib import rib_stl
 
-    refuse_feature(cam, "stl")
-    data, dev = cylinder_stl(cam.geometry, tol=cam.tolerance(req.tol), name=cam.name,
-                             bore_mm=cam.spec.manufacturing.bore_mm)
+    make = rib_stl if cam.spec.cylinder.rib_width_mm is not None else cylinder_stl
+    data, dev = make(cam.geometry, tol=cam.tolerance(req.tol), name=cam.name, bore_mm=cam.spec.manufacturing.bore_mm)
     return [Artifact(f"{safe_stem(cam.name)}.stl", data, "stl", deviation_mm=dev)]
 
 

@@ -494,8 +494,8 @@ def cylinder_report(report: Any, geometry: CylindricalGeometry) -> Any:
 
 
 def feature_refusal(cylinder: CylinderSpec | None, output: str) -> str | None:
-    """Why ``output`` is not made for this cylinder's feature (a rib's STEP, STL and 4-axis program), or None."""
-    if cylinder is None or cylinder.feature is not Feature.RIB or output not in ("step", "stl", "gcode"):
+    """Why ``output`` is not made for this cylinder's feature (a rib's 4-axis program), or None."""
+    if cylinder is None or cylinder.feature is not Feature.RIB or output != "gcode":
         return None
-    return ('not yet made for [cylinder] feature = "rib" (a rib gets dxf, xlsx, report and the checks; the solid, '
-            'its mesh and its 4-axis program are made for feature = "groove" only)')
+    return ('not yet made for [cylinder] feature = "rib" (a rib gets dxf, step, stl, xlsx, report and the checks; '
+            'the 4-axis program mills feature = "groove" only)')

@@ -147,10 +147,10 @@ tool_diameter_mm = 6.0
 """
 
 
-def test_rib_files_dxf_and_refused_solid(tmp_path, capsys):
+def test_rib_files_dxf_and_refused_program(tmp_path, capsys):
     """``run`` writes the developed rib (DXF: both rib flanks exactly ``rib_width_mm`` apart where it runs round,
-    read back with ezdxf) and the workbook, and skips the STEP with the reason naming ``[cylinder] feature``;
-    ``camfab gcode`` exits 2 with that reason."""
+    read back with ezdxf) and the workbook, and skips the 4-axis program with the reason naming
+    ``[cylinder] feature``; ``camfab gcode`` exits 2 with that reason."""
     ezdxf = pytest.importorskip("ezdxf")
     from camfab.cli import main
     from camfab.pipeline import Output, Request, load, run
@@ -158,8 +158,8 @@ def test_rib_files_dxf_and_refused_solid(tmp_path, capsys):
     src = tmp_path / "rib.toml"
     src.write_text(RIB_TOML, encoding="utf-8")
     cam = load(src)
-    res = run(cam, tmp_path / "out", Request(frozenset({Output.DXF, Output.STEP, Output.XLSX})))
-    assert "[cylinder] feature" in res.not_applicable["step"]
+    res = run(cam, tmp_path / "out", Request(frozenset({Output.DXF, Output.GCODE, Output.XLSX})))
+    assert "[cylinder] feature" in res.not_applicable["gcode"]
     assert sorted(p.name for p in (tmp_path / "out").iterdir() if p.suffix != ".lock") == [
         "Ribbed.dxf", "Ribbed.xlsx", "check.json"]
     doc = ezdxf.readfile(tmp_path / "out" / "Ribbed.dxf")
