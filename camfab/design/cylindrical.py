@@ -11,10 +11,10 @@ polar angle ``90° + σθ``.  A cylinder of radius r is **developed** (unrolled)
 so the developed plane is the same for both senses (σ only decides the hand of the 3D groove).  On it a
 translating follower's roller axis meets radius r at ``C_r(θ) = (r·θ, z₀ + S(θ))``: the developed pitch
 curve is exactly the motion law, on every radius, and its slope ``S′/r`` (per radian) differs across the
-groove depth.  The groove flanks at radius r are modelled as the parallel curves of ``C_r`` at ± the half
-groove width ``w = R_r(r) + backlash/2``: the roller's section by the cylinder r taken as a circle of radius
-R_r.  That section is in truth ``(r·sin(u/r))² + v² = R_r²`` (u, v developed, about the roller axis), a
-circle stretched along x by at most ``R_r³/(6r²)``; the checks use the circle (documented limitation).
+groove depth.  The groove flanks at radius r are the envelopes of the roller's exact section by the cylinder r
+(enlarged by half the backlash: ``w = R_r(r) + backlash/2``), a circle stretched along x by up to about
+``w³/(6r²)`` (:mod:`.roller_section`); a rib's (``feature = "rib"``) are those of two rollers ± (rib width/2 + w)
+either side of the pitch curve, the rib's mid-line.
 
 Oscillating follower (pivot perpendicular to the cam axis)
 ----------------------------------------------------------
@@ -184,9 +184,10 @@ class DevelopedContact(Contact):
     """One flank of the groove on the developed cylinder of radius r.
 
     ``sense`` is the flank: +1 the flank on the +z side of the roller, −1 the one on the −z side.  Its
-    ``roller_radius`` is the half groove width there (``R_r(r) + backlash/2``).  The pressure angle is the
-    angle from the follower's direction of increasing lift to the developed pitch normal, positive while the
-    roller rises (``tan δ = S′/r`` for a translating follower), the same on both flanks.
+    ``roller_radius`` is the half groove width there (``R_r(r) + backlash/2``); ``shift`` the roller's axial
+    offset from the pitch point (a rib's rollers).  The pressure angle is the angle, in the roller's plane, from
+    the follower's direction of increasing lift to the roller's normal at the contact, positive while the roller
+    rises (``tan δ = S′/(r·cos β*)`` for a translating follower, :mod:`.roller_section`).
     """
 
     closed = False
