@@ -15,7 +15,8 @@ from ..errors import ExportError
 from ..io import safe_stem
 from .artifact import Artifact
 
-__all__ = ["KIND_EXPORTERS", "KIND_CAD_OUTPUTS", "not_applicable_reason", "kind_exporter", "applicable", "applies"]
+__all__ = ["KIND_EXPORTERS", "KIND_CAD_OUTPUTS", "not_applicable_reason", "kind_exporter", "applicable", "applies",
+           "refuse_feature"]
 
 log = logging.getLogger("camfab.pipeline")
 
@@ -28,21 +29,32 @@ def _cylinder_dxf(cam: Any, req: Any) -> list[Artifact]:
     return [Artifact(f"{safe_stem(cam.name)}.dxf", text.encode("utf-8"), "dxf", deviation_mm=dev)]
 
 
-def _cylinder_step(cam: Any, req: Any) -> list[Artifact]:
-    """``<stem>.step``: the grooved cylinder (:mod:`camfab.cad.cylinder`)."""
-    from .cylinder import cylinder_step  # cadquery only when a file is made
+def refuse_feature(cam: Any, output: str) -> None:
+    """ExportError (exit 2) when the cylinder's ``feature`` has no ``output`` yet (a rib's solid)."""
+    from ..design.cylindrical import feature_refusal
 
-    text, dev = cylinder_step(cam.geometry, tol=cam.tolerance(req.tol), name=cam.name,
-                              bore_mm=cam.spec.manufacturing.bore_mm)
+    why = feature_refusal(cam.spec.cylinder, output)
+    if why:
+        raise ExportError(f"{output}: {why}")
+
+
+def _cylinder_step(cam: Any, req: Any) -> list[Artifact]:
+    """``<stem>.step``: the grooved cylinder (:mod:`camfab.cad.cylinder`) or the ribbed one (:mod:`.rib`)."""
+    from .cylinder import cylinder_step  # cadquery only when a file is made
+    from .rib import rib_step
+
+    make = rib_step if cam.spec.cylinder.rib_width_mm is not None else cylinder_step
+    text, dev = make(cam.geometry, tol=cam.tolerance(req.tol), name=cam.name, bore_mm=cam.spec.manufacturing.bore_mm)
     return [Artifact(f"{safe_stem(cam.name)}.step", text.encode("utf-8"), "step", deviation_mm=dev)]
 
 
 def _cylinder_stl(cam: Any, req: Any) -> list[Artifact]:
-    """``<stem>.stl``: the grooved cylinder's solid tessellated by OpenCascade (:mod:`camfab.cad.cylinder`)."""
+    """``<stem>.stl``: the grooved (or ribbed) cylinder's solid tessellated by OpenCascade."""
     from .cylinder import cylinder_stl  # cadquery only when a file is made
+    from .rib import rib_stl
 
-    data, dev = cylinder_stl(cam.geometry, tol=cam.tolerance(req.tol), name=cam.name,
-                             bore_mm=cam.spec.manufacturing.bore_mm)
+    make = rib_stl if cam.spec.cylinder.rib_width_mm is not None else cylinder_stl
+    data, dev = make(cam.geometry, tol=cam.tolerance(req.tol), name=cam.name, bore_mm=cam.spec.manufacturing.bore_mm)
     return [Artifact(f"{safe_stem(cam.name)}.stl", data, "stl", deviation_mm=dev)]
 
 
@@ -75,8 +87,12 @@ def kind_exporter(kind: str, out: str, default: Callable[[Any, Any], list[Artifa
 def applicable(cam: Any, outputs: Sequence[Any]) -> tuple[list[Any], dict[str, str]]:
     """``outputs`` split into those that apply to the cam's kind and, for the others, why not (each logged as
     a warning)."""
+    from ..design.cylindrical import feature_refusal
+
     keep = [o for o in outputs if applies(cam.spec.cam.kind, str(o))]
     why = {str(o): not_applicable_reason(cam.spec.cam.kind, str(o)) for o in outputs if o not in keep}
+    why |= {str(o): r for o in keep if (r := feature_refusal(getattr(cam.spec, "cylinder", None), str(o)))}
+    keep = [o for o in keep if str(o) not in why]
     for out, reason in why.items():
         log.warning("%s: %s skipped: %s", cam.name, out, reason)
     return keep, why

@@ -11,10 +11,10 @@ polar angle ``90° + σθ``.  A cylinder of radius r is **developed** (unrolled)
 so the developed plane is the same for both senses (σ only decides the hand of the 3D groove).  On it a
 translating follower's roller axis meets radius r at ``C_r(θ) = (r·θ, z₀ + S(θ))``: the developed pitch
 curve is exactly the motion law, on every radius, and its slope ``S′/r`` (per radian) differs across the
-groove depth.  The groove flanks at radius r are modelled as the parallel curves of ``C_r`` at ± the half
-groove width ``w = R_r(r) + backlash/2``: the roller's section by the cylinder r taken as a circle of radius
-R_r.  That section is in truth ``(r·sin(u/r))² + v² = R_r²`` (u, v developed, about the roller axis), a
-circle stretched along x by at most ``R_r³/(6r²)``; the checks use the circle (documented limitation).
+groove depth.  The groove flanks at radius r are the envelopes of the roller's exact section by the cylinder r
+(enlarged by half the backlash: ``w = R_r(r) + backlash/2``), a circle stretched along x by up to about
+``w³/(6r²)`` (:mod:`.roller_section`); a rib's (``feature = "rib"``) are those of two rollers ± (rib width/2 + w)
+either side of the pitch curve, the rib's mid-line.
 
 Oscillating follower (pivot perpendicular to the cam axis)
 ----------------------------------------------------------
@@ -50,17 +50,28 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..errors import Problem
-from ..geom2d import J, cross, dot
+from ..geom2d import cross, dot
 from .kinds import CamKind, FollowerMotion, FollowerType
 from .mechanism import Mechanism, finite_fields, lift_range, require_positive, require_rotation
 from .profile import DEG, CamGeometry, Contact, MotionLike, ProfileSample, inverse, xy
+from .roller_section import RollerSection, envelope
 
 __all__ = ["RollerShape", "CylinderSpec", "cylinder_section", "DevelopedContact", "CylindricalGeometry",
            "CylindricalTranslating", "CylindricalOscillating", "CYLINDER_KEYS", "slip_ratio", "pitch_3d",
-           "FAMILIES", "cylinder_report", "radius_summary"]
+           "FAMILIES", "cylinder_report", "radius_summary", "Feature", "feature_refusal"]
 
 #: ``[cylinder]`` keys
-CYLINDER_KEYS = ("radius_mm", "length_mm", "groove_depth_mm", "backlash_mm", "roller", "zero_position_mm")
+CYLINDER_KEYS = ("radius_mm", "length_mm", "groove_depth_mm", "backlash_mm", "roller", "zero_position_mm", "feature",
+                 "rib_width_mm", "rib_height_mm")
+
+
+class Feature(StrEnum):
+    """``[cylinder] feature``: what the follower runs on (``docs/decisions.md``, "Cylindrical cams: the rib")."""
+
+    #: a groove cut into the cylinder, one roller in it
+    GROOVE = "groove"
+    #: a rib standing on the cylinder, straddled by two rollers on one follower
+    RIB = "rib"
 
 
 class RollerShape(StrEnum):
@@ -82,13 +93,18 @@ class CylinderSpec:
     length_mm : float
         Length of the cylinder along its axis; z = 0 at one end.
     groove_depth_mm : float
-        Depth of the groove; it spans the radii R ± depth/2 (outer surface R + depth/2).
+        Depth of the groove; it spans the radii R ± depth/2 (outer surface R + depth/2).  A rib's height
+        (``rib_height_mm``): it spans the same radii, from its root on the cylinder to its top.
     backlash_mm : float
-        Groove width minus the roller diameter (at the pitch radius).
+        Groove width minus the roller diameter; for a rib, the clearance between each roller and the rib, twice.
     roller : RollerShape
         Cylindrical or conical roller.
     zero_position_mm : float or None
         Axial position z₀ of the roller at S = 0; default: the travel centred on the length.
+    feature : Feature
+        A groove (default) or a rib.
+    rib_width_mm : float or None
+        A rib's width where it runs round without lead (dwells); None for a groove.
     """
 
     radius_mm: float
@@ -97,6 +113,8 @@ class CylinderSpec:
     backlash_mm: float = 0.0
     roller: RollerShape = RollerShape.CYLINDRICAL
     zero_position_mm: float | None = None
+    feature: Feature = Feature.GROOVE
+    rib_width_mm: float | None = None
 
     @property
     def inner_radius_mm(self) -> float:
@@ -116,87 +134,96 @@ def cylinder_section(v: Any, t: Mapping[str, Any], kind: CamKind) -> CylinderSpe
             v.add("cylinder", dict(t), f"a {kind} cam has no cylinder", 'remove [cylinder] or set kind = "cylindrical"')
         return None
     v.keys(t, CYLINDER_KEYS, "cylinder")
+    feature = v.choice(t, "feature", "cylinder", Feature, Feature.GROOVE)
+    rib = feature is Feature.RIB
+    need = ("radius_mm", "length_mm", *(("rib_height_mm", "rib_width_mm") if rib else ("groove_depth_mm",)))
+    for k in {"groove_depth_mm", "rib_height_mm", "rib_width_mm"} - set(need):
+        if k in t:
+            v.add(f"cylinder.{k}", t[k], f'is not a key of a {feature.value} (feature = "{feature.value}")',
+                  f"remove {k}, or set feature = \"{'groove' if rib else 'rib'}\"")
     vals = {k: v.number(t, k, "cylinder", None, lo=0.0, lo_open=True, hi=1e5, fix=f"give {k} as a length > 0 in mm")
-            for k in ("radius_mm", "length_mm", "groove_depth_mm")}
+            for k in need}
     for k, val in vals.items():
         if val is None and k not in t:
-            v.add(f"cylinder.{k}", None, "is required for a cylindrical cam", f"add {k} = <mm> to [cylinder]")
+            v.add(f"cylinder.{k}", None, f"is required for a {feature.value}", f"add {k} = <mm> to [cylinder]")
     backlash = v.number(t, "backlash_mm", "cylinder", 0.0, lo=0.0, hi=1e3)
     zero = v.number(t, "zero_position_mm", "cylinder", None, lo=-1e5, hi=1e5)
     roller = v.choice(t, "roller", "cylinder", RollerShape, RollerShape.CYLINDRICAL)
     if any(val is None for val in vals.values()):
         return None
-    return CylinderSpec(vals["radius_mm"], vals["length_mm"], vals["groove_depth_mm"], backlash, roller, zero)
+    depth = vals["rib_height_mm"] if rib else vals["groove_depth_mm"]
+    return CylinderSpec(vals["radius_mm"], vals["length_mm"], depth, backlash, roller, zero, feature,
+                        vals.get("rib_width_mm"))
 
 
 # ---------------------------------------------------------------------------
-def _path(mech: Any, r: float, phi, S) -> tuple[np.ndarray, ...]:
-    """Developed pitch curve on radius r: C, C′, C″ (per radian of cam angle) and the follower's unit
-    direction of increasing lift v, each (n, 2)."""
+def _arm(mech: Any, S) -> tuple[np.ndarray, ...]:
+    """The roller axis's shift e aside the radial line along the developed x, e′, e″ (per radian), its axial
+    position z, z′, z″, and the follower's unit direction of increasing lift in the roller's plane (n, 2)."""
     s0, s1, s2 = S
-    x = np.asarray(phi, dtype=float)
     if mech.motion is FollowerMotion.TRANSLATING:
         z = np.zeros_like(s0)
-        return xy(r * x, mech.z0 + s0), xy(r + z, s1), xy(z, s2), xy(z, 1.0 + z)
+        return z, z, z, mech.z0 + s0, s1, s2, xy(z, 1.0 + z)
     L = mech.arm_length_mm
     f, f1, f2 = s0 * DEG, s1 * DEG, s2 * DEG
     c, s = np.cos(f), np.sin(f)
-    e = L * (1.0 - c)
-    e1 = L * s * f1
-    e2 = L * (c * f1**2 + s * f2)
+    return (L * (1.0 - c), L * s * f1, L * (c * f1**2 + s * f2), mech.z0 + L * s, L * c * f1,
+            L * (c * f2 - s * f1**2), xy(s, c))
+
+
+def _path(mech: Any, r: float, phi, S) -> tuple[np.ndarray, ...]:
+    """Developed pitch curve on radius r: C, C′, C″ (per radian of cam angle), each (n, 2)."""
+    x = np.asarray(phi, dtype=float)
+    e, e1, e2, z, z1, z2, _ = _arm(mech, S)
     k = 1.0 / np.sqrt(1.0 - (e / r) ** 2)
     g2 = e / r**2 * k**3
-    C = xy(r * x + r * np.arcsin(e / r), mech.z0 + L * s)
-    T = xy(r + k * e1, L * c * f1)
-    A = xy(k * e2 + g2 * e1**2, L * (c * f2 - s * f1**2))
-    v = xy(k * s, c)
-    return C, T, A, v / np.hypot(v[:, 0], v[:, 1])[:, None]
+    return xy(r * x + r * np.arcsin(e / r), z), xy(r + k * e1, z1), xy(k * e2 + g2 * e1**2, z2)
 
 
 class DevelopedContact(Contact):
     """One flank of the groove on the developed cylinder of radius r.
 
     ``sense`` is the flank: +1 the flank on the +z side of the roller, −1 the one on the −z side.  Its
-    ``roller_radius`` is the half groove width there (``R_r(r) + backlash/2``).  The pressure angle is the
-    angle from the follower's direction of increasing lift to the developed pitch normal, positive while the
-    roller rises (``tan δ = S′/r`` for a translating follower), the same on both flanks.
+    ``roller_radius`` is the half groove width there (``R_r(r) + backlash/2``); ``shift`` the roller's axial
+    offset from the pitch point (a rib's rollers).  The pressure angle is the angle, in the roller's plane, from
+    the follower's direction of increasing lift to the roller's normal at the contact, positive while the roller
+    rises (``tan δ = S′/(r·cos β*)`` for a translating follower, :mod:`.roller_section`).
     """
 
     closed = False
 
     def __init__(self, mechanism: Any, motion: MotionLike, radius: float, half_width: float, flank: int,
-                 label: str):
+                 label: str, shift: float = 0.0):
         super().__init__(motion, flank)
         self.mechanism, self.r, self.roller_radius, self.label = mechanism, float(radius), float(half_width), label
+        #: the roller's axial offset from the follower's pitch point (a rib's rollers: ±(w/2 + R_r + b/2))
+        self.shift = float(shift)
         self.oscillating = mechanism.motion is FollowerMotion.OSCILLATING
 
     def _evaluate(self, phi, rotate: bool, S=None) -> ProfileSample:
         x, s = self._S(phi, S)
-        C, T, A, v = _path(self.mechanism, self.r, x, s)
-        sg, rr = self.sense, self.roller_radius
-        speed = np.hypot(T[:, 0], T[:, 1])
-        t = T / speed[:, None]
-        up = J(t)
-        kp = sg * cross(T, A) / speed**3
-        n = -sg * up
-        point = C - rr * n
-        scale = 1.0 - rr * kp
-        with np.errstate(divide="ignore", invalid="ignore"):
-            k = kp / scale
+        mech, r, sg = self.mechanism, self.r, self.sense
+        C, T, A = _path(mech, r, x, s)
+        e, e1, e2, z, z1, z2, v = _arm(mech, s)
+        f = envelope(mech.section(r), sg, xy(r * x, z + self.shift), xy(r + 0 * z1, z1), xy(0 * z2, z2), e, e1, e2)
+        kp = sg * cross(T, A) / np.hypot(T[:, 0], T[:, 1]) ** 3
+        up = sg * f.roller_normal
         delta = np.arctan2(-cross(up, v), dot(up, v))
-        return ProfileSample(x, point, T * scale[:, None], n, sg * J(n), k, inverse(k), C, kp, inverse(kp), delta,
-                             None, None)
+        return ProfileSample(x, f.point, f.point_d1, f.normal, f.tangent, f.curvature, inverse(f.curvature), C, kp,
+                             inverse(kp), delta, None, None)
 
     def pitch(self, phi) -> tuple[np.ndarray, np.ndarray]:
-        """The developed pitch curve on this radius and its derivative per radian, (n, 2) each."""
+        """The follower's developed pitch curve on this radius (the groove's centre line, the rib's mid-line) and
+        its derivative per radian, (n, 2) each."""
         x, s = self._S(phi)
-        C, T, _, _ = _path(self.mechanism, self.r, x, s)
+        C, T, _ = _path(self.mechanism, self.r, x, s)
         return C, T
 
 
 class CylindricalGeometry(CamGeometry):
     """A cylindrical cam's geometry: both flanks on the groove bottom, the pitch cylinder and the outer
-    cylinder, in that order (six :class:`DevelopedContact`), each checked like a profile."""
+    cylinder (a rib's root, pitch and top), in that order (six :class:`DevelopedContact`, the +z flank first),
+    each checked like a profile."""
 
     @property
     def cylinder(self) -> CylinderSpec:
@@ -275,6 +302,10 @@ class _Cylindrical(Mechanism):
                              f"the groove reaches the axis (it must be < 2·radius_mm = {2 * c.radius_mm:g} mm, "
                              "radius_mm being the pitch radius, the middle of the depth)",
                              "use a shallower groove or a larger radius_mm"))
+        if c.feature is Feature.RIB and isinstance(self, CylindricalOscillating):
+            p.append(Problem("cylinder.feature", c.feature.value, "a rib is followed by two rollers on a translating "
+                             "follower only (an oscillating forked follower is not modelled)",
+                             'use feature = "groove" or motion = "translating"'))
         if self.roller_radius_mm > 0 and c.radius_mm <= self.roller_radius_mm:
             p.append(Problem("follower.roller_radius_mm", self.roller_radius_mm,
                              f"the roller is wider than the pitch radius ({c.radius_mm:g} mm)",
@@ -295,18 +326,18 @@ class _Cylindrical(Mechanism):
             return p
         c = self.cylinder
         lo, hi = self.axial_travel(program)
-        w = self.half_width(c.outer_radius_mm)
+        w = self.half_width(c.outer_radius_mm) if c.rib_width_mm is None else 0.5 * c.rib_width_mm
         need = hi - lo + 2 * w
         if need >= c.length_mm:
             return [Problem("cylinder.length_mm", c.length_mm,
-                            f"the groove ({hi - lo:.6g} mm of travel plus the {2 * w:.6g} mm groove width) does "
+                            f"the {c.feature.value} ({hi - lo:.6g} mm of travel plus the {2 * w:.6g} mm width) does "
                             "not fit in the length",
                             f"give length_mm > {need:.6g} (with walls at both ends) or a smaller lift")]
         z0 = self.z0_for(program)
         if z0 + lo - w <= 0 or z0 + hi + w >= c.length_mm:
             return [Problem("cylinder.zero_position_mm", c.zero_position_mm,
-                            f"puts the groove (z from {z0 + lo - w:.6g} to {z0 + hi + w:.6g} mm) outside the cylinder "
-                            f"(0 to {c.length_mm:g} mm)",
+                            f"puts the {c.feature.value} (z from {z0 + lo - w:.6g} to {z0 + hi + w:.6g} mm) outside "
+                            f"the cylinder (0 to {c.length_mm:g} mm)",
                             "remove zero_position_mm (the travel is then centred) or move it")]
         return []
 
@@ -323,6 +354,13 @@ class _Cylindrical(Mechanism):
         rr = self.roller_radius_mm * (r / c.radius_mm if c.roller is RollerShape.CONICAL else 1.0)
         return rr + 0.5 * c.backlash_mm
 
+    def section(self, r: float) -> RollerSection:
+        """The roller enlarged by half the backlash, cut by the cylinder r (:mod:`.roller_section`)."""
+        c = self.cylinder
+        if c.roller is RollerShape.CONICAL:
+            return RollerSection(r, self.roller_radius_mm / c.radius_mm, 0.5 * c.backlash_mm)
+        return RollerSection(r, 0.0, self.roller_radius_mm + 0.5 * c.backlash_mm)
+
     @property
     def cone_half_angle_deg(self) -> float | None:
         """A conical roller's half-angle (apex on the cam axis), degrees; None for a cylindrical one."""
@@ -330,13 +368,30 @@ class _Cylindrical(Mechanism):
             return None
         return math.degrees(math.atan2(self.roller_radius_mm, self.cylinder.radius_mm))
 
+    @property
+    def rib_offset_mm(self) -> float | None:
+        """A rib's rollers: their axes' axial offset from the rib's mid-line, ``w/2 + R_r + b/2``; None for a
+        groove."""
+        c = self.cylinder
+        if c.rib_width_mm is None:
+            return None
+        return 0.5 * c.rib_width_mm + self.roller_radius_mm + 0.5 * c.backlash_mm
+
     def flank(self, program: MotionLike, r: float, flank: int) -> DevelopedContact:
+        """The flank ``flank`` (+1 the +z side) on the cylinder r: a groove's, enveloped by its roller's side
+        facing it; a rib's, by the side facing it of the roller beyond it (offset ±:attr:`rib_offset_mm`)."""
         import dataclasses
 
         me = dataclasses.replace(self, _z0=self.z0_for(program))
-        where = {self.cylinder.inner_radius_mm: "groove bottom", self.cylinder.radius_mm: "pitch cylinder",
-                 self.cylinder.outer_radius_mm: "outer cylinder"}.get(r, "cylinder")
+        c = self.cylinder
+        rib = c.feature is Feature.RIB
+        names = ("rib root", "pitch cylinder", "rib top") if rib else ("groove bottom", "pitch cylinder",
+                                                                       "outer cylinder")
+        where = dict(zip((c.inner_radius_mm, c.radius_mm, c.outer_radius_mm), names, strict=True)).get(r, "cylinder")
         side = "+z" if flank > 0 else "-z"
+        if rib:
+            return DevelopedContact(me, program, r, self.half_width(r), -flank,
+                                    f"{where} r = {r:.6g} mm, {side} rib flank", flank * (self.rib_offset_mm or 0.0))
         return DevelopedContact(me, program, r, self.half_width(r), flank, f"{where} r = {r:.6g} mm, {side} flank")
 
     def contacts(self, program: MotionLike) -> tuple[Contact, ...]:
@@ -425,11 +480,23 @@ def cylinder_report(report: Any, geometry: CylindricalGeometry) -> Any:
 
     mech = geometry.mechanism
     cyl = geometry.cylinder
-    summary = {"pitch_radius_mm": cyl.radius_mm, "inner_radius_mm": cyl.inner_radius_mm,
+    rib = cyl.feature is Feature.RIB
+    summary = {"feature": cyl.feature.value, "rib_width_mm": cyl.rib_width_mm,
+               "rib_height_mm": cyl.groove_depth_mm if rib else None,
+               "roller_offset_mm": mech.rib_offset_mm, "pitch_radius_mm": cyl.radius_mm,
+               "inner_radius_mm": cyl.inner_radius_mm,
                "outer_radius_mm": cyl.outer_radius_mm, "length_mm": cyl.length_mm,
-               "groove_depth_mm": cyl.groove_depth_mm, "backlash_mm": cyl.backlash_mm,
+               "groove_depth_mm": None if rib else cyl.groove_depth_mm, "backlash_mm": cyl.backlash_mm,
                "zero_position_mm": mech.z0_for(geometry.program), "roller": cyl.roller.value,
                "cone_half_angle_deg": mech.cone_half_angle_deg, "slip_ratio_max": slip_ratio(geometry),
                "radii": radius_summary(geometry)}
     return dataclasses.replace(report, cylinder=summary, area_mm2=None, base_radius_mm=cyl.inner_radius_mm,
                                max_radius_mm=cyl.outer_radius_mm)
+
+
+def feature_refusal(cylinder: CylinderSpec | None, output: str) -> str | None:
+    """Why ``output`` is not made for this cylinder's feature (a rib's 4-axis program), or None."""
+    if cylinder is None or cylinder.feature is not Feature.RIB or output != "gcode":
+        return None
+    return ('not yet made for [cylinder] feature = "rib" (a rib gets dxf, step, stl, xlsx, report and the checks; '
+            'the 4-axis program mills feature = "groove" only)')

@@ -39,9 +39,11 @@ CYLINDER_FIRST_ROW = 14
 def cylinder_rows(spec: Any, geometry: Any) -> list[tuple[str, float, str]]:
     """Rows A4:C11: the cylinder's dimensions and the speed (label, value, unit)."""
     cyl, mech = geometry.cylinder, geometry.mechanism
-    return [("Pitch radius R", cyl.radius_mm, "mm"), ("Groove bottom radius", cyl.inner_radius_mm, "mm"),
-            ("Outer radius", cyl.outer_radius_mm, "mm"), ("Length", cyl.length_mm, "mm"),
-            ("Groove depth", cyl.groove_depth_mm, "mm"), ("Backlash", cyl.backlash_mm, "mm"),
+    rib = cyl.rib_width_mm is not None  # a rib: its root, top and height in the same rows
+    return [("Pitch radius R", cyl.radius_mm, "mm"),
+            ("Rib root radius" if rib else "Groove bottom radius", cyl.inner_radius_mm, "mm"),
+            ("Rib top radius" if rib else "Outer radius", cyl.outer_radius_mm, "mm"), ("Length", cyl.length_mm, "mm"),
+            ("Rib height" if rib else "Groove depth", cyl.groove_depth_mm, "mm"), ("Backlash", cyl.backlash_mm, "mm"),
             ("Roller z at S = 0", mech.z0_for(geometry.program), "mm"), ("Angular speed ω", spec.speed, "rad/s")]
 
 

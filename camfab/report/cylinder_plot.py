@@ -63,7 +63,8 @@ def unrolled_figure(spec: Any, geometry: Any, report: Any = None, *, n: int = 14
         top.set_xticks(np.arange(0.0, 361.0, 45.0))
         top.set_xlabel("cam angle (°)")
         ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
-        half = geometry.mechanism.half_width(R)
-        fig.suptitle(f"{mpl_text(spec.name)}: groove unrolled on the pitch cylinder (width {2 * half:g} mm)",
-                     fontsize=11)
+        rib = cyl.rib_width_mm
+        what = (f"rib unrolled on the pitch cylinder (width {rib:g} mm where it runs round)" if rib is not None
+                else f"groove unrolled on the pitch cylinder (width {2 * geometry.mechanism.half_width(R):g} mm)")
+        fig.suptitle(f"{mpl_text(spec.name)}: {what}", fontsize=11)
     return fig

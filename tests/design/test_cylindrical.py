@@ -24,9 +24,21 @@ def design(motion=None, follower=None, **cyl):
                              "motion": m})
 
 
+def helix_contact(p: float, w: float, r: float) -> tuple[float, float]:
+    """A groove of developed slope p on radius r, a cylindrical roller section of radius w: (cos t*, tan δ).
+    The envelope condition r·k·cos t + p·r·sin t = 0 with k = √(1 − (w·cos t/r)²) squared is the quadratic
+    (w/r)²C⁴ − (1 + p²)C² + p² = 0 in C = cos t (its small root; C < 0 on the rising +z flank), and the
+    pressure angle in the roller's plane is tan δ = |cos t|/sin t = p/k."""
+    q = (w / r) ** 2
+    c2 = ((1 + p * p) - math.sqrt((1 + p * p) ** 2 - 4 * p * p * q)) / (2 * q)
+    return -math.sqrt(c2), p / math.sqrt(1 - q * c2)
+
+
 def test_constant_lead_groove_is_a_helix():
     """A rise at constant velocity: on every radius r the developed pitch curve is a straight line of slope
-    h/(β·r), its curvature 0 and its pressure angle constant, atan(h/(β·r)) — a helix of lead 2π·h/β."""
+    h/(β·r), its curvature 0 and its pressure angle constant (closed form :func:`helix_contact`, → atan(h/(β·r))
+    for a small roller) — a helix of lead 2π·h/β; each flank is a parallel straight line at the exact
+    section's support distance."""
     geom = geometry_from_spec(design())
     assert isinstance(geom, CylindricalGeometry)
     beta, h = math.pi / 2, 20.0
@@ -37,10 +49,16 @@ def test_constant_lead_groove_is_a_helix():
             d = s.pitch - s.pitch[0]
             np.testing.assert_allclose(d[:, 1], d[:, 0] * h / (beta * r), atol=1e-12)
             np.testing.assert_allclose(s.curvature_pitch, 0.0, atol=1e-15)
-            np.testing.assert_allclose(s.pressure_angle, math.atan(h / (beta * r)), rtol=1e-14)
-            # the flank is the pitch line moved by the half width along the normal: a parallel straight line
-            off = (s.point - s.pitch) @ np.array([-h / (beta * r), 1.0]) / math.hypot(1.0, h / (beta * r))
-            np.testing.assert_allclose(off, flank * (6.0 + 0.05), rtol=1e-13)
+            p, w = h / (beta * r), 6.05
+            ct, tan_d = helix_contact(p, w, r)
+            np.testing.assert_allclose(s.pressure_angle, math.atan(tan_d), rtol=1e-12)
+            # the flank: the pitch line moved along its normal by the section's support distance
+            st = math.sqrt(1 - ct * ct)
+            n = np.array([-p, 1.0]) / math.hypot(1.0, p)
+            support = np.array([r * math.asin(w * ct / r), w * st]) @ n
+            off = (s.point - s.pitch) @ n
+            np.testing.assert_allclose(off, flank * support, rtol=1e-12)
+            assert 0 < support - w < w**3 / r**2
     # 3D: every pitch point lies on the helix z = z0 + h·θ/β at radius R, polar angle 90° + σθ
     p = pitch_3d(geom, phi)
     np.testing.assert_allclose(np.hypot(p[:, 0], p[:, 1]), 40.0, rtol=1e-14)
@@ -49,12 +67,12 @@ def test_constant_lead_groove_is_a_helix():
 
 
 def test_pressure_angle_worst_over_the_depth():
-    """tan δ = S′/r: the groove bottom has the largest pressure angle; the report's object is that worst, and
-    the per-radius summary gives each radius its own."""
+    """tan δ = S′/(r·k) (:func:`helix_contact`): the groove bottom has the largest pressure angle; the report's
+    object is that worst, and the per-radius summary gives each radius its own."""
     spec = design()
     rep = check_design(spec)
     radii = rep.cylinder["radii"]
-    want = [math.degrees(math.atan(20.0 / (math.pi / 2) / r)) for r in (35.0, 40.0, 45.0)]
+    want = [math.degrees(math.atan(helix_contact(20.0 / (math.pi / 2) / r, 6.05, r)[1])) for r in (35.0, 40.0, 45.0)]
     np.testing.assert_allclose([x["pressure_angle_max_deg"] for x in radii], want, rtol=1e-9)
     assert rep.pressure_angle.max == pytest.approx(want[0], rel=1e-9)
     assert rep.to_dict()["cylinder"]["radii"][0]["where"] == "groove bottom"

@@ -1,6 +1,6 @@
 """A cylindrical cam's workbook and report: the ``Cylinder`` sheet read back with openpyxl against the closed-form
-development (cycloidal rise: x = r·θ, z = z₀ + S, the flanks at ± the half width along the developed normal,
-tan δ = S′/r), and the report's unrolled-profile plot against the exact developed curves."""
+development (cycloidal rise: x = r·θ, z = z₀ + S, the flanks at the exact roller section's contact point,
+tan δ = S′/(r·k)), and the report's unrolled-profile plot against the exact developed curves."""
 from __future__ import annotations
 
 import io
@@ -32,10 +32,15 @@ def exact(theta: np.ndarray, r: float) -> dict[str, np.ndarray]:
     s1[down] = -H / BETA * (1 - np.cos(2 * np.pi * t))
     s0[(theta > BETA) & ~down] = np.where(theta[(theta > BETA) & ~down] < math.pi, H, 0.0)
     pitch = np.stack([r * theta, Z0 + s0], axis=1)
-    n = np.stack([-s1, np.full_like(s1, r)], axis=1) / np.hypot(r, s1)[:, None]  # developed normal towards +z
-    w = RR + BACKLASH / 2
-    return {"S": s0, "pitch": pitch, "plus": pitch + w * n, "minus": pitch - w * n,
-            "delta": np.degrees(np.arctan2(s1, r))}
+    # the roller's section by the cylinder r: (r·asin(w·cos t/r), w·sin t) about the pitch point; it touches the
+    # +z flank where r·k·cos t + S′·sin t = 0, k = √(1 − (w·cos t/r)²): (w/r)²C⁴ − (1 + p²)C² + p² = 0, C = cos t
+    w, p = RR + BACKLASH / 2, s1 / r
+    q = (w / r) ** 2
+    c2 = ((1 + p * p) - np.sqrt((1 + p * p) ** 2 - 4 * p * p * q)) / (2 * q)
+    ct, st = -np.sign(p) * np.sqrt(c2), np.sqrt(1 - c2)
+    k = np.sqrt(1 - q * c2)
+    off = np.stack([r * np.arcsin(w * ct / r), w * st], axis=1)
+    return {"S": s0, "pitch": pitch, "plus": pitch + off, "minus": pitch - off, "delta": np.degrees(np.arctan(p / k))}
 
 
 @pytest.fixture(scope="module")
@@ -65,9 +70,12 @@ def test_workbook_cylinder_sheet_is_the_exact_development(cam, tmp_path):
         np.testing.assert_allclose(rows[:, c + 2:c + 4], ex["plus"], atol=1e-9)
         np.testing.assert_allclose(rows[:, c + 4:c + 6], ex["minus"], atol=1e-9)
         np.testing.assert_allclose(rows[:, c + 6], ex["delta"], atol=1e-9)
-        # the groove is the roller diameter plus the backlash wide everywhere
+        # across the developed plane the flanks are the roller diameter plus the backlash apart where the groove
+        # runs straight round (dwells), more on its slopes (the section is stretched along x)
         width = np.hypot(*(rows[:, c + 2:c + 4] - rows[:, c + 4:c + 6]).T)
-        np.testing.assert_allclose(width, 2 * RR + BACKLASH, atol=1e-9)
+        dwell = ex["delta"] == 0
+        np.testing.assert_allclose(width[dwell], 2 * RR + BACKLASH, atol=1e-9)
+        assert np.all(width >= 2 * RR + BACKLASH - 1e-9) and width.max() > 2 * RR + BACKLASH + 1e-4
 
 
 def test_unrolled_plot_is_the_exact_development(cam):
