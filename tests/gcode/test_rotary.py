@@ -7,6 +7,7 @@ import math
 import re
 import shutil
 import subprocess
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +21,8 @@ from camfab.gcode.model import design_job
 from camfab.gcode.rotary import cylinder_job, rotary_gcode
 
 EXAMPLE = Path(pipeline.__file__).parent / "examples" / "cylindrical_translating.toml"
+#: the example's end mill radius (its [manufacturing] tool_diameter_mm / 2)
+TOOL_R = tomllib.loads(EXAMPLE.read_text())["manufacturing"]["tool_diameter_mm"] / 2
 RS274 = shutil.which("rs274")
 _WORD = re.compile(r"([A-Z])([+-]?\d+\.?\d*)")
 
@@ -82,7 +85,8 @@ def test_backplot_lies_on_the_exact_pitch_curve(post):
     zs = [z for z, _ in passes]
     assert zs[-1] == pytest.approx(35.0, abs=1e-9)  # the last level on the groove bottom radius
     assert np.all(np.diff([45.0, *zs]) < 0) and np.all(-np.diff([45.0, *zs]) <= 3.0 + 1e-9)
-    feed = 546.2  # the cutting data of the example (header)
+    # the example's cutting data, as the header states it (linuxcnc "(feed: F mm/min", fanuc "(FEED F MM/MIN")
+    feed = float(re.search(r"\(feed:? ([0-9.]+) mm/min", data.decode(), re.IGNORECASE).group(1))
     for r, P in passes:
         X, A, F = P.T
         theta = -np.radians(A)  # cw: A = −θ
@@ -127,7 +131,7 @@ def test_rs274_runs_the_4_axis_program(post, tmp_path):
     assert np.allclose(finish[:, 2], 35.0)
     C, _ = _pitch_dense(35.0)
     d, _ = cKDTree(C).query(np.stack([35.0 * -np.radians(finish[:, 3]), finish[:, 0]], axis=1))
-    off = np.abs(d - (6.025 - 5.9)) <= tol
+    off = np.abs(d - (6.025 - TOOL_R)) <= tol
     assert np.sum(~off) == 2 and np.all(d[~off] <= tol)
 
 
@@ -153,7 +157,7 @@ def test_finishing_passes_lie_on_the_flank_offsets_and_cut_the_groove_width():
     data, tol = _program()
     fin = [(label, z, P) for label, z, P in _passes(data.decode()) if label.startswith("finishing pass")]
     assert len(fin) == 2 and {("+z" in label) for label, _, _ in fin} == {True, False}
-    w, r_c, r_b = 6.025, 5.9, 35.0
+    w, r_c, r_b = 6.025, TOOL_R, 35.0
     C, up = _pitch_dense(r_b)
     cut = {}
     for label, z, P in fin:
