@@ -73,7 +73,7 @@ from .sheet import (
 from .sheet_check import Occupancy, dimension_parts
 
 __all__ = ["PAPERS", "LAYERS", "SheetLayout", "load_template", "sheet_layout", "parse_scale", "drawing_sheet",
-           "build_drawing", "title_fields", "notes_text"]
+           "build_drawing", "title_fields", "notes_text", "dimension", "verdict_note", "tolerance_notes"]
 
 
 def title_fields(spec, report, layout: SheetLayout) -> dict[str, str]:
@@ -285,6 +285,10 @@ def _dimensions(msp, spec, geometry, shapes, layout: SheetLayout, occ: Occupancy
                                      for sign in (1.0, -1.0)))]
         if _place(msp, occ, s, "linear", text, options, force=text != fit):
             break
+
+
+#: public names of the helpers the cylindrical cam's sheet (:mod:`camfab.cad.cylinder_sheet`) shares
+dimension, verdict_note, tolerance_notes = _dim, _verdict_note, _tolerance_notes
 
 
 def _rmax_point(geometry) -> tuple[float, float]:
