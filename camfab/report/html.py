@@ -388,9 +388,9 @@ def render_report(spec, geometry, report, *, standalone: bool = False, frames: i
     if is_cylindrical(geometry):  # the cylinder turning, the roller along its axis (report/cylinder_animation.py)
         from markupsafe import Markup
 
-        ctx.update(closed=True, anim_json=Markup(script_json(cylinder_animation_data(spec, geometry, report,
-                                                                                   frames=frames))),
-                   anim_js=Markup(_read_asset("cylinder_animation.js")), anim_caption=CYLINDER_ANIMATION_CAPTION)
+        data = cylinder_animation_data(spec, geometry, report, frames=frames)
+        ctx.update(closed=True, anim_json=Markup(script_json(data)), anim_caption=CYLINDER_ANIMATION_CAPTION,
+                   anim_js=Markup(_read_asset("cylinder_animation.js") + _read_asset("animation.js")))
     html = template_environment().get_template("report.html.j2").render(ctx)
     return {"report.html": html.encode("utf-8"), **files}
 

@@ -160,6 +160,11 @@
     ctx.textAlign = "left";
   }
 
+  // a cylindrical cam draws its own scene (cylinder_animation.js); every other cam its profile and followers
+  var scene = (D.cylinder && window.camfabCylinderScene)
+    ? window.camfabCylinderScene({ ctx: ctx, D: D, X: X, Y: Y, line: line, view: view })
+    : function (i) { drawCam(i); drawFollowers(i); };
+
   function frameIndex() { return Math.floor(pos) % N; }
 
   function render() {
@@ -172,8 +177,7 @@
     fit();
     ctx.save();
     ctx.beginPath(); ctx.rect(0, 0, W, H * 0.78); ctx.clip();
-    drawCam(i);
-    drawFollowers(i);
+    scene(i);
     ctx.restore();
     drawStrip(i);
     var unit = D.unit === "°" ? "°" : " mm";
