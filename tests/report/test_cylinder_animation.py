@@ -97,7 +97,7 @@ def test_groove_cam_roller_touches_both_flanks():
     np.testing.assert_allclose(np.hypot(*a.T), w, atol=2e-3)
     np.testing.assert_allclose(np.hypot(*b.T), w, atol=2e-3)
     np.testing.assert_allclose((a * b).sum(axis=1) / w**2, -1.0, atol=1e-3)  # opposite sides of the roller
-    assert len(d["outline"]) == 2  # both flanks drawn
+    assert len(d["outline"]) == 2 and d["groove"] == pytest.approx(w)  # both flanks, drawn as a groove
 
 
 def test_cylinder_report_plays_in_a_browser(tmp_path):
