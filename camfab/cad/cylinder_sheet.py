@@ -44,7 +44,7 @@ from .sheet import (
 )
 
 __all__ = ["cylinder_lift_table", "cylinder_layout", "build_cylinder_drawing", "cylinder_drawing_sheet",
-           "silhouette_notch", "MARGINS_MM"]
+           "silhouette_notch", "cylinder_notes", "MARGINS_MM"]
 
 #: paper mm kept round the two views for the dimensions and labels: left, bottom, right, top, and between them
 MARGINS_MM = (13.0, 18.0, 13.0, 19.0, 16.0)

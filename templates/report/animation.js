@@ -180,7 +180,7 @@
     ctx.textAlign = "left";
   }
 
-  // a cylindrical cam draws its own scene (cylinder_animation.js); every other cam its profile and followers
+  // a cylindrical cam draws its own scene (window.camfabCylinderScene); every other cam its profile and followers
   var scene = (D.cylinder && window.camfabCylinderScene)
     ? window.camfabCylinderScene({ ctx: ctx, D: D, X: X, Y: Y, line: line, view: view })
     : function (i) { drawCam(i); drawFollowers(i); };

@@ -1,5 +1,5 @@
 /* camfab report: a cylindrical cam's scene for the mechanism animation (vanilla JS, no network).
- * Loaded before animation.js, which runs the controls, the S strip and the readouts and calls this scene for the
+ * Inlined before the mechanism animation script, which runs the controls, the S strip and the readouts and calls this scene for the
  * view when its data (camfab.report.cylinder_animation) says "cylinder": the cylinder seen from the follower's
  * side (axis horizontal), turning — the groove's edges and generator lines turned by the frame's cam angle and
  * shown on the front half — and the roller at its exact position along the axis (the oscillating arm from its
