@@ -53,6 +53,8 @@ from ..design.drawing import keyway_depth_tolerance
 from ..design.kinds import ContactKind, FollowerType
 from ..results import Severity, Verdict
 from .dxf import write_deterministic
+from .groove import is_groove, plate_radius
+from .groove_sheet import groove_dimensions, groove_views
 from .plate import bore_loop, keyway_size
 from .sheet import (
     LAYERS,
@@ -73,7 +75,8 @@ from .sheet import (
 from .sheet_check import Occupancy, dimension_parts
 
 __all__ = ["PAPERS", "LAYERS", "SheetLayout", "load_template", "sheet_layout", "parse_scale", "drawing_sheet",
-           "build_drawing", "title_fields", "notes_text"]
+           "build_drawing", "title_fields", "notes_text", "dimension", "verdict_note", "tolerance_notes",
+           "place_dimension"]
 
 
 def title_fields(spec, report, layout: SheetLayout) -> dict[str, str]:
@@ -165,11 +168,12 @@ def notes_text(spec, geometry, report, shapes, layout: SheetLayout) -> list[str]
               if len(shapes.profiles) > 1 else "")
     groove = []
     if spec.cam.kind == "groove":  # one plate: the flanks of one groove (camfab.cad.groove)
-        from .groove import groove_width_note, plate_radius
+        from .groove import groove_width_note
 
         rmax, plates = plate_radius(geometry), "One plate with a face groove (inner flank solid, outer dashed);"
         groove = [f"Groove: {groove_width_note(geometry)} from the front face; outer flank up to R "
-                  f"{geometry.radius_extremes(1).max:.3f} mm; R max below is the plate's radius."]
+                  f"{geometry.radius_extremes(1).max:.3f} mm; R max below is the plate's radius; "
+                  "the side view (first-angle) has the front face on its right, the groove hidden."]
     return [
         f"Material: {_material(spec)}.",
         f"{plates or 'Plate'} thickness {m.thickness_mm:g} mm (side view); {bore}.",
@@ -287,6 +291,10 @@ def _dimensions(msp, spec, geometry, shapes, layout: SheetLayout, occ: Occupancy
             break
 
 
+#: public names of the helpers the cylindrical cam's sheet (:mod:`camfab.cad.cylinder_sheet`) shares
+dimension, verdict_note, tolerance_notes, place_dimension = _dim, _verdict_note, _tolerance_notes, _place
+
+
 def _rmax_point(geometry) -> tuple[float, float]:
     """The angle (degrees, sheet frame) and distance of the profile point at R max."""
     ext = geometry.radius_extremes()
@@ -366,7 +374,8 @@ def _view(msp, spec, geometry, shapes, layout: SheetLayout) -> None:
 
 
 def _extent(geometry, shapes) -> float:
-    return max([float(np.max(np.hypot(*lp.points.T))) for lp in shapes.profiles] + [geometry.max_radius])
+    rim = [plate_radius(geometry)] if is_groove(geometry) else []  # a groove plate's rim lies past its flanks
+    return max([float(np.max(np.hypot(*lp.points.T))) for lp in shapes.profiles] + [geometry.max_radius, *rim])
 
 
 def _side_view(msp, spec, layout: SheetLayout, y_lo: float, y_hi: float, bore: bool) -> None:
@@ -409,8 +418,13 @@ def build_drawing(spec, geometry, report, shapes, *, paper: str = "auto", lift_s
     _view(msp, spec, geometry, shapes, layout)
     _cam_labels(msp, spec, geometry, shapes, layout)
     _, y_lo, _, y_hi = _plate_box(shapes)  # the outline's extent (its arcs bulge past their end points)
+    if is_groove(geometry):  # the plate's rim, the groove in the side view (camfab.cad.groove_sheet)
+        y_lo, y_hi = -plate_radius(geometry), plate_radius(geometry)
+        groove_views(msp, spec, geometry, layout)
     _side_view(msp, spec, layout, y_lo, y_hi, True)
     _dimensions(msp, spec, geometry, shapes, layout, Occupancy(doc, layout))
+    if is_groove(geometry):
+        groove_dimensions(msp, spec, geometry, layout)
     return doc, layout
 
 

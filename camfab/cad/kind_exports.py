@@ -58,12 +58,29 @@ def _cylinder_stl(cam: Any, req: Any) -> list[Artifact]:
     return [Artifact(f"{safe_stem(cam.name)}.stl", data, "stl", deviation_mm=dev)]
 
 
+def _cylinder_drawing(cam: Any, req: Any) -> list[Artifact]:
+    """``<stem>_drawing.dxf``: the sheet of the developed groove, a side view and the lift table
+    (:mod:`camfab.cad.cylinder_sheet`)."""
+    from .cylinder_sheet import cylinder_drawing_sheet
+
+    text, dev = cylinder_drawing_sheet(cam.spec, cam.geometry, cam.check(), tol=cam.tolerance(req.tol))
+    return [Artifact(f"{safe_stem(cam.name)}_drawing.dxf", text.encode("utf-8"), "drawing", deviation_mm=dev)]
+
+
+def _cylinder_pdf(cam: Any, req: Any) -> list[Artifact]:
+    """``<stem>_drawing.pdf``: that sheet as a one-page PDF (:func:`camfab.cad.pdf.sheet_pdf`)."""
+    from .pdf import sheet_pdf
+
+    return [Artifact(a.filename.removesuffix(".dxf") + ".pdf", sheet_pdf(a.data), "pdf", deviation_mm=a.deviation_mm)
+            for a in _cylinder_drawing(cam, req)]
+
+
 #: cam kinds whose files are made by their own exporters, by output name; an output missing from a kind's
 #: entry does not apply to it (:func:`not_applicable_reason`); None: the pipeline's own stage, which handles the kind
 #: (the report and workbook; the 4-axis program of :mod:`camfab.gcode.rotary`, dispatched in ``pipeline._gcode``)
 KIND_EXPORTERS: dict[str, dict[str, Callable[[Any, Any], list[Artifact]] | None]] = {
     "cylindrical": {"dxf": _cylinder_dxf, "step": _cylinder_step, "xlsx": None, "report": None,
-                    "stl": _cylinder_stl, "gcode": None},
+                    "stl": _cylinder_stl, "gcode": None, "drawing": _cylinder_drawing, "pdf": _cylinder_pdf},
 }
 
 #: a kind's own outputs that need cadquery: a run skips them with a warning when it is missing, as the STEP

@@ -242,8 +242,9 @@ def title_block(msp, layout: SheetLayout, fields: dict[str, str]) -> None:
             put_text(msp, dxf_text(value), (cx + 1.5, cy + 1.5), h, "TITLE_BLOCK", "BOTTOM_LEFT", width=cw - 3.0)
 
 
-def lift_table_block(msp, layout: SheetLayout, table, closed: bool) -> None:
-    """The lift table in ``layout.table``, split into side-by-side column groups when it is tall."""
+def lift_table_block(msp, layout: SheetLayout, table, closed: bool, third: str | None = None) -> None:
+    """The lift table in ``layout.table``, split into side-by-side column groups when it is tall; ``third``
+    replaces the third column's heading (RADIUS mm / HEIGHT mm)."""
     tpl = load_template()["lift_table"]
     rh, widths, h = tpl["row_height_mm"], tpl["column_widths_mm"], tpl["text_height_mm"]
     x0, y0, x1, y1 = layout.table
@@ -253,7 +254,7 @@ def lift_table_block(msp, layout: SheetLayout, table, closed: bool) -> None:
     put_text(msp, f"LIFT TABLE (step {step:g}{'°' if closed else ' mm'})", ((x0 + x1) / 2, y1 - 0.75 * rh),
           h, "LIFT_TABLE", "MIDDLE_CENTER", width=x1 - x0 - 2)
     msp.add_line((x0, y1 - 1.5 * rh), (x1, y1 - 1.5 * rh), dxfattribs={"layer": "LIFT_TABLE"})
-    heads = ("ANGLE °" if closed else "TRAVEL mm", f"LIFT {unit}", "RADIUS mm" if closed else "HEIGHT mm")
+    heads = ("ANGLE °" if closed else "TRAVEL mm", f"LIFT {unit}", third or ("RADIUS mm" if closed else "HEIGHT mm"))
     gw = sum(widths)
     lift_dec = 4 if table.lift_unit == "deg" else 3
     for g in range(layout.table_groups):

@@ -129,6 +129,8 @@ def animation_data(spec, geometry, report, *, frames: int = 360, outline_points:
         "followers": followers,
         "bounds": _r([lo[0] - pad, hi[0] + pad, lo[1] - pad, hi[1] + pad]),
         "pa_limit": pa_lim, "rmax": round(float(rmax), _ROUND),
+        # a face-groove cam: the groove's half width (the script draws the groove between the flanks in the plate)
+        "groove": round(float(geometry.profiles[0].roller_radius), _ROUND) if spec.cam.kind == "groove" else None,
     }
 
 

@@ -375,6 +375,7 @@ def render_report(spec, geometry, report, *, standalone: bool = False, frames: i
         ``{"report.html": ..., "plots/svaj.svg": ..., ...}`` (and ``"plots/svaj.png"``… with ``png``).
     """
     from .animation import animation_data
+    from .cylinder_animation import CYLINDER_ANIMATION_CAPTION, cylinder_animation_data, is_cylindrical
     from .cylinder_plot import UNROLLED_PLOT_TEXT
     from .plots import report_figures
     from .vibration_plot import VIBRATION_PLOT_TEXT, vibration_figures
@@ -382,9 +383,15 @@ def render_report(spec, geometry, report, *, standalone: bool = False, frames: i
     files, plots = plot_files({**report_figures(spec, geometry, report), **vibration_figures(spec, geometry, report)},
                               standalone=standalone, png=png,
                               text={**plot_text(geometry), **VIBRATION_PLOT_TEXT, **UNROLLED_PLOT_TEXT})
-    anim = animation_data(spec, geometry, report, frames=frames)
-    html = template_environment().get_template("report.html.j2").render(
-        report_context(spec, geometry, report, plots, anim))
+    ctx = report_context(spec, geometry, report, plots, animation_data(spec, geometry, report, frames=frames)
+                         if not is_cylindrical(geometry) else {})
+    if is_cylindrical(geometry):  # the cylinder turning, the roller along its axis (report/cylinder_animation.py)
+        from markupsafe import Markup
+
+        data = cylinder_animation_data(spec, geometry, report, frames=frames)
+        ctx.update(closed=True, anim_json=Markup(script_json(data)), anim_caption=CYLINDER_ANIMATION_CAPTION,
+                   anim_js=Markup(_read_asset("cylinder_animation.js") + _read_asset("animation.js")))
+    html = template_environment().get_template("report.html.j2").render(ctx)
     return {"report.html": html.encode("utf-8"), **files}
 
 

@@ -55,9 +55,29 @@
     if (stroke) { ctx.strokeStyle = stroke; ctx.lineWidth = width || 1; ctx.setLineDash(dash || []); ctx.stroke(); ctx.setLineDash([]); }
   }
 
+  // a face-groove cam: the plate (a wall of the groove's width round the outer flank), the groove between the
+  // flanks, the island inside the inner flank; both flanks solid
+  function drawGroove(c, s) {
+    [[1, "wall"], [1, "groove"], [0, "island"]].forEach(function (step) {
+      var pts = D.outline[step[0]];
+      ctx.beginPath();
+      for (var j = 0; j < pts.length; j += 2) {
+        var u = pts[j] * c - pts[j + 1] * s, v = pts[j] * s + pts[j + 1] * c;
+        if (j === 0) { ctx.moveTo(X(u), Y(v)); } else { ctx.lineTo(X(u), Y(v)); }
+      }
+      ctx.closePath();
+      if (step[1] === "wall") {
+        ctx.strokeStyle = COL.cam; ctx.lineWidth = 4 * D.groove * view.s; ctx.stroke(); return;
+      }
+      ctx.fillStyle = step[1] === "groove" ? "#f7f3ea" : COL.cam; ctx.fill();
+      ctx.strokeStyle = COL.camLine; ctx.lineWidth = 2; ctx.stroke();
+    });
+  }
+
   function drawCam(i) {
     var a = D.frames.angle[i], c = Math.cos(a), s = Math.sin(a), dx = D.frames.shift[i];
-    D.outline.forEach(function (pts, k) {
+    if (D.groove) { drawGroove(c, s); }
+    (D.groove ? [] : D.outline).forEach(function (pts, k) {
       var copies = D.closed ? [0] : [-D.period, 0, D.period];
       copies.forEach(function (off) {
         ctx.beginPath();
@@ -160,6 +180,11 @@
     ctx.textAlign = "left";
   }
 
+  // a cylindrical cam draws its own scene (window.camfabCylinderScene); every other cam its profile and followers
+  var scene = (D.cylinder && window.camfabCylinderScene)
+    ? window.camfabCylinderScene({ ctx: ctx, D: D, X: X, Y: Y, line: line, view: view })
+    : function (i) { drawCam(i); drawFollowers(i); };
+
   function frameIndex() { return Math.floor(pos) % N; }
 
   function render() {
@@ -172,8 +197,7 @@
     fit();
     ctx.save();
     ctx.beginPath(); ctx.rect(0, 0, W, H * 0.78); ctx.clip();
-    drawCam(i);
-    drawFollowers(i);
+    scene(i);
     ctx.restore();
     drawStrip(i);
     var unit = D.unit === "°" ? "°" : " mm";
