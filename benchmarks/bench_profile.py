@@ -25,6 +25,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import sys
 import time
 from pathlib import Path
@@ -118,12 +119,28 @@ def memory_report(repeat: int) -> None:
                                  capture_output=True, text=True).stdout
             r = json.loads(out)
             print(f"{n:>12,}{label:>28}{r['rss_mb']:>14.0f}{r['traced_mb']:>16.0f}{r['cpu_s']:>8.2f}")
+    print(f"time per angle of evaluate (whole sample), ns, best of {repeat}; in a fresh process, glibc's defaults "
+          "and with freed memory kept (MALLOC_TRIM_THRESHOLD_=64 MB, MALLOC_MMAP_THRESHOLD_=32 MB)")
+    rows = []
+    for env in ({}, {"MALLOC_TRIM_THRESHOLD_": str(64 << 20), "MALLOC_MMAP_THRESHOLD_": str(32 << 20)}):
+        out = subprocess.run([sys.executable, __file__, "--per-angle-child", str(repeat)], check=True,
+                             capture_output=True, text=True, env={**os.environ, **env}).stdout
+        rows.append(json.loads(out))
+    for n, a, b in zip(PER_ANGLE, *rows, strict=True):
+        print(f"{n:>12,} angles {a:8.0f} {b:8.0f}")
+
+
+#: angle counts of the per-angle timing (the issue: 5 000–40 000 angles 3x slower per angle than 10^5)
+PER_ANGLE = (5_000, 10_000, 20_000, 40_000, 100_000, 1_000_000)
+
+
+def per_angle_child(repeat: int) -> list[float]:
     contact = CAMS[0][1](MotionProgram.from_segments(ROWS)).profiles[0]
-    print("time per angle of evaluate (whole sample), best of", repeat)
-    for n in (5_000, 10_000, 20_000, 40_000, 100_000, 1_000_000):
+    out = []
+    for n in PER_ANGLE:
         phi = np.linspace(0, 2 * math.pi, n, endpoint=False)
-        t = best(lambda phi=phi: contact.evaluate(phi), repeat)
-        print(f"{n:>12,} angles {t * 1e9 / n:8.1f} ns per angle")
+        out.append(best(lambda phi=phi: contact.evaluate(phi), repeat) * 1e9 / n)
+    return out
 
 
 def main() -> None:
@@ -135,7 +152,11 @@ def main() -> None:
     ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--memory", action="store_true", help="peak memory of evaluate vs evaluate_fields")
     ap.add_argument("--memory-child", nargs=2, metavar=("N", "MODE"), help=argparse.SUPPRESS)
+    ap.add_argument("--per-angle-child", type=int, help=argparse.SUPPRESS)
     a = ap.parse_args()
+    if a.per_angle_child:
+        print(json.dumps(per_angle_child(a.per_angle_child)))
+        return
     if a.memory_child:
         print(json.dumps(memory_child(int(a.memory_child[0]), a.memory_child[1])))
         return
