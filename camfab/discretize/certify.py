@@ -23,7 +23,8 @@ depend on ``samples``: each of its distances is taken to an exact curve point (a
 :data:`CERTIFY_SHARE` of ``tol``, and accepts that measurement when ``D + gap ≤ tol`` (less the writers'
 room); otherwise it measures as before (the default sample count), so a fit is never accepted on weaker
 evidence than it was.  ``K`` and ``max|P′|`` come from the fit's Hermite stand-in (its midpoint error is a
-two-hundredth of ``tol``), sampled at its nodes and midpoints and enlarged by :data:`_SAFETY`.
+two-hundredth of ``tol``), sampled at both ends and the midpoint of every interval and enlarged by
+:data:`_SAFETY`.
 """
 from __future__ import annotations
 
@@ -52,18 +53,16 @@ _SAFETY = 1.25
 
 
 def _curve_bounds(sur: HermiteSurrogate) -> tuple[float, float]:
-    """``(max |κ|, max |P′|)`` of the stand-in at its nodes and interval midpoints, every smooth piece."""
-    kmax, vmax = 0.0, 0.0
-    for p in range(sur.first.size - 1):
-        x = sur.x[sur.first[p]:sur.first[p + 1] + 1]
-        t = np.concatenate([x, 0.5 * (x[:-1] + x[1:])])
-        d, dd = sur.derivative(t, p), sur.second_derivative(t, p)
-        v = np.hypot(d[:, 0], d[:, 1])
-        with np.errstate(divide="ignore", invalid="ignore"):
-            k = np.abs(cross(d, dd)) / v ** 3
-        kmax = max(kmax, float(np.max(k)))
-        vmax = max(vmax, float(np.max(v)))
-    return _SAFETY * kmax, _SAFETY * vmax
+    """``(max |κ|, max |P′|)`` of the stand-in at both ends and the midpoint of every interval (each inside its
+    own smooth piece: one-sided at breakpoints), enlarged by :data:`_SAFETY`."""
+    a, b = sur.x[:-1], sur.x[1:]
+    t = np.concatenate([a, 0.5 * (a + b), b])
+    piece = np.tile(sur.piece, 3)
+    d, dd = sur.derivative(t, piece), sur.second_derivative(t, piece)
+    v = np.hypot(d[:, 0], d[:, 1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k = np.abs(cross(d, dd)) / v ** 3
+    return _SAFETY * float(np.max(k)), _SAFETY * float(np.max(v))
 
 
 def semiconcavity(sur: HermiteSurrogate, chain: Chain, tol: float) -> tuple[float, float]:
