@@ -12,13 +12,20 @@ Timings are best-of-``--repeat`` (the machine may be shared).
 core redesign (``benchmarks/baseline.py``), in the same run; the redesign's target is a ratio of at most
 1.3 for each.
 
-Run:  python3 benchmarks/bench_profile.py [--n 100000] [--repeat 5] [--baseline]
+``--memory`` instead measures the peak memory of one profile evaluation of the translating roller at 10^6 and
+10^7 angles, the whole sample (``evaluate``, 16 fields) against only the profile points
+(``evaluate_fields(phi, ("point",))``, what the exporters and the arc fit ask for), each in a fresh process (peak
+resident set less the resident set before the call, and the tracemalloc peak of numpy's allocations), and the
+time per angle of the whole sample from 5 000 to 10^5 angles (best of ``--repeat``).
+
+Run:  python3 benchmarks/bench_profile.py [--n 100000] [--repeat 5] [--baseline] [--memory]
 """
 from __future__ import annotations
 
 import argparse
 import json
 import math
+import os
 import sys
 import time
 from pathlib import Path
@@ -80,6 +87,62 @@ def timings(n: int, repeat: int) -> dict[str, float]:
     return out
 
 
+def memory_child(n: int, mode: str) -> dict[str, float]:
+    """Peak memory (MB) of one evaluation of the translating roller at ``n`` angles in this process: ``mode``
+    "full" (``evaluate``) or "point" (``evaluate_fields(phi, ("point",))``); the angles are not counted."""
+    import resource
+    import tracemalloc
+
+    geom = CAMS[0][1](MotionProgram.from_segments(ROWS))
+    contact = geom.profiles[0]
+    contact.evaluate(np.linspace(0, 1, 1000))  # per-law tables built, caches warm
+    phi = np.linspace(0, 2 * math.pi, n, endpoint=False)
+    rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    tracemalloc.start()
+    t0 = time.process_time()
+    r = contact.evaluate(phi).point if mode == "full" else contact.evaluate_fields(phi, ("point",))["point"]
+    cpu = time.process_time() - t0
+    _, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return {"rss_mb": (rss - rss0) / 1024.0, "traced_mb": peak / 2**20, "cpu_s": cpu, "check": float(r[-1, 0])}
+
+
+def memory_report(repeat: int) -> None:
+    import subprocess
+
+    print("translating roller, one profile evaluation, peak memory in a fresh process (MB above the angles):")
+    print(f"{'angles':>12}{'mode':>28}{'peak RSS MB':>14}{'tracemalloc MB':>16}{'CPU s':>8}")
+    for n in (10**6, 10**7):
+        for mode, label in (("full", "evaluate (16 fields)"), ("point", 'evaluate_fields("point")')):
+            out = subprocess.run([sys.executable, __file__, "--memory-child", str(n), mode], check=True,
+                                 capture_output=True, text=True).stdout
+            r = json.loads(out)
+            print(f"{n:>12,}{label:>28}{r['rss_mb']:>14.0f}{r['traced_mb']:>16.0f}{r['cpu_s']:>8.2f}")
+    print(f"time per angle of evaluate (whole sample), ns, best of {repeat}; in a fresh process, glibc's defaults "
+          "and with freed memory kept (MALLOC_TRIM_THRESHOLD_=64 MB, MALLOC_MMAP_THRESHOLD_=32 MB)")
+    rows = []
+    for env in ({}, {"MALLOC_TRIM_THRESHOLD_": str(64 << 20), "MALLOC_MMAP_THRESHOLD_": str(32 << 20)}):
+        out = subprocess.run([sys.executable, __file__, "--per-angle-child", str(repeat)], check=True,
+                             capture_output=True, text=True, env={**os.environ, **env}).stdout
+        rows.append(json.loads(out))
+    for n, a, b in zip(PER_ANGLE, *rows, strict=True):
+        print(f"{n:>12,} angles {a:8.0f} {b:8.0f}")
+
+
+#: angle counts of the per-angle timing (the issue: 5 000–40 000 angles 3x slower per angle than 10^5)
+PER_ANGLE = (5_000, 10_000, 20_000, 40_000, 100_000, 1_000_000)
+
+
+def per_angle_child(repeat: int) -> list[float]:
+    contact = CAMS[0][1](MotionProgram.from_segments(ROWS)).profiles[0]
+    out = []
+    for n in PER_ANGLE:
+        phi = np.linspace(0, 2 * math.pi, n, endpoint=False)
+        out.append(best(lambda phi=phi: contact.evaluate(phi), repeat) * 1e9 / n)
+    return out
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=100_000)
@@ -87,7 +150,19 @@ def main() -> None:
     ap.add_argument("--baseline", nargs="?", const="", default=None, metavar="REF")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--memory", action="store_true", help="peak memory of evaluate vs evaluate_fields")
+    ap.add_argument("--memory-child", nargs=2, metavar=("N", "MODE"), help=argparse.SUPPRESS)
+    ap.add_argument("--per-angle-child", type=int, help=argparse.SUPPRESS)
     a = ap.parse_args()
+    if a.per_angle_child:
+        print(json.dumps(per_angle_child(a.per_angle_child)))
+        return
+    if a.memory_child:
+        print(json.dumps(memory_child(int(a.memory_child[0]), a.memory_child[1])))
+        return
+    if a.memory:
+        memory_report(a.repeat)
+        return
     if a.child:
         print(json.dumps(timings(a.n, a.repeat)))
         return

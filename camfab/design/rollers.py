@@ -71,26 +71,13 @@ class DiscRollerContact(Contact):
               extra: dict[str, bool]) -> None:
         """Rows of ``out[:, a:b]`` for one chunk of samples (see :meth:`_evaluate`)."""
         sg, rr = self.sense, self.roller_radius
-        cx, cy, c1x, c1y, c2x, c2y, vx, vy, xi = self._components(S)
+        comp = self._components(S)
+        xi = comp[-1]
         if xi is not None:
             out[15, a:b] = xi
             extra["arm"] = True
-        # component arrays instead of (n, 2) column slices: this is the hot path
-        if not (isinstance(cx, np.ndarray) and cx.shape == cy.shape):
-            cx = cx + 0.0 * cy  # broadcast a scalar coordinate to the sample count
-        # (σ = ±1 is applied by choosing the operation or the sign of one factor: exact, and
-        # no extra pass over the arrays)
-        tx, ty = (c1x - cy, c1y + cx) if sg > 0 else (c1x + cy, c1y - cx)  # T = σ·J·C + C′
-        ax = c2x - cx - 2 * sg * c1y                                        # A2 = −C + 2σ·J·C′ + C″
-        ay = c2y - cy + 2 * sg * c1x
-        speed = np.sqrt(tx * tx + ty * ty)  # |T| is far from overflow: no need for hypot's care
-        inv = np.divide(sg, speed)  # σ/|T|
-        # n = −σ·J·t = σ·(ty, −tx)/|T|, pitch curvature κp = σ·(T × A2)/|T|³
-        nx = ty * inv
-        ny = np.negative(tx * inv)
-        inv3 = inv * inv
-        inv3 *= inv  # σ³/|T|³ = σ/|T|³
-        kpc = np.multiply(tx * ay - ty * ax, inv3, out=out[10, a:b])
+        cx, cy, vx, vy, tx, ty, speed, inv, nx, ny = self._frame(comp)
+        kpc = self._pitch_curvature(comp, cx, cy, tx, ty, inv, out[10, a:b])
         scale = 1.0 - rr * kpc
         with np.errstate(divide="ignore", invalid="ignore"):
             kc = np.divide(kpc, scale, out=out[11, a:b])
@@ -105,6 +92,67 @@ class DiscRollerContact(Contact):
             out[16, a:b] = face
             extra["face"] = True
         self._place(out, a, b, x, cx, cy, nx, ny, speed * scale, rotate)
+
+    def _frame(self, comp: tuple[Any, ...]) -> tuple[Any, ...]:
+        """``(cx, cy, vx, vy, tx, ty, |T|, σ/|T|, nx, ny)`` of the :meth:`_components` ``comp``: C, the rise
+        velocity, T = σ·J·C + C′, its length and inverse, and the fixed-frame normal."""
+        sg = self.sense
+        cx, cy, c1x, c1y, _, _, vx, vy, _ = comp
+        # component arrays instead of (n, 2) column slices: this is the hot path
+        if not (isinstance(cx, np.ndarray) and cx.shape == cy.shape):
+            cx = cx + 0.0 * cy  # broadcast a scalar coordinate to the sample count
+        # (σ = ±1 is applied by choosing the operation or the sign of one factor: exact, and
+        # no extra pass over the arrays)
+        tx, ty = (c1x - cy, c1y + cx) if sg > 0 else (c1x + cy, c1y - cx)  # T = σ·J·C + C′
+        speed = np.sqrt(tx * tx + ty * ty)  # |T| is far from overflow: no need for hypot's care
+        inv = np.divide(sg, speed)  # σ/|T|
+        # n = −σ·J·t = σ·(ty, −tx)/|T|
+        nx = ty * inv
+        ny = np.negative(tx * inv)
+        return cx, cy, vx, vy, tx, ty, speed, inv, nx, ny
+
+    def _pitch_curvature(self, comp: tuple[Any, ...], cx, cy, tx, ty, inv, out: np.ndarray) -> np.ndarray:
+        """κp = σ·(T × A2)/|T|³ into ``out``, A2 = −C + 2σ·J·C′ + C″."""
+        sg = self.sense
+        _, _, c1x, c1y, c2x, c2y, _, _, _ = comp
+        ax = c2x - cx - 2 * sg * c1y
+        ay = c2y - cy + 2 * sg * c1x
+        inv3 = inv * inv
+        inv3 *= inv  # σ³/|T|³ = σ/|T|³
+        return np.multiply(tx * ay - ty * ax, inv3, out=out)
+
+    def evaluate_fields(self, phi, fields):
+        """:meth:`Contact.evaluate_fields`; the profile point and P′ alone (what the exporters and the arc fit
+        use) skip the curvatures' inverses, the pressure angle and the arm and face outputs (bit for bit the
+        same values: the same operations)."""
+        names = tuple(fields)
+        if type(self)._evaluate is not DiscRollerContact._evaluate or not names or \
+                not set(names) <= {"point", "point_d1"}:
+            return super().evaluate_fields(phi, names)
+        x = np.atleast_1d(np.asarray(phi, dtype=float))
+        n = x.size
+        want_d1 = "point_d1" in names
+        out = np.empty((4 if want_d1 else 2, n))  # point (and P′): (2, n) rows handed out transposed
+        tmp = np.empty((5, min(n, CHUNK)))  # one chunk's pitch point, normal and κp
+        sg, rr = self.sense, self.roller_radius
+        for a in range(0, n, CHUNK):
+            b = min(a + CHUNK, n)
+            xc, w = x[a:b], b - a
+            comp = self._components(self.motion.evaluate(xc, (0, 1, 2)))
+            cx, cy, _, _, tx, ty, speed, inv, nx, ny = self._frame(comp)
+            c, s = cos_sin(sg * xc)
+            rot_into(tmp[0:2], 0, w, cx, cy, c, s)
+            rot_into(tmp[2:4], 0, w, nx, ny, c, s)
+            nrx, nry = tmp[2, :w], tmp[3, :w]
+            np.subtract(tmp[0, :w], rr * nrx, out=out[0, a:b])
+            np.subtract(tmp[1, :w], rr * nry, out=out[1, a:b])
+            if want_d1:
+                kpc = self._pitch_curvature(comp, cx, cy, tx, ty, inv, tmp[4, :w])
+                f = speed * (1.0 - rr * kpc)
+                np.multiply(np.multiply(nry, -sg), f, out=out[2, a:b])
+                np.multiply(np.multiply(nrx, sg), f, out=out[3, a:b])
+        got = {"point": out[0:2].T, "point_d1": out[2:4].T if want_d1 else None}
+        return {f: got[f] for f in names}
 
     def _place(self, out: np.ndarray, a: int, b: int, x: np.ndarray, cx, cy, nx, ny, f, rotate: bool) -> None:
         """Pitch point, normal, tangent, profile point and P′ of one chunk, in the cam frame (``rotate``)

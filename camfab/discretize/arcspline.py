@@ -18,10 +18,10 @@ import math
 import numpy as np
 
 from ..geom2d import cross, dot, rotate
+from .certify import certified_deviation
 from .chain import Chain, merge_cocircular
 from .curve import ParametricCurve, points_at
 from .entities import LINE_SWEEP_RAD, MAX_TURNING_RAD, arc_from, biarc, entity_point
-from .measure import measure_deviation
 from .spanmodel import SpanModel, cumtrapz, equioscillate
 from .spans import Span, cut_spans, span_density, span_ends, span_shape
 from .surrogate import HermiteSurrogate
@@ -340,7 +340,7 @@ def fit_spline(curve: ParametricCurve, surrogate: tuple[HermiteSurrogate, float]
         if curve.closed:
             chain, labels = _merge_wrap(chain, labels)
         merged = merge_cocircular(chain, labels)
-        dev = measure_deviation(merged, curve)
+        dev = certified_deviation(merged, curve, sur, tol, expected=max(errs))
         if within(dev.max, tol):
             return merged, dev.max, params
         worst = _span_deviations(curve, spans, parts, merged, dev)

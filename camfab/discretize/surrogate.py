@@ -79,8 +79,8 @@ class HermiteSurrogate:
         u, c = self._local(t, piece)
         return c[1] + u * (2 * c[2] + 3 * u * c[3])
 
-    def second_derivative(self, t, piece: int) -> np.ndarray:
-        """``d²P/dt²`` of the surrogate inside smooth piece ``piece``."""
+    def second_derivative(self, t, piece: int | np.ndarray) -> np.ndarray:
+        """``d²P/dt²`` of the surrogate inside smooth piece ``piece`` (one per ``t``, or one for all)."""
         t = np.asarray(t, dtype=float)
         i = self._index(t, piece)
         u = (t - self.x[i])[..., None]

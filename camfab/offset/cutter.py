@@ -69,8 +69,8 @@ def profile_curve(contact) -> ParametricCurve:
         log.info("profile: the follower's velocity jumps at %s; the profile is the one the follower makes there",
                  corner_note(contact, corners))
         return cornered_curve(contact, corners)
-    return ParametricCurve(lambda t: contact.evaluate(t).point, contact.breakpoints, contact.period,
-                           lambda t: contact.evaluate(t).point_d1)
+    return ParametricCurve(lambda t: contact.evaluate_fields(t, ("point",))["point"], contact.breakpoints,
+                           contact.period, lambda t: contact.evaluate_fields(t, ("point_d1",))["point_d1"])
 
 
 def pitch_curve(contact) -> ParametricCurve | None:
@@ -80,7 +80,8 @@ def pitch_curve(contact) -> ParametricCurve | None:
         return None
     if contact.evaluate(np.array([0.0])).pitch is None:
         return None
-    return ParametricCurve(lambda t: contact.evaluate(t).pitch, contact.breakpoints, contact.period)
+    return ParametricCurve(lambda t: contact.evaluate_fields(t, ("pitch",))["pitch"], contact.breakpoints,
+                           contact.period)
 
 
 def offset_curve(contact, distance: float) -> ParametricCurve:
@@ -97,12 +98,12 @@ def offset_curve(contact, distance: float) -> ParametricCurve:
         return cornered_curve(contact, corners, distance)
 
     def point(t):
-        s = contact.evaluate(t)
-        return s.point + distance * s.normal
+        s = contact.evaluate_fields(t, ("point", "normal"))
+        return s["point"] + distance * s["normal"]
 
     def deriv(t):
-        s = contact.evaluate(t)
-        return s.point_d1 * (1.0 + distance * s.curvature)[:, None]
+        s = contact.evaluate_fields(t, ("point_d1", "curvature"))
+        return s["point_d1"] * (1.0 + distance * s["curvature"])[:, None]
 
     return ParametricCurve(point, contact.breakpoints, contact.period, deriv)
 

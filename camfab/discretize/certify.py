@@ -1,0 +1,106 @@
+"""How many curve samples a deviation measurement needs to certify a fit within ``tol``.
+
+:func:`~camfab.discretize.measure.measure_deviation` takes the exact distance from ``samples`` curve points
+(shared out by parameter length) to the chain and refines the worst local maxima; its default (20 000
+points) is fixed whatever the curve.  The fit's own acceptance test only needs to know that the true maximum
+is within ``tol``, and a bound on the distance between samples tells how many points guarantee that.
+
+Derivation.  Let ``g(s)`` be the distance from the curve point at arc length ``s`` to the chain.  Near the
+chain (within ``tol``, far below every radius) the nearest point of a G1 chain lies inside an entity or on a
+joint where both neighbours' formulas agree, so ``g = min_j g_j`` with ``g_j`` the distance to entity ``j``'s
+line or full circle.  For a circle of centre ``c`` and radius ``r``, with ``ρ = |P - c|`` and ``u = (P - c)/ρ``:
+``g_j'' = ±(κ·(n·u) + (1 - (t·u)²)/ρ)``, so ``g_j'' ≤ K = max|κ_curve| + max_j 1/(r_j - tol)`` (a line: ``K =
+max|κ_curve|``).  Every ``g_j`` is then K-semiconcave, and so is their minimum, hence on a sample interval
+of arc length ``h``::
+
+    g(s) ≤ (linear interpolation of the two samples) + K·(s - a)(b - s)/2 ≤ max(samples) + K·h²/8.
+
+The sampled maximum ``D`` the measurement reports is at least the largest sample (its refinement only adds),
+so the true curve-to-chain maximum is at most ``D + K·h²/8`` with ``h ≤ max|P′|·period / samples`` (at least
+``samples·(hi - lo)/period`` points fall on every smooth piece).  The other direction (chain to curve) does not
+depend on ``samples``: each of its distances is taken to an exact curve point (an upper bound).  Hence
+:func:`certified_deviation` measures with the fewest samples whose gap ``K·h²/8`` is
+:data:`CERTIFY_SHARE` of ``tol``, and accepts that measurement when ``D + gap ≤ tol`` (less the writers'
+room); otherwise it measures as before (the default sample count), so a fit is never accepted on weaker
+evidence than it was.  ``K`` and ``max|P′|`` come from the fit's Hermite stand-in (its midpoint error is a
+two-hundredth of ``tol``), sampled at both ends and the midpoint of every interval and enlarged by
+:data:`_SAFETY`.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..geom2d import cross
+from .chain import Chain
+from .curve import ParametricCurve
+from .measure import measure_deviation
+from .results import Deviation
+from .surrogate import HermiteSurrogate
+from .tolerance import WRITE_ROOM_MM, within
+
+__all__ = ["CERTIFY_SHARE", "DEFAULT_SAMPLES", "semiconcavity", "sample_gap", "samples_for", "certified_deviation"]
+
+#: the share of ``tol`` the gap between curve samples may cost (the fit aims at 97 % of tol less the stand-in's
+#: error; the measured deviation of the examples lands at 80–97 %)
+CERTIFY_SHARE = 0.05
+#: the measurement's default curve samples (:func:`~camfab.discretize.measure.measure_deviation`)
+DEFAULT_SAMPLES = 20000
+#: the sampled curvature and speed maxima of the stand-in are enlarged by this factor (their maxima between the
+#: samples: the stand-in has thousands of nodes over a smooth curve)
+_SAFETY = 1.25
+
+
+def _curve_bounds(sur: HermiteSurrogate) -> tuple[float, float]:
+    """``(max |κ|, max |P′|)`` of the stand-in at both ends and the midpoint of every interval (each inside its
+    own smooth piece: one-sided at breakpoints), enlarged by :data:`_SAFETY`."""
+    a, b = sur.x[:-1], sur.x[1:]
+    t = np.concatenate([a, 0.5 * (a + b), b])
+    piece = np.tile(sur.piece, 3)
+    d, dd = sur.derivative(t, piece), sur.second_derivative(t, piece)
+    v = np.hypot(d[:, 0], d[:, 1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k = np.abs(cross(d, dd)) / v ** 3
+    return _SAFETY * float(np.max(k)), _SAFETY * float(np.max(v))
+
+
+def semiconcavity(sur: HermiteSurrogate, chain: Chain, tol: float) -> tuple[float, float]:
+    """``(K, max |P′|)``: the bound of ``g''`` (module notes) and the curve's largest speed; ``K`` is inf when
+    an arc's radius is not above ``tol``."""
+    kc, vmax = _curve_bounds(sur)
+    r = 1.0 / np.abs(chain.curvature[chain.curvature != 0.0])
+    if r.size == 0:
+        return kc, vmax
+    rmin = float(r.min())
+    return (kc + 1.0 / (rmin - tol) if rmin > tol else math.inf), vmax
+
+
+def sample_gap(K: float, vmax: float, period: float, samples: int) -> float:
+    """``K·h²/8`` with ``h = vmax·period/samples``: how far the curve-to-chain maximum may exceed the sampled one."""
+    h = vmax * period / samples
+    return K * h * h / 8.0
+
+
+def samples_for(K: float, vmax: float, period: float, gap: float) -> int | None:
+    """The fewest samples whose :func:`sample_gap` is at most ``gap`` (None when the bound is not finite)."""
+    if not (math.isfinite(K) and math.isfinite(vmax) and gap > 0):
+        return None
+    n = vmax * period * math.sqrt(K / (8.0 * gap))
+    return max(8, math.ceil(n)) if math.isfinite(n) else None
+
+
+def certified_deviation(chain: Chain, curve: ParametricCurve, sur: HermiteSurrogate, tol: float,
+                        expected: float = 0.0) -> Deviation:
+    """The measured deviation of ``chain`` from ``curve``: with the fewest samples that certify it within
+    ``tol`` (module notes) when they are fewer than the default and the certificate holds, else as measured
+    with the default samples.  ``expected`` (the fit's model error, mm) narrows the gap allowed to half the
+    room it leaves when that is less than :data:`CERTIFY_SHARE` of ``tol``."""
+    K, vmax = semiconcavity(sur, chain, tol)
+    gap = min(CERTIFY_SHARE * tol, 0.5 * (tol - WRITE_ROOM_MM - expected))
+    n = samples_for(K, vmax, curve.period, gap)
+    if n is not None and n < DEFAULT_SAMPLES:
+        dev = measure_deviation(chain, curve, samples=n)
+        if within(dev.max + sample_gap(K, vmax, curve.period, n), tol):
+            return dev
+    return measure_deviation(chain, curve)

@@ -1,0 +1,86 @@
+"""The sample count that certifies a fit within tol (:mod:`camfab.discretize.certify`): the bound
+``max ≤ sampled max + K·h²/8`` checked against dense exact samples (10⁶ per profile), with the independent
+point-to-arc distances of ``test_discretize.py``."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from camfab.design.assemble import geometry_from_spec
+from camfab.design.spec import design_from_dict
+from camfab.discretize import arcs, points_at
+from camfab.discretize.certify import CERTIFY_SHARE, certified_deviation, sample_gap, samples_for, semiconcavity
+from camfab.discretize.surrogate import HermiteSurrogate, fit_surrogate
+from camfab.formats import load_design
+from camfab.offset.cutter import profile_curve
+
+from .test_discretize import Dense, arc_dist, check_arcs
+
+TOL = 1e-3
+
+
+def issue15_curve():
+    """Issue 15's roller cam: Rb 50, Rr 5, cycloidal ±25 mm over 120°, dwells of 60°."""
+    return profile_curve(geometry_from_spec(design_from_dict({
+        "name": "issue15", "cam": {"kind": "disc", "rotation": "cw", "omega_rad_s": 1.0},
+        "follower": {"type": "roller", "motion": "translating", "base_radius_mm": 50.0, "roller_radius_mm": 5.0},
+        "motion": [{"law": "cycloidal", "lift": 25.0, "angle_deg": 120.0},
+                   {"law": "dwell", "lift": 0.0, "angle_deg": 60.0},
+                   {"law": "cycloidal", "lift": -25.0, "angle_deg": 120.0},
+                   {"law": "dwell", "lift": 0.0, "angle_deg": 60.0}]})).profiles[0])
+
+
+CURVES = {"issue15": issue15_curve,
+          "constant_width": lambda: profile_curve(geometry_from_spec(
+              load_design("camfab/examples/constant_width.toml")).profiles[0])}
+
+
+def _to_arcs(res, pts):
+    """Exact distance from every point to the arcs (all of them: a few tens)."""
+    out = np.empty(len(pts))
+    for a in range(0, len(pts), 20000):
+        q = pts[a:a + 20000, None]
+        out[a:a + 20000] = arc_dist(q, res.starts[None], res.ends[None], res.centres[None], res.radii[None],
+                                    res.sweeps[None]).min(axis=1)
+    return out
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", sorted(CURVES))
+def test_sampled_maximum_plus_gap_bounds_the_dense_maximum(name):
+    curve = CURVES[name]()
+    res = arcs(curve, tol=TOL)
+    K, vmax = semiconcavity(fit_surrogate(curve, TOL)[0], res.chain(), TOL)
+    dense_t = np.unique(np.concatenate([np.linspace(0.0, curve.period, 10**6), curve.breakpoints]))
+    dense = _to_arcs(res, points_at(curve, dense_t)).max()
+    gaps = []
+    for n in (300, 1000, 3000, 10000):  # the curve samples the measurement takes (shared out by parameter length)
+        raw = _to_arcs(res, points_at(curve, HermiteSurrogate(curve, n, min_count=8).x)).max()
+        gap = sample_gap(K, vmax, curve.period, n)
+        assert raw <= dense + 1e-12
+        assert dense <= raw + gap + 1e-12, (n, raw, gap, dense)
+        gaps.append(gap)
+    assert gaps == sorted(gaps, reverse=True) and gaps[-1] < 0.05 * TOL  # not vacuous: h² scaling, small at 10⁴
+
+
+@pytest.mark.slow
+def test_certified_fit_matches_a_dense_independent_check():
+    curve = issue15_curve()
+    res = arcs(curve, tol=TOL)
+    sur = fit_surrogate(curve, TOL)[0]
+    K, vmax = semiconcavity(sur, res.chain(), TOL)
+    n = samples_for(K, vmax, curve.period, CERTIFY_SHARE * TOL)
+    assert n is not None and n < 20000  # fewer samples than the default measurement
+    independent = check_arcs(res, Dense(curve, 10**6))
+    assert independent <= TOL and res.max_deviation <= TOL
+    # the reported maximum is the dense one to the digits printed (the refinement finds the peak)
+    assert res.max_deviation == pytest.approx(independent, rel=1e-5)
+    dev = certified_deviation(res.chain(), curve, sur, TOL)  # certified with n samples: within tol with the gap
+    assert dev.max + sample_gap(K, vmax, curve.period, n) <= TOL
+    assert dev.max == res.max_deviation
+
+
+def test_no_finite_bound_means_no_shortcut():
+    assert samples_for(float("inf"), 1.0, 1.0, 1e-3) is None
+    assert samples_for(1.0, 1.0, 1.0, 0.0) is None
+    assert sample_gap(2.0, 3.0, 1.0, 30) == pytest.approx(2.0 * 0.1 ** 2 / 8)
