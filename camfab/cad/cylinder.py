@@ -29,8 +29,8 @@ from ..textsafe import dxf_string, plain
 from .dxf import LAYERS, ezdxf_module, write_deterministic
 from .step import cadquery, solid_dumps
 
-__all__ = ["developed_curves", "developed_dxf", "grooved_cylinder", "cylinder_step", "cylinder_stl", "solid_mesh",
-           "sweep_points", "SWEEP_POINTS"]
+__all__ = ["developed_curves", "developed_dxf", "grooved_cylinder", "cylinder_solid", "cylinder_step", "cylinder_stl",
+           "solid_mesh", "solid_stl", "sweep_points", "SWEEP_POINTS"]
 
 #: points of the 3D pitch curve the STEP's periodic B-spline passes through (per turn) to begin with; doubled
 #: (at most 4 times) until the spline lies within the tolerance (the sweep's cost grows with them: 8 s at 48)
@@ -140,13 +140,9 @@ def grooved_cylinder(geometry: CylindricalGeometry, *, n: int = SWEEP_POINTS, bo
     cyl = geometry.cylinder
     r_far = cyl.outer_radius_mm + CLEARANCE_MM
     radii = np.linspace(cyl.inner_radius_mm, r_far, SECTION_RADII)
-    theta, sections = groove_sections(geometry, n, radii)
-    path = cq.Wire.assembleEdges([cq.Edge.makeSpline([_vec(cq, p) for p in pitch_3d(geometry, theta)],
-                                                     periodic=True)])
-    aux = cq.Wire.assembleEdges([cq.Edge.makeSpline([_vec(cq, p) for p in pitch_3d(geometry, theta, r_far)],
-                                                    periodic=True)])
+    _, sections = groove_sections(geometry, n, radii)
     wires = [cq.Wire.makePolygon([_vec(cq, p) for p in (*sec[0], *sec[1][::-1])], close=True) for sec in sections]
-    groove = cq.Solid.sweep_multi([*wires, wires[0]], path, makeSolid=True, mode=aux)
+    groove = _split_closed(cq, cq.Solid.makeLoft([*wires, wires[0]], False))  # the first section closes the loop
     body = cq.Solid.makeCylinder(cyl.outer_radius_mm, cyl.length_mm, cq.Vector(0, 0, 0), cq.Vector(0, 0, 1))
     solid = body.cut(groove)
     if bore_mm > 0:
@@ -155,6 +151,17 @@ def grooved_cylinder(geometry: CylindricalGeometry, *, n: int = SWEEP_POINTS, bo
         raise ExportError(f"the grooved cylinder is not a valid solid (OCC's checker): groove {cyl.groove_depth_mm:g} "
                           "mm deep swept around the pitch curve. Check the design for an undercut")
     return solid
+
+
+def _split_closed(cq, solid):
+    """``solid`` with each of its closed faces (the loft's, closed around the track) split in two along an
+    iso-line: no face's boundary crosses its own seam, which OCC's STEP reader rebuilt 2.5 µm off (measured)."""
+    from OCP.ShapeUpgrade import ShapeUpgrade_ShapeDivideClosed
+
+    divide = ShapeUpgrade_ShapeDivideClosed(solid.wrapped)
+    divide.SetNbSplitPoints(1)
+    divide.Perform()
+    return cq.Shape.cast(divide.Result())
 
 
 def path_deviation(geometry: CylindricalGeometry, n: int = SWEEP_POINTS, samples: int = 500) -> float:
@@ -176,12 +183,19 @@ def path_deviation(geometry: CylindricalGeometry, n: int = SWEEP_POINTS, samples
     return worst
 
 
+def cylinder_solid(geometry: CylindricalGeometry, *, tol: float, bore_mm: float = 0.0):
+    """The grooved cylinder (:func:`grooved_cylinder` with :func:`sweep_points` sections) and the measured
+    deviation of its pitch path (mm): what the STEP, STL and IGES files and the assembly are made of."""
+    n, dev = sweep_points(geometry, tol)
+    return grooved_cylinder(geometry, n=n, bore_mm=bore_mm), dev
+
+
 def cylinder_step(geometry: CylindricalGeometry, *, tol: float, name: str = "cam",
                   bore_mm: float = 0.0) -> tuple[str, float]:
     """STEP text of the grooved cylinder and the measured deviation of its sweep path (mm); more points when
     the default ones leave the path farther than ``tol`` from the exact curve."""
-    n, dev = sweep_points(geometry, tol)
-    return solid_dumps(grooved_cylinder(geometry, n=n, bore_mm=bore_mm), name=name), dev
+    solid, dev = cylinder_solid(geometry, tol=tol, bore_mm=bore_mm)
+    return solid_dumps(solid, name=name), dev
 
 
 def sweep_points(geometry: CylindricalGeometry, tol: float) -> tuple[int, float]:
@@ -218,8 +232,12 @@ def cylinder_stl(geometry: CylindricalGeometry, *, tol: float, name: str = "cam"
                  bore_mm: float = 0.0) -> tuple[bytes, float]:
     """Binary STL of the grooved cylinder (the STEP's solid, :func:`solid_mesh` within ``tol``) and the sweep
     path's measured deviation (mm; the mesh adds at most ``tol``, OCC's linear deflection)."""
-    n, dev = sweep_points(geometry, tol)
-    mesh = solid_mesh(grooved_cylinder(geometry, n=n, bore_mm=bore_mm), tol)
-    data = mesh.export(file_type="stl")
+    solid, dev = cylinder_solid(geometry, tol=tol, bore_mm=bore_mm)
+    return solid_stl(solid, tol=tol, name=name), dev
+
+
+def solid_stl(solid, *, tol: float, name: str = "cam") -> bytes:
+    """Binary STL of the grooved cylinder ``solid`` (:func:`solid_mesh` within ``tol``), camfab's header."""
+    data = solid_mesh(solid, tol).export(file_type="stl")
     head = f"camfab {plain(name)} units=mm tol={tol:g} grooved cylinder".encode("ascii", "replace")[:80]
-    return head.ljust(80, b" ") + data[80:], dev
+    return head.ljust(80, b" ") + data[80:]

@@ -8,6 +8,7 @@ an output a kind's entry lacks does not apply to it: ``camfab run`` and ``camfab
 from __future__ import annotations
 
 import logging
+import weakref
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -15,7 +16,8 @@ from ..errors import ExportError
 from ..io import safe_stem
 from .artifact import Artifact
 
-__all__ = ["KIND_EXPORTERS", "KIND_CAD_OUTPUTS", "not_applicable_reason", "kind_exporter", "applicable", "applies"]
+__all__ = ["KIND_EXPORTERS", "KIND_CAD_OUTPUTS", "not_applicable_reason", "kind_exporter", "applicable", "applies",
+           "cylinder_solid"]
 
 log = logging.getLogger("camfab.pipeline")
 
@@ -28,21 +30,38 @@ def _cylinder_dxf(cam: Any, req: Any) -> list[Artifact]:
     return [Artifact(f"{safe_stem(cam.name)}.dxf", text.encode("utf-8"), "dxf", deviation_mm=dev)]
 
 
+#: each cam's grooved cylinder by (tolerance, bore): built once per design and shared by its STEP, STL, IGES and
+#: assembly (the build is the slow part of a cylindrical run), dropped with the cam
+_SOLIDS: weakref.WeakKeyDictionary[Any, dict[tuple[float, float], tuple[Any, float]]] = weakref.WeakKeyDictionary()
+
+
+def cylinder_solid(cam: Any, req: Any) -> tuple[Any, float]:
+    """The cam's grooved cylinder (cadquery solid) and its path's measured deviation (mm), built once per cam,
+    tolerance and bore (:func:`camfab.cad.cylinder.cylinder_solid`)."""
+    from .cylinder import cylinder_solid as build  # cadquery only when a file is made
+
+    tol, bore = cam.tolerance(req.tol), float(cam.spec.manufacturing.bore_mm)
+    made = _SOLIDS.setdefault(cam, {})
+    if (tol, bore) not in made:
+        made[(tol, bore)] = build(cam.geometry, tol=tol, bore_mm=bore)
+    return made[(tol, bore)]
+
+
 def _cylinder_step(cam: Any, req: Any) -> list[Artifact]:
     """``<stem>.step``: the grooved cylinder (:mod:`camfab.cad.cylinder`)."""
-    from .cylinder import cylinder_step  # cadquery only when a file is made
+    from .step import solid_dumps
 
-    text, dev = cylinder_step(cam.geometry, tol=cam.tolerance(req.tol), name=cam.name,
-                              bore_mm=cam.spec.manufacturing.bore_mm)
+    solid, dev = cylinder_solid(cam, req)
+    text = solid_dumps(solid, name=cam.name)
     return [Artifact(f"{safe_stem(cam.name)}.step", text.encode("utf-8"), "step", deviation_mm=dev)]
 
 
 def _cylinder_stl(cam: Any, req: Any) -> list[Artifact]:
     """``<stem>.stl``: the grooved cylinder's solid tessellated by OpenCascade (:mod:`camfab.cad.cylinder`)."""
-    from .cylinder import cylinder_stl  # cadquery only when a file is made
+    from .cylinder import solid_stl
 
-    data, dev = cylinder_stl(cam.geometry, tol=cam.tolerance(req.tol), name=cam.name,
-                             bore_mm=cam.spec.manufacturing.bore_mm)
+    solid, dev = cylinder_solid(cam, req)
+    data = solid_stl(solid, tol=cam.tolerance(req.tol), name=cam.name)
     return [Artifact(f"{safe_stem(cam.name)}.stl", data, "stl", deviation_mm=dev)]
 
 
