@@ -379,7 +379,11 @@ def _iges(cam: Cam, req: Request) -> list[Artifact]:
     from .cad import iges
     from .cad.export import plate_of
 
-    loops, devs = iges.outlines(cam.shapes(req.tol), cam.tolerance(req.tol))  # refuses a groove cam (README)
+    if cam.shapes(req.tol).groove:  # one plate with the groove pocketed
+        from .cad.groove import groove_iges
+
+        return [groove_iges(cam.spec, cam.geometry, shapes=cam.shapes(req.tol), tol=cam.tolerance(req.tol))]
+    loops, devs = iges.outlines(cam.shapes(req.tol), cam.tolerance(req.tol))
     n = len(loops)
     return [Artifact(f"{safe_stem(cam.name)}{_suffix(i, n)}.igs",
                      iges.dumps(loop, plate_of(cam.spec), name=f"{cam.name}{_suffix(i, n)}").encode("ascii"),

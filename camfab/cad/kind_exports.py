@@ -65,16 +65,25 @@ def _cylinder_stl(cam: Any, req: Any) -> list[Artifact]:
     return [Artifact(f"{safe_stem(cam.name)}.stl", data, "stl", deviation_mm=dev)]
 
 
+def _cylinder_iges(cam: Any, req: Any) -> list[Artifact]:
+    """``<stem>.igs``: the grooved cylinder (the STEP's solid) as IGES (:func:`camfab.cad.iges.shape_dumps`)."""
+    from .iges import shape_dumps
+
+    solid, dev = cylinder_solid(cam, req)
+    text = shape_dumps(solid, name=cam.name)
+    return [Artifact(f"{safe_stem(cam.name)}.igs", text.encode("ascii"), "iges", deviation_mm=dev)]
+
+
 #: cam kinds whose files are made by their own exporters, by output name; an output missing from a kind's
 #: entry does not apply to it (:func:`not_applicable_reason`); None: the pipeline's own stage, which handles the kind
 #: (the report and workbook; the 4-axis program of :mod:`camfab.gcode.rotary`, dispatched in ``pipeline._gcode``)
 KIND_EXPORTERS: dict[str, dict[str, Callable[[Any, Any], list[Artifact]] | None]] = {
     "cylindrical": {"dxf": _cylinder_dxf, "step": _cylinder_step, "xlsx": None, "report": None,
-                    "stl": _cylinder_stl, "gcode": None},
+                    "stl": _cylinder_stl, "gcode": None, "iges": _cylinder_iges},
 }
 
 #: a kind's own outputs that need cadquery: a run skips them with a warning when it is missing, as the STEP
-KIND_CAD_OUTPUTS: dict[str, frozenset[str]] = {"cylindrical": frozenset({"step", "stl"})}
+KIND_CAD_OUTPUTS: dict[str, frozenset[str]] = {"cylindrical": frozenset({"step", "stl", "iges"})}
 
 
 def not_applicable_reason(kind: str, output: str) -> str:

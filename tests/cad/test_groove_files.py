@@ -135,13 +135,18 @@ def test_assembly_roller_sits_in_the_groove_within_the_backlash(tmp_path):
         assert _dist(parts["roller"].wrapped, parts["cam"].wrapped) == pytest.approx(mech.backlash_mm / 2, abs=tol)
 
 
-def test_iges_of_a_groove_is_refused_without_output(tmp_path, capsys):
+def test_iges_of_a_groove_is_the_pocketed_plate(tmp_path):
+    """``--outputs iges`` writes the grooved plate as IGES: read back by OpenCascade, one valid solid with the
+    STEP's volume (the pocket included)."""
     from camfab.cli import main
 
+    from .test_kind_iges import read_iges, volume
+    from .test_step_occ import read_step
+
     out = tmp_path / "out"
-    assert main(["run", "groove_translating", "-o", str(out), "--outputs", "iges"]) == 2
-    assert "IGES of a groove cam is not made yet" in capsys.readouterr().err
-    assert not out.exists() or not any(out.iterdir())
+    assert main(["run", "groove_translating", "-o", str(out), "--outputs", "iges,step"]) == 0
+    iges, step = read_iges(out / "GrooveTranslating.igs"), read_step(out / "GrooveTranslating.step")
+    assert volume(iges) == pytest.approx(volume(step), rel=1e-7)
 
 
 def test_shop_file_names_of_a_groove_are_its_one_plate_files(files):
