@@ -8,6 +8,7 @@ an output a kind's entry lacks does not apply to it: ``camfab run`` and ``camfab
 from __future__ import annotations
 
 import logging
+import math
 import weakref
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -74,16 +75,43 @@ def _cylinder_iges(cam: Any, req: Any) -> list[Artifact]:
     return [Artifact(f"{safe_stem(cam.name)}.igs", text.encode("ascii"), "iges", deviation_mm=dev)]
 
 
+def _cylinder_assembly(cam: Any, req: Any) -> list[Artifact]:
+    """``<stem>_assembly.step`` (and ``_pose<k>`` for ``req.poses``): the grooved cylinder, its shaft and the
+    follower at ``req.angle`` degrees (:mod:`camfab.cad.cylinder_assembly`)."""
+    from ..errors import InputError
+    from ..pipeline import MAX_POSES
+    from .cylinder_assembly import dumps
+
+    if not math.isfinite(req.angle) or abs(req.angle) > 1e6:
+        raise InputError(f"--angle {req.angle}: must be a finite number of at most 1e6 (degrees)")
+    if not 0 <= req.poses <= MAX_POSES:
+        raise InputError(f"--poses {req.poses}: must be a whole number from 0 to {MAX_POSES}")
+    solid, dev = cylinder_solid(cam, req)
+    stem = safe_stem(cam.name)
+
+    def one(deg: float) -> bytes:
+        return dumps(cam.spec, cam.geometry, solid, math.radians(deg % 360.0)).encode("utf-8")
+
+    out = [Artifact(f"{stem}_assembly.step", one(req.angle), "step", None, dev, f"the mechanism at {req.angle:g}°")]
+    width = len(str(req.poses))
+    for k in range(req.poses):
+        at = req.angle + k * 360.0 / req.poses
+        out.append(Artifact(f"{stem}_assembly_pose{k + 1:0{width}d}.step", one(at), "step", None, dev,
+                            f"pose {k + 1} of {req.poses}: {at:g}°"))
+    return out
+
+
 #: cam kinds whose files are made by their own exporters, by output name; an output missing from a kind's
 #: entry does not apply to it (:func:`not_applicable_reason`); None: the pipeline's own stage, which handles the kind
 #: (the report and workbook; the 4-axis program of :mod:`camfab.gcode.rotary`, dispatched in ``pipeline._gcode``)
 KIND_EXPORTERS: dict[str, dict[str, Callable[[Any, Any], list[Artifact]] | None]] = {
     "cylindrical": {"dxf": _cylinder_dxf, "step": _cylinder_step, "xlsx": None, "report": None,
-                    "stl": _cylinder_stl, "gcode": None, "iges": _cylinder_iges},
+                    "stl": _cylinder_stl, "gcode": None, "iges": _cylinder_iges,
+                    "assembly": _cylinder_assembly},
 }
 
 #: a kind's own outputs that need cadquery: a run skips them with a warning when it is missing, as the STEP
-KIND_CAD_OUTPUTS: dict[str, frozenset[str]] = {"cylindrical": frozenset({"step", "stl", "iges"})}
+KIND_CAD_OUTPUTS: dict[str, frozenset[str]] = {"cylindrical": frozenset({"step", "stl", "iges", "assembly"})}
 
 
 def not_applicable_reason(kind: str, output: str) -> str:
