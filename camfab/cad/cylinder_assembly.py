@@ -15,7 +15,7 @@ import math
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -82,7 +82,7 @@ def parts(spec, geometry, solid, phi: float) -> CylinderParts:
 def dumps(spec, geometry, solid, phi: float) -> str:
     """The assembly STEP (AP214) text at cam angle ``phi`` (rad), reproducible (the plate assemblies' header
     and canonical order)."""
-    assy = to_assembly(parts(spec, geometry, solid, phi))
+    assy = to_assembly(cast(Any, parts(spec, geometry, solid, phi)))  # reads its items only
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "assembly.step"  # never a path built from the name
         assy.export(str(path), "STEP")
