@@ -60,6 +60,35 @@ def test_roller_clears_both_flanks_by_half_the_backlash(cam, deg, tmp_path):
     assert _volume(BRepAlgoAPI_Common(pushed.wrapped, body.wrapped).Shape()) > _bound(tol, size, width)
 
 
+OSCILLATING = {"name": "barrel_arm", "cam": {"kind": "cylindrical"},
+               "cylinder": {"radius_mm": 40.0, "length_mm": 70.0, "groove_depth_mm": 10.0, "backlash_mm": 0.05},
+               "follower": {"type": "roller", "motion": "oscillating", "roller_radius_mm": 6.0, "arm_length_mm": 60.0},
+               "motion": [{"law": "cycloidal", "lift": 20.0, "angle_deg": 160.0}, {"law": "dwell", "angle_deg": 20.0},
+                          {"law": "cycloidal", "lift": -20.0, "angle_deg": 160.0}, {"law": "dwell", "angle_deg": 20.0}],
+               "manufacturing": {"tolerance_mm": 0.01}}
+
+
+def test_oscillating_arm_reaches_from_its_pivot_to_the_roller(tmp_path):
+    """An oscillating follower at 80° (mid-rise, arm at 10°): the roller's axis at X = −σ·L(1 − cos φ), clear of
+    both flanks; the arm touches the pin and the pivot, and stands off the cam."""
+    from camfab.design.spec import design_from_dict
+
+    cam = pipeline.Cam(design_from_dict(OSCILLATING))
+    solid, dev = cylinder_solid(cam, pipeline.Request(frozenset({pipeline.Output.ASSEMBLY})))
+    geom, phi = cam.geometry, math.radians(80.0)
+    arm = math.radians(float(geom.program.evaluate([phi], (0,))[0][0]))
+    assert cylinder_assembly.axis_x(geom, phi) == pytest.approx(-60.0 * (1 - math.cos(arm)), abs=1e-9)
+    path = tmp_path / "arm.step"
+    path.write_text(cylinder_assembly.dumps(cam.spec, geom, solid, phi), encoding="utf-8")
+    parts = _read(path)
+    assert set(parts) == {"cam", "shaft", "roller", "pin", "arm", "pivot"}
+    body, half = parts["cam"], geom.cylinder.backlash_mm / 2
+    assert _dist(parts["roller"].wrapped, body.wrapped) == pytest.approx(half, abs=2 * dev + 1e-3)
+    assert _dist(parts["arm"].wrapped, parts["pin"].wrapped) < 1e-6
+    assert _dist(parts["arm"].wrapped, parts["pivot"].wrapped) < 1e-6
+    assert _dist(parts["arm"].wrapped, body.wrapped) > half
+
+
 def test_run_writes_the_assembly(tmp_path):
     res = pipeline.run(pipeline.load("cylindrical_translating"), tmp_path,
                        pipeline.Request(frozenset({pipeline.Output.ASSEMBLY}), angle=30.0))
