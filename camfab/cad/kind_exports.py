@@ -79,7 +79,7 @@ def _cylinder_assembly(cam: Any, req: Any) -> list[Artifact]:
     """``<stem>_assembly.step`` (and ``_pose<k>`` for ``req.poses``): the grooved cylinder, its shaft and the
     follower at ``req.angle`` degrees (:mod:`camfab.cad.cylinder_assembly`)."""
     from ..errors import InputError
-    from ..pipeline import MAX_POSES
+    from ..limits import MAX_POSES
     from .cylinder_assembly import dumps
 
     if not math.isfinite(req.angle) or abs(req.angle) > 1e6:
