@@ -21,7 +21,7 @@ from camfab.cad.kind_exports import cylinder_solid  # noqa: E402
 
 from .test_assembly import _bound, _read, _volume  # noqa: E402
 
-pytestmark = pytest.mark.slow  # one grooved cylinder (~8 s), three assemblies and their distances
+pytestmark = pytest.mark.slow  # grooved cylinders (~6 s each), assemblies and their distances
 
 
 @pytest.fixture(scope="module")

@@ -18,7 +18,7 @@ from OCP.GProp import GProp_GProps  # noqa: E402
 
 from camfab.cad.cylinder import grooved_cylinder, sweep_points  # noqa: E402
 
-pytestmark = pytest.mark.slow  # the grooved cylinder built twice (~8 s each)
+pytestmark = pytest.mark.slow  # the grooved cylinder built twice (~6 s each)
 
 EXAMPLE = Path(__file__).parents[2] / "camfab" / "examples" / "cylindrical_translating.toml"
 TOL = 0.01

@@ -45,7 +45,7 @@ def volume(shape) -> float:
     return props.Mass()
 
 
-@pytest.mark.slow  # one grooved cylinder (~8 s)
+@pytest.mark.slow  # one grooved cylinder (~6 s)
 def test_cylindrical_iges_is_the_step_solid(tmp_path):
     res = run(load(EXAMPLE), tmp_path, Request(frozenset({Output.STEP, Output.IGES})))
     assert "iges" not in res.not_applicable
