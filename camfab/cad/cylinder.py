@@ -6,15 +6,18 @@ flank on ``PROFILE_2`` (the disc cams' layers), each an arc chain within the tol
 (measured), and the developed outline of the cylinder (its ends z = 0 and z = length, the seam x = 0 and
 x = 2πR) on ``OUTLINE``.
 
-STEP: the cylinder (outer radius R + depth/2, length along +Z from z = 0) minus the groove, swept along the
-exact 3D pitch curve (a periodic B-spline through its points, within the tolerance: measured) with the
-follower's roller axis as the sweep's auxiliary spine, through sections (``sweep_multi``): at each of the
-interpolated cam angles the section in the plane normal to the path holds the exact flank points of
+STEP: the cylinder (outer radius R + depth/2, length along +Z from z = 0) minus the groove, a loft
+(``BRepOffsetAPI_ThruSections``) through sections at the interpolated cam angles (:func:`sweep_points`: as many
+as the periodic B-spline through the exact 3D pitch curve needs to lie within the tolerance, measured), closed by
+its first section: each section, in the plane normal to the pitch curve, holds the exact flank points of
 :data:`SECTION_RADII` radii from the groove bottom to past the outer surface (each flank developed on its own
 radius, wrapped, and cut by that plane), so the flanks follow the developed offsets on every radius — not a
 rectangle swept along the pitch curve, whose flanks are right on the pitch cylinder only and pinch a full-depth
 roller by up to w·(1 − (rR + S′²)/(|C_r′||C_R′|)) off it (5 µm in the example).  The groove bottom is the
-straight segment across the two flank points on the bottom radius (flat across, as an end mill's end).
+straight segment across the two flank points on the bottom radius (flat across, as an end mill's end).  The
+loft's edges along the track are iso-curves of its faces (exact pcurves: OCC's boolean argument analyser finds
+nothing; the sweep it replaces had curve-on-surface faults), its faces split in two so none crosses its own seam
+(docs/decisions.md, "Cylindrical cams: the loft, one build, IGES, assembly").
 """
 from __future__ import annotations
 
@@ -32,8 +35,8 @@ from .step import cadquery, solid_dumps
 __all__ = ["developed_curves", "developed_dxf", "grooved_cylinder", "cylinder_solid", "cylinder_step", "cylinder_stl",
            "solid_mesh", "solid_stl", "sweep_points", "SWEEP_POINTS"]
 
-#: points of the 3D pitch curve the STEP's periodic B-spline passes through (per turn) to begin with; doubled
-#: (at most 4 times) until the spline lies within the tolerance (the sweep's cost grows with them: 8 s at 48)
+#: sections of the groove's loft (per turn) to begin with: the points the periodic B-spline through the 3D pitch
+#: curve passes through, doubled (at most 4 times) until it lies within the tolerance (cost: 4.7 s CPU at 48)
 SWEEP_POINTS = 48
 #: how far past the outer surface the groove tool reaches (mm), so the cut leaves no skin
 CLEARANCE_MM = 1.0
