@@ -76,6 +76,8 @@ MAX_PROGRAM_MOVES = 500_000
 MAX_ITEMS = MAX_KNOTS
 #: problems listed by :func:`data_problems` before it sums up the rest
 MAX_LISTED = 100
+#: most assembly poses one run writes (``--poses``; :data:`camfab.pipeline.MAX_POSES`)
+MAX_POSES = 360
 
 
 def preview(value: Any, width: int = 40) -> str:

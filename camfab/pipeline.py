@@ -36,7 +36,7 @@ from .design.spec import DesignSpec
 from .errors import GeometryError, InputError, MissingDependencyError, Problem, SpecError
 from .formats import EXAMPLES_DIR, load_design, resolve_design_path
 from .io import atomic_write, inside, output_folder, safe_stem, write_all
-from .limits import MAX_SIZE_OVER_TOL
+from .limits import MAX_POSES, MAX_SIZE_OVER_TOL
 from .results import CheckReport, IssueCode, Severity, Verdict
 
 __all__ = ["Output", "SHOP_OUTPUTS", "Request", "RunResult", "Cam", "EXPORTERS", "gcode_job", "run", "build_files",
@@ -65,9 +65,6 @@ SHOP_OUTPUTS = (Output.DXF, Output.STEP, Output.STL, Output.GCODE, Output.DRAWIN
 
 #: outputs a run skips, with a warning, when cadquery is missing (the rest is written)
 CAD_OUTPUTS = (Output.STEP, Output.ASSEMBLY, Output.IGES)
-
-#: most assembly poses one run writes (``--poses``)
-MAX_POSES = 360
 
 log = logging.getLogger(__name__)
 
@@ -379,7 +376,11 @@ def _iges(cam: Cam, req: Request) -> list[Artifact]:
     from .cad import iges
     from .cad.export import plate_of
 
-    loops, devs = iges.outlines(cam.shapes(req.tol), cam.tolerance(req.tol))  # refuses a groove cam (README)
+    if cam.shapes(req.tol).groove:  # one plate with the groove pocketed
+        from .cad.groove import groove_iges
+
+        return [groove_iges(cam.spec, cam.geometry, shapes=cam.shapes(req.tol), tol=cam.tolerance(req.tol))]
+    loops, devs = iges.outlines(cam.shapes(req.tol), cam.tolerance(req.tol))
     n = len(loops)
     return [Artifact(f"{safe_stem(cam.name)}{_suffix(i, n)}.igs",
                      iges.dumps(loop, plate_of(cam.spec), name=f"{cam.name}{_suffix(i, n)}").encode("ascii"),

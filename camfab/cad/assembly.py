@@ -367,7 +367,7 @@ def build(spec, geometry, outlines: Sequence[ArcChain], x: float, *, dims: Dimen
     pitch = t + hub + layer_gap
     parts = _Parts([])
     if getattr(geometry.mechanism, "cam_kind", None) == "groove":
-        return _groove_parts(cq, parts, geometry, outlines, x, cam_move, plate, d)
+        return _groove_parts(cq, parts, geometry, outlines, x, cam_move, plate, d, poses[0])
     two = len(outlines) > 1
     for i, outline in enumerate(outlines):
         at = (cam_move, 0.0, i * pitch) if not geometry.closed else (0.0, 0.0, i * pitch)
@@ -388,10 +388,11 @@ def build(spec, geometry, outlines: Sequence[ArcChain], x: float, *, dims: Dimen
 
 
 def _groove_parts(cq, parts: _Parts, geometry, outlines: Sequence[ArcChain], x: float, cam_move: float, plate,
-                  d: Dimensions) -> _Parts:
+                  d: Dimensions, pose: FollowerPose) -> _Parts:
     """A groove cam's assembly: the grooved plate turned to ``x``, the shaft, and the roller (radius R_r) centred on
     the pitch curve in the groove, standing ``clearance`` out of the front face (z = 0) and clear of the floor by
-    as much.  The follower's stem or arm is not drawn yet (README, "Groove cams")."""
+    as much; in front of the plate (2·``clearance`` off its face) the follower: the roller's pin and the stem
+    along the follower's axis past the plate, or the arm from its pivot."""
     from .groove import plate_radius
     from .plate import circle_loop
     from .step import groove_solid
@@ -405,7 +406,23 @@ def _groove_parts(cq, parts: _Parts, geometry, outlines: Sequence[ArcChain], x: 
         parts.add("shaft", _cyl(cq, 0.0, 0.0, plate.bore_mm / 2, -t, 2 * t))
     c = geometry.profiles[0].evaluate_fixed(np.array([x])).pitch[0]
     parts.add("roller", _cyl(cq, float(c[0]), float(c[1]), mech.roller_radius_mm, -d.clearance, depth - d.clearance))
+    _groove_follower(cq, parts, pose, d, plate_radius(geometry))
     return parts
+
+
+def _groove_follower(cq, parts: _Parts, p: FollowerPose, d: Dimensions, plate_r: float) -> None:
+    """The groove cam's follower in front of the plate (:func:`_groove_parts`), in the pose's local frame."""
+    at = (p.origin[0], p.origin[1], 0.0)
+    rot = math.degrees(math.atan2(-p.up[0], p.up[1]))
+    z1 = -2 * d.clearance
+    z0 = z1 - d.arm_thickness
+    parts.add("pin", _cyl(cq, *p.centre, d.pin_diameter / 2, z0, -d.clearance), at, rot)
+    if p.oscillating:
+        parts.add("arm", _bar(cq, (0.0, 0.0), p.centre, d.arm_width, z0, z1), at, rot)
+        parts.add("pivot", _cyl(cq, 0.0, 0.0, d.pivot_diameter / 2, z0 - d.arm_thickness, z1), at, rot)
+    else:  # the stem from the roller's pin out along the follower's axis, past the plate's rim
+        reach = plate_r + math.hypot(*p.origin) + d.stem_diameter
+        parts.add("stem", _bar(cq, p.centre, (p.centre[0], p.centre[1] + reach), d.stem_diameter, z0, z1), at, rot)
 
 
 def to_assembly(parts: _Parts, name: str = "mechanism"):

@@ -6,15 +6,18 @@ flank on ``PROFILE_2`` (the disc cams' layers), each an arc chain within the tol
 (measured), and the developed outline of the cylinder (its ends z = 0 and z = length, the seam x = 0 and
 x = 2πR) on ``OUTLINE``.
 
-STEP: the cylinder (outer radius R + depth/2, length along +Z from z = 0) minus the groove, swept along the
-exact 3D pitch curve (a periodic B-spline through its points, within the tolerance: measured) with the
-follower's roller axis as the sweep's auxiliary spine, through sections (``sweep_multi``): at each of the
-interpolated cam angles the section in the plane normal to the path holds the exact flank points of
+STEP: the cylinder (outer radius R + depth/2, length along +Z from z = 0) minus the groove, a loft
+(``BRepOffsetAPI_ThruSections``) through sections at the interpolated cam angles (:func:`sweep_points`: as many
+as the periodic B-spline through the exact 3D pitch curve needs to lie within the tolerance, measured), closed by
+its first section: each section, in the plane normal to the pitch curve, holds the exact flank points of
 :data:`SECTION_RADII` radii from the groove bottom to past the outer surface (each flank developed on its own
 radius, wrapped, and cut by that plane), so the flanks follow the developed offsets on every radius — not a
 rectangle swept along the pitch curve, whose flanks are right on the pitch cylinder only and pinch a full-depth
 roller by up to w·(1 − (rR + S′²)/(|C_r′||C_R′|)) off it (5 µm in the example).  The groove bottom is the
-straight segment across the two flank points on the bottom radius (flat across, as an end mill's end).
+straight segment across the two flank points on the bottom radius (flat across, as an end mill's end).  The
+loft's edges along the track are iso-curves of its faces (exact pcurves: OCC's boolean argument analyser finds
+nothing; the sweep it replaces had curve-on-surface faults), its faces split in two so none crosses its own seam
+(docs/decisions.md, "Cylindrical cams: the loft, one build, IGES, assembly").
 """
 from __future__ import annotations
 
@@ -29,11 +32,11 @@ from ..textsafe import dxf_string, plain
 from .dxf import LAYERS, ezdxf_module, write_deterministic
 from .step import cadquery, solid_dumps
 
-__all__ = ["developed_curves", "developed_dxf", "grooved_cylinder", "cylinder_step", "cylinder_stl", "solid_mesh",
-           "sweep_points", "SWEEP_POINTS"]
+__all__ = ["developed_curves", "developed_dxf", "grooved_cylinder", "cylinder_solid", "cylinder_step", "cylinder_stl",
+           "solid_mesh", "solid_stl", "sweep_points", "SWEEP_POINTS"]
 
-#: points of the 3D pitch curve the STEP's periodic B-spline passes through (per turn) to begin with; doubled
-#: (at most 4 times) until the spline lies within the tolerance (the sweep's cost grows with them: 8 s at 48)
+#: sections of the groove's loft (per turn) to begin with: the points the periodic B-spline through the 3D pitch
+#: curve passes through, doubled (at most 4 times) until it lies within the tolerance (cost: 4.7 s CPU at 48)
 SWEEP_POINTS = 48
 #: how far past the outer surface the groove tool reaches (mm), so the cut leaves no skin
 CLEARANCE_MM = 1.0
@@ -140,13 +143,9 @@ def grooved_cylinder(geometry: CylindricalGeometry, *, n: int = SWEEP_POINTS, bo
     cyl = geometry.cylinder
     r_far = cyl.outer_radius_mm + CLEARANCE_MM
     radii = np.linspace(cyl.inner_radius_mm, r_far, SECTION_RADII)
-    theta, sections = groove_sections(geometry, n, radii)
-    path = cq.Wire.assembleEdges([cq.Edge.makeSpline([_vec(cq, p) for p in pitch_3d(geometry, theta)],
-                                                     periodic=True)])
-    aux = cq.Wire.assembleEdges([cq.Edge.makeSpline([_vec(cq, p) for p in pitch_3d(geometry, theta, r_far)],
-                                                    periodic=True)])
+    _, sections = groove_sections(geometry, n, radii)
     wires = [cq.Wire.makePolygon([_vec(cq, p) for p in (*sec[0], *sec[1][::-1])], close=True) for sec in sections]
-    groove = cq.Solid.sweep_multi([*wires, wires[0]], path, makeSolid=True, mode=aux)
+    groove = _split_closed(cq, cq.Solid.makeLoft([*wires, wires[0]], False))  # the first section closes the loop
     body = cq.Solid.makeCylinder(cyl.outer_radius_mm, cyl.length_mm, cq.Vector(0, 0, 0), cq.Vector(0, 0, 1))
     solid = body.cut(groove)
     if bore_mm > 0:
@@ -155,6 +154,17 @@ def grooved_cylinder(geometry: CylindricalGeometry, *, n: int = SWEEP_POINTS, bo
         raise ExportError(f"the grooved cylinder is not a valid solid (OCC's checker): groove {cyl.groove_depth_mm:g} "
                           "mm deep swept around the pitch curve. Check the design for an undercut")
     return solid
+
+
+def _split_closed(cq, solid):
+    """``solid`` with each of its closed faces (the loft's, closed around the track) split in two along an
+    iso-line: no face's boundary crosses its own seam, which OCC's STEP reader rebuilt 2.5 µm off (measured)."""
+    from OCP.ShapeUpgrade import ShapeUpgrade_ShapeDivideClosed
+
+    divide = ShapeUpgrade_ShapeDivideClosed(solid.wrapped)
+    divide.SetNbSplitPoints(1)
+    divide.Perform()
+    return cq.Shape.cast(divide.Result())
 
 
 def path_deviation(geometry: CylindricalGeometry, n: int = SWEEP_POINTS, samples: int = 500) -> float:
@@ -176,12 +186,19 @@ def path_deviation(geometry: CylindricalGeometry, n: int = SWEEP_POINTS, samples
     return worst
 
 
+def cylinder_solid(geometry: CylindricalGeometry, *, tol: float, bore_mm: float = 0.0):
+    """The grooved cylinder (:func:`grooved_cylinder` with :func:`sweep_points` sections) and the measured
+    deviation of its pitch path (mm): what the STEP, STL and IGES files and the assembly are made of."""
+    n, dev = sweep_points(geometry, tol)
+    return grooved_cylinder(geometry, n=n, bore_mm=bore_mm), dev
+
+
 def cylinder_step(geometry: CylindricalGeometry, *, tol: float, name: str = "cam",
                   bore_mm: float = 0.0) -> tuple[str, float]:
     """STEP text of the grooved cylinder and the measured deviation of its sweep path (mm); more points when
     the default ones leave the path farther than ``tol`` from the exact curve."""
-    n, dev = sweep_points(geometry, tol)
-    return solid_dumps(grooved_cylinder(geometry, n=n, bore_mm=bore_mm), name=name), dev
+    solid, dev = cylinder_solid(geometry, tol=tol, bore_mm=bore_mm)
+    return solid_dumps(solid, name=name), dev
 
 
 def sweep_points(geometry: CylindricalGeometry, tol: float) -> tuple[int, float]:
@@ -218,8 +235,12 @@ def cylinder_stl(geometry: CylindricalGeometry, *, tol: float, name: str = "cam"
                  bore_mm: float = 0.0) -> tuple[bytes, float]:
     """Binary STL of the grooved cylinder (the STEP's solid, :func:`solid_mesh` within ``tol``) and the sweep
     path's measured deviation (mm; the mesh adds at most ``tol``, OCC's linear deflection)."""
-    n, dev = sweep_points(geometry, tol)
-    mesh = solid_mesh(grooved_cylinder(geometry, n=n, bore_mm=bore_mm), tol)
-    data = mesh.export(file_type="stl")
-    head = f"camfab {plain(name)} units=mm tol={tol:g} grooved cylinder".encode("ascii", "replace")[:80]
-    return head.ljust(80, b" ") + data[80:], dev
+    solid, dev = cylinder_solid(geometry, tol=tol, bore_mm=bore_mm)
+    return solid_stl(solid, tol=tol, name=name), dev
+
+
+def solid_stl(solid, *, tol: float, name: str = "cam", what: str = "grooved cylinder") -> bytes:
+    """Binary STL of the cylinder ``solid`` (:func:`solid_mesh` within ``tol``), camfab's header naming ``what``."""
+    data = solid_mesh(solid, tol).export(file_type="stl")
+    head = f"camfab {plain(name)} units=mm tol={tol:g} {what}".encode("ascii", "replace")[:80]
+    return head.ljust(80, b" ") + data[80:]

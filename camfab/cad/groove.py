@@ -9,6 +9,7 @@ hub) to ``groove_depth_mm``.
   line, the roller-centre path) on ``PITCH_CURVE``, the plate's rim circle on ``PLATE``; with tool paths, the
   centre pass and both flank finishing passes on ``TOOL_PATH``.
 * STEP: the plate solid with the groove pocket (exact lines and arcs).
+* IGES: the STEP's solid (:func:`groove_iges`).
 * STL: the same solid as a watertight mesh, every loop flattened by chords inscribed in its arcs within tol/2.
 """
 from __future__ import annotations
@@ -28,7 +29,7 @@ from .export import Artifact, CamShapes, plate_of, solid_outlines
 from .plate import PlateSpec, bore_loop, circle_loop
 from .stepheader import design_meta
 
-__all__ = ["RIM_MIN_MM", "is_groove", "plate_radius", "groove_artifacts", "groove_mesh"]
+__all__ = ["RIM_MIN_MM", "is_groove", "plate_radius", "groove_artifacts", "groove_mesh", "groove_iges"]
 
 #: the thinnest outer wall of a groove plate (mm)
 RIM_MIN_MM = 3.0
@@ -65,6 +66,18 @@ def groove_artifacts(spec, geometry, formats: list[str], *, shapes: CamShapes, t
         out.append(Artifact(f"{stem}.step", text.encode("utf-8"), "step", inner.n_entities + outer.n_entities,
                             max(devs), f"groove {depth:g} mm deep from the face z = 0"))
     return out
+
+
+def groove_iges(spec, geometry, *, shapes: CamShapes, tol: float) -> Artifact:
+    """``<stem>.igs``: the groove cam's plate with the groove pocketed (the STEP's solid), as IGES."""
+    from .iges import shape_dumps
+
+    (inner, outer), devs = solid_outlines(shapes, tol)
+    solid = step.groove_solid(circle_loop(plate_radius(geometry)), inner, outer, plate_of(spec),
+                              float(geometry.mechanism.groove_depth_mm))
+    text = shape_dumps(solid.val(), name=spec.name)
+    return Artifact(f"{safe_stem(spec.name)}.igs", text.encode("ascii"), "iges", inner.n_entities + outer.n_entities,
+                    max(devs))
 
 
 def _dxf(spec, geometry, shapes: CamShapes, plate: PlateSpec, outline: ArcChain, tol: float, flavour: str,

@@ -1,7 +1,8 @@
 """IGES of the cam plate (for older CAM systems), through OpenCascade's IGES writer, reproducible.
 
-The solid is the STEP's (:func:`camfab.cad.step.plate_solid`: exact lines and arcs), written as an IGES 5.3
-B-rep (manifold solid, type 186).  The global section names camfab and the design's file stem; its two dates are
+The solid is the STEP's (:func:`camfab.cad.step.plate_solid`: exact lines and arcs; a groove cam's pocketed
+plate, a cylindrical cam's grooved cylinder: :func:`shape_dumps`), written as an IGES 5.3 B-rep (manifold solid,
+type 186).  The global section names camfab and the design's file stem; its two dates are
 the STEP header's time stamp (``docs/decisions.md``, "STEP header": ``SOURCE_DATE_EPOCH`` or 1970-01-01), so the
 file is byte-identical from run to run.
 """
@@ -19,7 +20,7 @@ from .plate import PlateSpec
 from .step import cadquery, plate_solid
 from .stepheader import step_timestamp
 
-__all__ = ["dumps", "outlines"]
+__all__ = ["dumps", "outlines", "shape_dumps"]
 
 _DATE = re.compile(r"15H\d{8}\.\d{6}")
 
@@ -30,25 +31,33 @@ def outlines(shapes, tol: float) -> tuple[list, list[float]]:
     Raises
     ------
     ExportError
-        A groove cam: its plate is a pocketed solid, which this writer (one extruded outline) cannot make yet.
+        A groove cam: its plate is a pocketed solid, not one extruded outline
+        (:func:`camfab.cad.groove.groove_iges` writes it).
     """
     from .export import solid_outlines
 
     if shapes.groove:
-        raise ExportError("IGES of a groove cam is not made yet: the IGES writer extrudes one outline and cannot "
-                          "pocket the groove; use the STEP file (step = true) for the grooved plate")
+        raise ExportError("a groove cam's IGES is its pocketed plate (camfab.cad.groove.groove_iges), not one "
+                          "extruded outline")
     return solid_outlines(shapes, tol)
 
 
 def dumps(outline: ArcChain, plate: PlateSpec, *, name: str = "cam") -> str:
     """IGES text of the plate (mm), byte-identical for the same input."""
     cadquery()  # MissingDependencyError when cadquery (and its OCP) is missing
+    return shape_dumps(plate_solid(outline, plate).val(), name=name)
+
+
+def shape_dumps(solid, *, name: str = "cam") -> str:
+    """IGES text of any cadquery solid (mm; a groove cam's pocketed plate, a grooved cylinder), the global
+    section as :func:`dumps` writes it."""
+    cadquery()
     from OCP.IGESControl import IGESControl_Writer
     from OCP.TCollection import TCollection_HAsciiString
 
     stamp = step_timestamp().replace("-", "").replace(":", "").replace("T", ".")  # YYYYMMDD.HHNNSS
     writer = IGESControl_Writer("MM", 1)  # 1: B-rep solids (type 186), not trimmed faces
-    writer.AddShape(plate_solid(outline, plate).val().wrapped)
+    writer.AddShape(solid.wrapped)
     writer.ComputeModel()
     model = writer.Model()
     gs = model.GlobalSection()

@@ -8,6 +8,8 @@ an output a kind's entry lacks does not apply to it: ``camfab run`` and ``camfab
 from __future__ import annotations
 
 import logging
+import math
+import weakref
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -16,7 +18,7 @@ from ..io import safe_stem
 from .artifact import Artifact
 
 __all__ = ["KIND_EXPORTERS", "KIND_CAD_OUTPUTS", "not_applicable_reason", "kind_exporter", "applicable", "applies",
-           "refuse_feature"]
+           "refuse_feature", "cylinder_solid"]
 
 log = logging.getLogger("camfab.pipeline")
 
@@ -38,23 +40,44 @@ def refuse_feature(cam: Any, output: str) -> None:
         raise ExportError(f"{output}: {why}")
 
 
+#: each cam's cylinder solid by (tolerance, bore): built once per design and shared by its STEP, STL, IGES and
+#: assembly (the build is the slow part of a cylindrical run), dropped with the cam
+_SOLIDS: weakref.WeakKeyDictionary[Any, dict[tuple[float, float], tuple[Any, float]]] = weakref.WeakKeyDictionary()
+
+
+def _is_rib(cam: Any) -> bool:
+    return cam.spec.cylinder.rib_width_mm is not None
+
+
+def cylinder_solid(cam: Any, req: Any) -> tuple[Any, float]:
+    """The cam's grooved (or ribbed) cylinder (cadquery solid) and its path's measured deviation (mm), built once
+    per cam, tolerance and bore (:func:`camfab.cad.cylinder.cylinder_solid`, :func:`camfab.cad.rib.rib_solid`)."""
+    from .cylinder import cylinder_solid as grooved  # cadquery only when a file is made
+    from .rib import rib_solid
+
+    tol, bore = cam.tolerance(req.tol), float(cam.spec.manufacturing.bore_mm)
+    made = _SOLIDS.setdefault(cam, {})
+    if (tol, bore) not in made:
+        made[(tol, bore)] = (rib_solid if _is_rib(cam) else grooved)(cam.geometry, tol=tol, bore_mm=bore)
+    return made[(tol, bore)]
+
+
 def _cylinder_step(cam: Any, req: Any) -> list[Artifact]:
     """``<stem>.step``: the grooved cylinder (:mod:`camfab.cad.cylinder`) or the ribbed one (:mod:`.rib`)."""
-    from .cylinder import cylinder_step  # cadquery only when a file is made
-    from .rib import rib_step
+    from .step import solid_dumps
 
-    make = rib_step if cam.spec.cylinder.rib_width_mm is not None else cylinder_step
-    text, dev = make(cam.geometry, tol=cam.tolerance(req.tol), name=cam.name, bore_mm=cam.spec.manufacturing.bore_mm)
+    solid, dev = cylinder_solid(cam, req)
+    text = solid_dumps(solid, name=cam.name)
     return [Artifact(f"{safe_stem(cam.name)}.step", text.encode("utf-8"), "step", deviation_mm=dev)]
 
 
 def _cylinder_stl(cam: Any, req: Any) -> list[Artifact]:
     """``<stem>.stl``: the grooved (or ribbed) cylinder's solid tessellated by OpenCascade."""
-    from .cylinder import cylinder_stl  # cadquery only when a file is made
-    from .rib import rib_stl
+    from .cylinder import solid_stl
 
-    make = rib_stl if cam.spec.cylinder.rib_width_mm is not None else cylinder_stl
-    data, dev = make(cam.geometry, tol=cam.tolerance(req.tol), name=cam.name, bore_mm=cam.spec.manufacturing.bore_mm)
+    solid, dev = cylinder_solid(cam, req)
+    data = solid_stl(solid, tol=cam.tolerance(req.tol), name=cam.name,
+                     what="ribbed cylinder" if _is_rib(cam) else "grooved cylinder")
     return [Artifact(f"{safe_stem(cam.name)}.stl", data, "stl", deviation_mm=dev)]
 
 
@@ -75,16 +98,53 @@ def _cylinder_pdf(cam: Any, req: Any) -> list[Artifact]:
             for a in _cylinder_drawing(cam, req)]
 
 
+def _cylinder_iges(cam: Any, req: Any) -> list[Artifact]:
+    """``<stem>.igs``: the grooved cylinder (the STEP's solid) as IGES (:func:`camfab.cad.iges.shape_dumps`)."""
+    from .iges import shape_dumps
+
+    solid, dev = cylinder_solid(cam, req)
+    text = shape_dumps(solid, name=cam.name)
+    return [Artifact(f"{safe_stem(cam.name)}.igs", text.encode("ascii"), "iges", deviation_mm=dev)]
+
+
+def _cylinder_assembly(cam: Any, req: Any) -> list[Artifact]:
+    """``<stem>_assembly.step`` (and ``_pose<k>`` for ``req.poses``): the grooved cylinder, its shaft and the
+    follower at ``req.angle`` degrees (:mod:`camfab.cad.cylinder_assembly`)."""
+    from ..errors import InputError
+    from ..limits import MAX_POSES
+    from .cylinder_assembly import dumps
+
+    refuse_feature(cam, "assembly")  # a rib: exit 2 naming [cylinder] feature
+    if not math.isfinite(req.angle) or abs(req.angle) > 1e6:
+        raise InputError(f"--angle {req.angle}: must be a finite number of at most 1e6 (degrees)")
+    if not 0 <= req.poses <= MAX_POSES:
+        raise InputError(f"--poses {req.poses}: must be a whole number from 0 to {MAX_POSES}")
+    solid, dev = cylinder_solid(cam, req)
+    stem = safe_stem(cam.name)
+
+    def one(deg: float) -> bytes:
+        return dumps(cam.spec, cam.geometry, solid, math.radians(deg % 360.0)).encode("utf-8")
+
+    out = [Artifact(f"{stem}_assembly.step", one(req.angle), "step", None, dev, f"the mechanism at {req.angle:g}°")]
+    width = len(str(req.poses))
+    for k in range(req.poses):
+        at = req.angle + k * 360.0 / req.poses
+        out.append(Artifact(f"{stem}_assembly_pose{k + 1:0{width}d}.step", one(at), "step", None, dev,
+                            f"pose {k + 1} of {req.poses}: {at:g}°"))
+    return out
+
+
 #: cam kinds whose files are made by their own exporters, by output name; an output missing from a kind's
 #: entry does not apply to it (:func:`not_applicable_reason`); None: the pipeline's own stage, which handles the kind
 #: (the report and workbook; the 4-axis program of :mod:`camfab.gcode.rotary`, dispatched in ``pipeline._gcode``)
 KIND_EXPORTERS: dict[str, dict[str, Callable[[Any, Any], list[Artifact]] | None]] = {
     "cylindrical": {"dxf": _cylinder_dxf, "step": _cylinder_step, "xlsx": None, "report": None,
-                    "stl": _cylinder_stl, "gcode": None, "drawing": _cylinder_drawing, "pdf": _cylinder_pdf},
+                    "stl": _cylinder_stl, "gcode": None, "drawing": _cylinder_drawing, "pdf": _cylinder_pdf,
+                    "iges": _cylinder_iges, "assembly": _cylinder_assembly},
 }
 
 #: a kind's own outputs that need cadquery: a run skips them with a warning when it is missing, as the STEP
-KIND_CAD_OUTPUTS: dict[str, frozenset[str]] = {"cylindrical": frozenset({"step", "stl"})}
+KIND_CAD_OUTPUTS: dict[str, frozenset[str]] = {"cylindrical": frozenset({"step", "stl", "iges", "assembly"})}
 
 
 def not_applicable_reason(kind: str, output: str) -> str:

@@ -17,7 +17,7 @@ from ..textsafe import plain
 from .cylinder import CLEARANCE_MM, SECTION_RADII, groove_sections, solid_mesh, sweep_points
 from .step import cadquery, solid_dumps
 
-__all__ = ["ribbed_cylinder", "rib_step", "rib_stl"]
+__all__ = ["ribbed_cylinder", "rib_solid", "rib_step", "rib_stl"]
 
 
 def _spline(cq, points: np.ndarray):
@@ -44,6 +44,13 @@ def ribbed_cylinder(geometry: CylindricalGeometry, *, n: int, bore_mm: float = 0
         raise ExportError(f"the ribbed cylinder is not one valid solid (OCC's checker): rib {cyl.rib_width_mm:g} mm "
                           f"wide, {cyl.groove_depth_mm:g} mm high. Check the design for an undercut")
     return solid.Solids()[0] if hasattr(solid, "Solids") else solid
+
+
+def rib_solid(geometry: CylindricalGeometry, *, tol: float, bore_mm: float = 0.0):
+    """The ribbed cylinder (:func:`ribbed_cylinder` with :func:`~camfab.cad.cylinder.sweep_points` sections) and
+    the measured deviation of its path (mm): what its STEP, STL and IGES files are made of."""
+    n, dev = sweep_points(geometry, tol)
+    return ribbed_cylinder(geometry, n=n, bore_mm=bore_mm), dev
 
 
 def rib_step(geometry: CylindricalGeometry, *, tol: float, name: str = "cam",

@@ -495,8 +495,9 @@ def cylinder_report(report: Any, geometry: CylindricalGeometry) -> Any:
 
 
 def feature_refusal(cylinder: CylinderSpec | None, output: str) -> str | None:
-    """Why ``output`` is not made for this cylinder's feature (a rib's 4-axis program), or None."""
-    if cylinder is None or cylinder.feature is not Feature.RIB or output != "gcode":
+    """Why ``output`` is not made for this cylinder's feature (a rib's 4-axis program and assembly), or None."""
+    if cylinder is None or cylinder.feature is not Feature.RIB or output not in ("gcode", "assembly"):
         return None
-    return ('not yet made for [cylinder] feature = "rib" (a rib gets dxf, step, stl, xlsx, report and the checks; '
-            'the 4-axis program mills feature = "groove" only)')
+    what = "the 4-axis program mills" if output == "gcode" else "the assembly places one roller in"
+    return ('not yet made for [cylinder] feature = "rib" (a rib gets dxf, step, stl, iges, xlsx, report, the '
+            f'drawing and the checks; {what} feature = "groove" only)')

@@ -16,9 +16,9 @@ trimesh = pytest.importorskip("trimesh")
 from OCP.BRepGProp import BRepGProp  # noqa: E402
 from OCP.GProp import GProp_GProps  # noqa: E402
 
-from camfab.cad.cylinder import grooved_cylinder, sweep_points  # noqa: E402
+from camfab.cad.kind_exports import cylinder_solid  # noqa: E402
 
-pytestmark = pytest.mark.slow  # the grooved cylinder built twice (~20 s each)
+pytestmark = pytest.mark.slow  # the grooved cylinder (~6 s)
 
 EXAMPLE = Path(__file__).parents[2] / "camfab" / "examples" / "cylindrical_translating.toml"
 TOL = 0.01
@@ -32,7 +32,7 @@ def test_run_writes_a_watertight_stl_of_the_step_solid(tmp_path):
     assert data.startswith(b"camfab BarrelCam units=mm")
     mesh = trimesh.load(io.BytesIO(data), file_type="stl")
     assert mesh.is_watertight and mesh.is_volume
-    solid = grooved_cylinder(cam.geometry, n=sweep_points(cam.geometry, TOL)[0])
+    solid, _ = cylinder_solid(cam, Request(frozenset({Output.STL}), tol=TOL))  # the run's, built once
     vol, area = GProp_GProps(), GProp_GProps()
     assert BRepGProp.VolumeProperties_s(solid.wrapped, vol, 1e-6, True) < 1e-5
     BRepGProp.SurfaceProperties_s(solid.wrapped, area, 1e-6, True)

@@ -119,7 +119,8 @@ def test_dxf_layers_and_stl_watertight(files):
 
 def test_assembly_roller_sits_in_the_groove_within_the_backlash(tmp_path):
     """The assembly at several cam angles: the roller (radius R_r, centred on the pitch curve) is b/2 from the
-    grooved plate (OCC distance between the read-back parts): it touches neither flank nor the floor."""
+    grooved plate (OCC distance between the read-back parts): it touches neither flank nor the floor; its pin and
+    the follower's stem stand off the plate."""
     from camfab.cad import assembly
 
     from .test_assembly import _read
@@ -131,17 +132,26 @@ def test_assembly_roller_sits_in_the_groove_within_the_backlash(tmp_path):
         path = tmp_path / f"{ang:g}.step"
         path.write_text(text, encoding="utf-8")
         parts = _read(path)
-        assert {"cam", "shaft", "roller"} <= set(parts)
+        assert {"cam", "shaft", "roller", "pin", "stem"} <= set(parts)
         assert _dist(parts["roller"].wrapped, parts["cam"].wrapped) == pytest.approx(mech.backlash_mm / 2, abs=tol)
+        for other in ("pin", "stem"):  # in front of the plate, off its face
+            assert _dist(parts[other].wrapped, parts["cam"].wrapped) > mech.backlash_mm / 2
+        stem = parts["stem"].BoundingBox()
+        assert stem.ymax > parts["cam"].BoundingBox().ymax  # along the follower's axis (+Y) past the rim
 
 
-def test_iges_of_a_groove_is_refused_without_output(tmp_path, capsys):
+def test_iges_of_a_groove_is_the_pocketed_plate(tmp_path):
+    """``--outputs iges`` writes the grooved plate as IGES: read back by OpenCascade, one valid solid with the
+    STEP's volume (the pocket included)."""
     from camfab.cli import main
 
+    from .test_kind_iges import read_iges, volume
+    from .test_step_occ import read_step
+
     out = tmp_path / "out"
-    assert main(["run", "groove_translating", "-o", str(out), "--outputs", "iges"]) == 2
-    assert "IGES of a groove cam is not made yet" in capsys.readouterr().err
-    assert not out.exists() or not any(out.iterdir())
+    assert main(["run", "groove_translating", "-o", str(out), "--outputs", "iges,step"]) == 0
+    iges, step = read_iges(out / "GrooveTranslating.igs"), read_step(out / "GrooveTranslating.step")
+    assert volume(iges) == pytest.approx(volume(step), rel=1e-7)
 
 
 def test_shop_file_names_of_a_groove_are_its_one_plate_files(files):

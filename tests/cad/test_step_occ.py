@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from camfab import pipeline
+from camfab.cad.kind_exports import kind_exporter
 from camfab.tolerances import MAX_ARC_RADIUS_MM
 
 pytest.importorskip("cadquery", reason="STEP needs cadquery (the step extra)")
@@ -60,7 +61,8 @@ def circle_radii(shape) -> list[float]:
 
 def _check(name: str, tmp_path: Path) -> None:
     cam = pipeline.load(name)
-    arts = pipeline.EXPORTERS[pipeline.Output.STEP](cam, pipeline.Request(frozenset({pipeline.Output.STEP})))
+    step = kind_exporter(cam.spec.cam.kind, "step", pipeline.EXPORTERS[pipeline.Output.STEP])
+    arts = step(cam, pipeline.Request(frozenset({pipeline.Output.STEP})))
     tol = cam.tolerance()
     for art in arts:
         assert art.deviation_mm is not None and art.deviation_mm <= tol
@@ -79,9 +81,47 @@ def test_step_passes_occ_checks(name, tmp_path):
     _check(name, tmp_path)
 
 
-#: examples whose STEP is not a plate: the grooved cylinder passes BRepCheck_Analyzer (tests/cad/test_cylinder_step.py)
-#: but not yet this analyser (self-intersection and curve-on-surface faults of its swept B-spline faces; 9 min): open
+#: examples whose STEP is not a plate: the grooved cylinder (tests/cad/test_cylinder_step.py), whose read-back
+#: fails only the curve-on-surface check, by nanometres (test_cylinder_step_faults_are_nanometre_gaps): open
 NOT_PLATES = ("cylindrical_translating",)
+
+
+def _bop_results(shape) -> list[tuple[str, float]]:
+    a = BOPAlgo_ArgumentAnalyzer()
+    a.SetShape1(shape)
+    for mode in ("ArgumentTypeMode", "CurveOnSurfaceMode", "SelfInterMode", "SmallEdgeMode", "RebuildFaceMode",
+                 "TangentMode", "MergeVertexMode", "MergeEdgeMode", "ContinuityMode"):
+        setattr(a, mode, True)
+    a.Perform()
+    return [(str(r.GetCheckStatus()), r.GetMaxDistance1()) for r in a.GetCheckResult()] if a.HasFaulty() else []
+
+
+@pytest.mark.slow
+def test_cylinder_step_faults_are_nanometre_gaps(tmp_path):
+    """The grooved cylinder (a loft through the groove's sections, cut from the cylinder): the solid as built passes
+    every check; read back from its STEP it has no self-interference, small edge or other fault, and the only
+    faults left are curve-on-surface gaps below 10 nm (0.1 % of the 0.01 mm tolerance) on the groove's opening
+    edges (the boolean's intersection of the lofted flanks with the outer cylinder), where OCC's STEP reader sets
+    each edge's tolerance from a few samples of the gap (1-4e-7 mm) and the analyser finds its peak (≤ 2.5e-6 mm,
+    measured). Before the loft, the swept groove had faults of 4.5e-5 mm on its own edges and took 9 minutes."""
+    from camfab.cad.kind_exports import cylinder_solid
+
+    cam = pipeline.load("cylindrical_translating")
+    solid, _ = cylinder_solid(cam, pipeline.Request(frozenset({pipeline.Output.STEP})))
+    assert _bop_results(solid.wrapped) == []
+    faults = _read_cylinder(cam, tmp_path)
+    assert {status for status, _ in faults} <= {"BOPAlgo_CheckStatus.BOPAlgo_InvalidCurveOnSurface"}
+    assert max((gap for _, gap in faults), default=0.0) < 1e-5
+
+
+def _read_cylinder(cam, tmp_path: Path) -> list[tuple[str, float]]:
+    step = kind_exporter(cam.spec.cam.kind, "step", pipeline.EXPORTERS[pipeline.Output.STEP])
+    (art,) = step(cam, pipeline.Request(frozenset({pipeline.Output.STEP})))
+    path = tmp_path / art.filename
+    path.write_bytes(art.data)
+    shape = read_step(path)
+    assert BRepCheck_Analyzer(shape).IsValid()
+    return _bop_results(shape)
 
 
 @pytest.mark.slow
