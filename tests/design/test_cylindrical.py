@@ -180,9 +180,9 @@ def test_run_writes_the_dxf_and_names_what_does_not_apply(tmp_path):
     from camfab import pipeline
 
     cam = pipeline.load("cylindrical_translating")
-    res = cam.run(tmp_path, ["dxf", "xlsx", "gcode", "drawing", "lift_table"])
+    res = cam.run(tmp_path, ["dxf", "xlsx", "gcode", "lift_table"])
     assert sorted(res.files) == ["BarrelCam.dxf", "BarrelCam.nc", "BarrelCam.xlsx", "check.json"]
-    assert set(res.not_applicable) == {"drawing", "lift_table"}
+    assert set(res.not_applicable) == {"lift_table"}
     assert all("cylindrical" in why for why in res.not_applicable.values())
     check = json.loads((tmp_path / "check.json").read_text())
     assert check["cylinder"]["radii"][0]["radius_mm"] == 35.0
