@@ -376,12 +376,15 @@ def render_report(spec, geometry, report, *, standalone: bool = False, frames: i
     """
     from .animation import animation_data
     from .cylinder_plot import UNROLLED_PLOT_TEXT
+    from .figpool import reusing_figures
     from .plots import report_figures
     from .vibration_plot import VIBRATION_PLOT_TEXT, vibration_figures
 
-    files, plots = plot_files({**report_figures(spec, geometry, report), **vibration_figures(spec, geometry, report)},
-                              standalone=standalone, png=png,
-                              text={**plot_text(geometry), **VIBRATION_PLOT_TEXT, **UNROLLED_PLOT_TEXT})
+    with reusing_figures():  # the figures of the previous design drawn again (byte-identical, cheaper)
+        files, plots = plot_files({**report_figures(spec, geometry, report),
+                                   **vibration_figures(spec, geometry, report)},
+                                  standalone=standalone, png=png,
+                                  text={**plot_text(geometry), **VIBRATION_PLOT_TEXT, **UNROLLED_PLOT_TEXT})
     anim = animation_data(spec, geometry, report, frames=frames)
     html = template_environment().get_template("report.html.j2").render(
         report_context(spec, geometry, report, plots, anim))
