@@ -5,7 +5,8 @@ Inside :func:`reusing_figures` (what :func:`camfab.report.html.render_report` do
 lines, texts, patches and legends removed, the scales, limits, titles, labels and layout as a new figure has
 them — so matplotlib keeps the axes and their tick objects, the largest cost of making a plot after its
 drawing.  The files are byte-identical to a new figure's (tests/report/test_figpool.py); outside the block
-every call makes a new figure, so a figure a caller holds is never redrawn under it.
+every call makes a new figure, so a figure a caller holds is never redrawn under it (docs/decisions.md, "Report
+figures: one draw per save, kept figures").
 """
 from __future__ import annotations
 

@@ -135,9 +135,10 @@ def _fix_titles(ax) -> None:
     """Keep the axes' titles where matplotlib's automatic placement would leave them (just above the axes), and
     turn that placement off when nothing can push them up: no tick marks or labels on top, no x label on top, no
     y offset text ("1e6") and no twin or child axes.  The automatic placement measures the x and y axes' tight
-    boxes (every tick label) at every draw: 40 % of a report plot's save (docs/decisions.md "Plot layout")."""
+    boxes (every tick label) at every draw: ~40 % of a report plot's save, profiled (docs/decisions.md "Report
+    figures: one draw per save, kept figures")."""
     xaxis = ax.xaxis
-    ticks = [t for t in (xaxis.get_major_ticks(numticks=1) + xaxis.get_minor_ticks(numticks=1))]
+    ticks = xaxis.get_major_ticks(numticks=1) + xaxis.get_minor_ticks(numticks=1)
     on_top = any(t.tick2line.get_visible() or t.label2.get_visible() for t in ticks)
     twins = getattr(ax, "_twinned_axes", None)  # matplotlib's grouper of twinx/twiny axes
     if on_top or xaxis.get_label_position() != "bottom" or ax.child_axes \
