@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import base64
 import dataclasses
+import functools
 import json
 import math
 from collections.abc import Mapping
@@ -112,8 +113,10 @@ def _read_asset(name: str) -> str:
     return read_template("report", name)
 
 
+@functools.lru_cache(maxsize=1)
 def template_environment():
-    """The jinja2 environment of the report templates (autoescaping on, loaded from the package)."""
+    """The jinja2 environment of the report templates (autoescaping on, loaded from the package); one per
+    process, so each template is compiled once, not on every page (27 ms CPU each time otherwise)."""
     import jinja2
 
     def load(name: str):
