@@ -148,6 +148,24 @@ def _crosses(quad: np.ndarray, seg: np.ndarray, eps: float = 0.05) -> np.ndarray
     return hit & (d.max(axis=0) > 0) & (d.min(axis=0) < 0)
 
 
+def _any_crosses(quads: np.ndarray, seg: np.ndarray, eps: float = 0.05) -> bool:
+    """Whether any of the segments passes through the inside of any of the boxes ``quads`` (m, 4, 2): the test
+    of :func:`_crosses`, all boxes at once (a new dimension's few lines against every text on the sheet)."""
+    e = np.stack([quads[:, 1] - quads[:, 0], quads[:, 3] - quads[:, 0]], axis=1)  # (m, 2 edges, 2)
+    normals = np.stack([-e[..., 1], e[..., 0]], axis=-1)
+    hit = np.ones((len(quads), len(seg)), dtype=bool)
+    for k in range(2):
+        n = normals[:, k] / np.hypot(normals[:, k, 0], normals[:, k, 1])[:, None]  # (m, 2)
+        q = quads[..., 0] * n[:, :1] + quads[..., 1] * n[:, 1:]  # (m, 4)
+        lo, hi = q.min(axis=1)[:, None] + eps, q.max(axis=1)[:, None] - eps
+        a = seg[None, :, 0] * n[:, :1] + seg[None, :, 1] * n[:, 1:]  # (m, n)
+        b = seg[None, :, 2] * n[:, :1] + seg[None, :, 3] * n[:, 1:]
+        hit &= (np.maximum(a, b) > lo) & (np.minimum(a, b) < hi)
+    nx, ny = seg[:, 1] - seg[:, 3], seg[:, 2] - seg[:, 0]
+    d = nx * (quads[..., :1] - seg[:, 0]) + ny * (quads[..., 1:] - seg[:, 1])  # (m, 4, n): the corners' sides
+    return bool((hit & (d.max(axis=1) > 0) & (d.min(axis=1) < 0)).any())
+
+
 def _overlap(a: np.ndarray, b: np.ndarray, eps: float = 0.05) -> bool:
     """Whether two boxes (corners (4, 2)) share more than a rim of ``eps``."""
     for n in np.vstack([_axes(a), _axes(b)]):
@@ -278,7 +296,7 @@ class Occupancy:
                 return False
             if any(_overlap(q, other) for other in self.quads):
                 return False
-        return not (len(segments) and any(_crosses(q, segments).any() for q in self.quads))
+        return not (len(segments) and self.quads and _any_crosses(np.array(self.quads), segments))
 
     def add(self, quads: list[np.ndarray], segments: np.ndarray) -> None:
         self.quads += quads

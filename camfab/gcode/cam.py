@@ -68,8 +68,11 @@ def cam_program(contact, job: Job, *, tol: float, compensation: str | None = Non
     share = contour_tolerance(tol, post, job.units)
     # the arcs get (1 - REFIT_SHARE) of the share, the chords of arcs above max_r the room the fit leaves
     tol_fit = max(share * (1.0 - REFIT_SHARE), 1e-6)
-    # the offset's shapely cross-check runs at the usual share; a finer fit (a coarse post's rounding) follows
-    path = tool_centre_path(contact, r, tol=max(tol_fit, tol * FIT_SHARE * (1.0 - REFIT_SHARE)))
+    # the finishing contour's arcs are the tool path's own fit at tol_fit (one fit, not one at the usual share and
+    # a finer one after it: the shapely cross-check does not depend on the tolerance); the compensated and
+    # lines-only programs use the tool path only for its size and cross-check, at the usual share
+    usual = max(tol_fit, tol * FIT_SHARE * (1.0 - REFIT_SHARE))
+    path = tool_centre_path(contact, r, tol=tol_fit if arcs_allowed and not compensation else usual)
     max_r = arc_radius_limit(float(np.hypot(*np.asarray(path.arcs.starts, dtype=float).T).max()), cap)
     if compensation:
         # the program carries the part contour (the controller offsets it exactly): its deviation is the claim

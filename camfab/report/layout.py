@@ -90,7 +90,7 @@ def fixed_layout(fig) -> None:
     """Place the figure's axes (one column) with margins measured from its texts; layout engine off."""
     axes = [ax for ax in fig.axes if ax.get_visible()]
     if not axes:
-        fig.set_layout_engine("none")
+        _no_engine(fig)
         return
     renderer = fig.canvas.get_renderer()
     w_in, h_in = fig.get_size_inches()
@@ -112,10 +112,39 @@ def fixed_layout(fig) -> None:
     top_pt, bottom_pt = _EDGE_PT + sup + tops[0], _EDGE_PT + bottoms[-1]
     usable = h_in * 72.0 - top_pt - bottom_pt
     mean_h = (usable - gap * (n - 1)) / n
-    fig.set_layout_engine("none")
+    _no_engine(fig)
     grid = axes[0].get_subplotspec().get_gridspec()
     grid.update(left=(left + _EDGE_PT) / (72.0 * w_in), right=1.0 - (right + _EDGE_PT) / (72.0 * w_in),
                 top=1.0 - top_pt / (72.0 * h_in), bottom=bottom_pt / (72.0 * h_in),
                 hspace=gap / mean_h if n > 1 else 0.0)
     for ax in axes:
         ax.set_position(ax.get_subplotspec().get_position(fig))
+        _fix_titles(ax)
+
+
+def _no_engine(fig) -> None:
+    """Turn the layout engine off altogether: ``set_layout_engine("none")`` leaves a placeholder engine, and
+    with any engine set ``savefig`` draws the whole figure once more (without output) before the real draw."""
+    import matplotlib
+
+    with matplotlib.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
+        fig.set_layout_engine(None)  # with both rc settings off this sets no engine (matplotlib's documented rule)
+
+
+def _fix_titles(ax) -> None:
+    """Keep the axes' titles where matplotlib's automatic placement would leave them (just above the axes), and
+    turn that placement off when nothing can push them up: no tick marks or labels on top, no x label on top, no
+    y offset text ("1e6") and no twin or child axes.  The automatic placement measures the x and y axes' tight
+    boxes (every tick label) at every draw: ~40 % of a report plot's save, profiled (docs/decisions.md "Report
+    figures: one draw per save, kept figures")."""
+    xaxis = ax.xaxis
+    ticks = xaxis.get_major_ticks(numticks=1) + xaxis.get_minor_ticks(numticks=1)
+    on_top = any(t.tick2line.get_visible() or t.label2.get_visible() for t in ticks)
+    twins = getattr(ax, "_twinned_axes", None)  # matplotlib's grouper of twinx/twiny axes
+    if on_top or xaxis.get_label_position() != "bottom" or ax.child_axes \
+            or (twins is not None and len(twins.get_siblings(ax)) > 1):
+        return
+    _tick_labels(ax.yaxis)  # the formatter's offset follows the ticks of the placed axes
+    if ax.yaxis.get_major_formatter().get_offset():
+        return
+    ax._autotitlepos = False  # matplotlib's switch of the automatic placement (set_title(y=...) sets it too)

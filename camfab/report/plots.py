@@ -28,6 +28,7 @@ from ..errors import InputError
 from ..results import Extreme, IssueCode
 from ..textsafe import mpl_text
 from ._common import CURVATURE_CODES, Axis, axis_of, finding_spans, fmt, fmt_at, sample_grid
+from .figpool import figure_with_axes
 from .layout import fixed_layout
 
 __all__ = ["svaj_figure", "profile_figure", "curvature_figure", "pressure_angle_figure", "face_position_figure",
@@ -158,8 +159,7 @@ def svaj_figure(spec, prog, *, n: int = _N):
     lu = spec.follower.lift_unit
     names = {"S": "Displacement S", "V": "Velocity V", "A": "Acceleration A", "J": "Jerk J"}
     with plot_style():
-        fig = new_figure(9.0, 8.6)
-        axes = fig.subplots(4, 1, sharex=True)
+        fig, axes = figure_with_axes("svaj", 9.0, 8.6, lambda f: f.subplots(4, 1, sharex=True))
         for k, ((q, colour), ax) in enumerate(zip(_SVAJ, axes, strict=True)):
             ax.plot(x * axis.scale, vals[k], color=colour)
             ax.axhline(0.0, color="0.2", lw=0.6)
@@ -212,8 +212,7 @@ def profile_figure(spec, geometry, report):
     # a curved face's pitch curve (its centre of curvature) lies a face radius out and would dwarf the cam
     curved = any(c.curved_face for c in geometry.profiles)
     with plot_style():
-        fig = new_figure(8.8, 6.6)
-        ax = fig.subplots()
+        fig, ax = figure_with_axes("profile", 8.8, 6.6, lambda f: f.subplots())
         ax.set_aspect("equal")
         for k, c in enumerate(geometry.profiles):
             x = sample_grid(c.period, c.breakpoints)
@@ -305,8 +304,7 @@ def curvature_figure(spec, geometry, report, *, n: int = _N):
     lim = 3.0 * rmax
     multi = len(geometry.profiles) > 1
     with plot_style():
-        fig = new_figure(9.0, 4.4)
-        ax = fig.subplots()
+        fig, ax = figure_with_axes("curvature", 9.0, 4.4, lambda f: f.subplots())
         lo, hi = 0.0, 0.0
         for k, (c, x, s) in enumerate(_profile_samples(geometry, n)):
             tag = f"{c.label or f'cam {k + 1}'}: " if multi else ""
@@ -357,8 +355,7 @@ def pressure_angle_figure(spec, geometry, report, *, n: int = _N):
     lim = pa.limit if pa is not None else None
     multi = len(geometry.profiles) > 1
     with plot_style():
-        fig = new_figure(9.0, 4.2)
-        ax = fig.subplots()
+        fig, ax = figure_with_axes("pressure_angle", 9.0, 4.2, lambda f: f.subplots())
         for k, (c, x, s) in enumerate(_profile_samples(geometry, n)):
             if s.pressure_angle is None:
                 continue
@@ -406,8 +403,7 @@ def face_position_figure(spec, geometry, report, *, n: int = _N):
     face = report.face_length
     multi = len(geometry.profiles) > 1
     with plot_style():
-        fig = new_figure(9.0, 4.0)
-        ax = fig.subplots()
+        fig, ax = figure_with_axes("face_position", 9.0, 4.0, lambda f: f.subplots())
         for k, (_c, x, s) in enumerate(_profile_samples(geometry, n)):
             if s.face_position is None:
                 continue
@@ -499,8 +495,8 @@ def dynamics_figure(spec, geometry, report, *, n: int = _N):
     xu, fs = axis.unit, spec.dynamics.safety_force_n
     drive_label = "drive torque T (N·m)" if geometry.closed else "drive force (N)"
     with plot_style():
-        fig = new_figure(9.0, 6.4)
-        ax, ax2 = fig.subplots(2, 1, sharex=True, height_ratios=(3, 2))
+        fig, (ax, ax2) = figure_with_axes("dynamics", 9.0, 6.4,
+                                          lambda f: f.subplots(2, 1, sharex=True, height_ratios=(3, 2)))
         force, lim = _finite_view(sm.contact_force, locking)
         ax.plot(x * axis.scale, force, color="C0", label="follower 1" if pair else "contact force N")
         if pair:
