@@ -41,6 +41,7 @@ angle; D does not depend on the speed).
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -62,7 +63,6 @@ from ..results import (
 )
 from ..sets import sorted_unique
 from ..units import DEG, RPM
-from .conjugate import DesmodromicGeometry
 from .profile import CamGeometry, Contact
 
 __all__ = ["Loads", "DynamicsSample", "ContactDynamics", "PairDynamics", "pair_of", "analyse_dynamics"]
@@ -354,7 +354,10 @@ def analyse_dynamics(geometry: CamGeometry, loads: Loads, speed: float, *, prelo
     root refinement.  ``speed`` is ω (rad/s), or mm/s for a translating cam.
     """
     if form_closed is None:
-        form_closed = isinstance(geometry, DesmodromicGeometry)
+        # a desmodromic geometry exists only once its module is loaded (imported on first use: a check of a
+        # spring-loaded cam need not import it)
+        conjugate = sys.modules.get(f"{__package__}.conjugate")
+        form_closed = conjugate is not None and isinstance(geometry, conjugate.DesmodromicGeometry)
     if not form_closed and len(geometry.profiles) != 1:
         raise InputError(f"form_closed=False needs one profile, the geometry has {len(geometry.profiles)}: "
                          "a force-closed cam has one follower; pass form_closed=True for a conjugate pair")

@@ -1,0 +1,114 @@
+"""Exact nearest-site queries in the plane on uniform grids, numpy only.
+
+The deviation measurement of every fit asked ``scipy.spatial.cKDTree`` for its candidates; importing
+``scipy.spatial`` cost ~0.36 s of every ``camfab export`` (it pulls scipy.sparse, scipy.special and scipy.linalg).
+Here the sites are bucketed in square cells, each query takes the sites of the 3×3 cells around it, and its
+answer is certified exact when no site outside those cells can beat it (every such site is at least one cell
+away); queries left uncertified retry on a grid of 8× coarser cells, and the last ones are compared with every
+site (docs/decisions.md, "Start-up and export time").
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+__all__ = ["grid_nearest"]
+
+#: each level's cells are this many times the previous level's
+_GROWTH = 8.0
+#: (query, site) pairs compared at once when a query is compared with every site
+_BRUTE_PAIRS = 2_000_000
+_OFFSETS = np.array([(dx, dy) for dx in (-1, 0, 1) for dy in (-1, 0, 1)], dtype=np.int64)
+
+
+def _candidates(sites: np.ndarray, q: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """Every (query row, site index) pair whose site lies in the 3×3 cells around the query's cell, or None
+    when the grid would need more cells than int64 keys can number."""
+    origin = sites.min(axis=0)
+    cs = np.floor((sites - origin) / cell)
+    nx, ny = cs.max(axis=0) + 1
+    if nx * ny > 2.0 ** 60:
+        return None
+    ny_i = int(ny)
+    ci = cs.astype(np.int64)
+    keys = ci[:, 0] * ny_i + ci[:, 1]
+    order = np.argsort(keys, kind="stable")
+    skeys = keys[order]
+    qc = np.floor((q - origin) / cell)
+    qc = np.clip(qc, -2.0, np.array([nx, ny]) + 1.0).astype(np.int64)  # far queries: no site near, no overflow
+    nb = qc[:, None, :] + _OFFSETS[None, :, :]  # (N, 9, 2)
+    valid = (nb[..., 0] >= 0) & (nb[..., 0] < nx) & (nb[..., 1] >= 0) & (nb[..., 1] < ny)
+    nkey = np.where(valid, nb[..., 0] * ny_i + nb[..., 1], -1)
+    lo = np.searchsorted(skeys, nkey, side="left")
+    hi = np.searchsorted(skeys, nkey, side="right")
+    counts = np.where(valid, hi - lo, 0).ravel()
+    total = int(counts.sum())
+    rows = np.repeat(np.repeat(np.arange(q.shape[0]), 9), counts)
+    first = np.repeat(lo.ravel(), counts)
+    within = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
+    return rows, order[first + within]
+
+
+def _row_minima(rows: np.ndarray, site: np.ndarray, d: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per query row: the smallest ``d`` and its site (the lowest site index among equal distances);
+    ``inf`` and 0 for a row without pairs."""
+    best = np.full(n, np.inf)
+    arg = np.zeros(n, dtype=np.int64)
+    if rows.size:
+        perm = np.lexsort((site, d, rows))
+        r = rows[perm]
+        head = np.concatenate([[True], r[1:] != r[:-1]])
+        best[r[head]] = d[perm][head]
+        arg[r[head]] = site[perm][head]
+    return best, arg
+
+
+def grid_nearest(q: np.ndarray, sites: np.ndarray, cell: float,
+                 distance: Callable[[np.ndarray, np.ndarray], np.ndarray], reach: float = 0.0
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """The smallest ``distance(q_rows, site_indices)`` over every site, for each query point, exactly.
+
+    Parameters
+    ----------
+    q : (N, 2) array
+        Query points.
+    sites : (M, 2) array
+        The sites' positions; ``distance(q, j)`` must be at least ``|q − sites[j]| − reach`` (a site stands for
+        an object within ``reach`` of it, e.g. a short piece of an arc).
+    cell : float
+        The finest cells' side (about the spacing of the sites).
+    distance : callable
+        ``distance(points (K, 2), site indices (K,)) -> (K,)`` distances.
+
+    Returns
+    -------
+    (distance (N,), site index (N,))
+        The minimum over all sites and the site holding it (the lowest index among equal distances).
+    """
+    q = np.asarray(q, dtype=float).reshape(-1, 2)
+    n, m = q.shape[0], sites.shape[0]
+    best = np.full(n, np.inf)
+    arg = np.zeros(n, dtype=np.int64)
+    extent = float(np.ptp(np.vstack([sites, q]), axis=0).max()) if n else 0.0
+    todo = np.arange(n)
+    cell = max(float(cell), 1e-12 * max(extent, 1.0))
+    while todo.size and cell < extent:
+        pairs = _candidates(sites, q[todo], cell)
+        if pairs is None:
+            break
+        rows, site = pairs
+        d, j = _row_minima(rows, site, distance(q[todo][rows], site), todo.size)
+        # a site outside the 3×3 cells is at least `cell` from the query: its object at least cell − reach
+        done = d <= (cell - reach) * (1.0 - 1e-9)
+        best[todo[done]], arg[todo[done]] = d[done], j[done]
+        todo = todo[~done]
+        cell *= _GROWTH
+    step = max(1, _BRUTE_PAIRS // max(m, 1))
+    every = np.arange(m)
+    for c in range(0, todo.size, step):  # what no grid certified: against every site
+        sel = todo[c:c + step]
+        d = distance(np.repeat(q[sel], m, axis=0), np.tile(every, sel.size)).reshape(sel.size, m)
+        arg[sel] = d.argmin(axis=1)
+        best[sel] = d[np.arange(sel.size), arg[sel]]
+    return best, arg
