@@ -19,48 +19,50 @@ __all__ = ["grid_nearest"]
 _GROWTH = 8.0
 #: (query, site) pairs compared at once when a query is compared with every site
 _BRUTE_PAIRS = 2_000_000
-_OFFSETS = np.array([(dx, dy) for dx in (-1, 0, 1) for dy in (-1, 0, 1)], dtype=np.int64)
 
 
 def _candidates(sites: np.ndarray, q: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray] | None:
-    """Every (query row, site index) pair whose site lies in the 3×3 cells around the query's cell, or None
-    when the grid would need more cells than int64 keys can number."""
+    """Every (query row, site index) pair whose site lies in the 3×3 cells around the query's cell, grouped by
+    query row in increasing order, or None when the grid would need more cells than int64 keys can number.
+
+    Keys number the cells column by column, so a query's 3×3 cells are three runs of consecutive keys (one
+    ``searchsorted`` pair each)."""
     origin = sites.min(axis=0)
     cs = np.floor((sites - origin) / cell)
     nx, ny = cs.max(axis=0) + 1
     if nx * ny > 2.0 ** 60:
         return None
     ny_i = int(ny)
-    ci = cs.astype(np.int64)
-    keys = ci[:, 0] * ny_i + ci[:, 1]
+    keys = cs[:, 0].astype(np.int64) * ny_i + cs[:, 1].astype(np.int64)
     order = np.argsort(keys, kind="stable")
     skeys = keys[order]
     qc = np.floor((q - origin) / cell)
     qc = np.clip(qc, -2.0, np.array([nx, ny]) + 1.0).astype(np.int64)  # far queries: no site near, no overflow
-    nb = qc[:, None, :] + _OFFSETS[None, :, :]  # (N, 9, 2)
-    valid = (nb[..., 0] >= 0) & (nb[..., 0] < nx) & (nb[..., 1] >= 0) & (nb[..., 1] < ny)
-    nkey = np.where(valid, nb[..., 0] * ny_i + nb[..., 1], -1)
-    lo = np.searchsorted(skeys, nkey, side="left")
-    hi = np.searchsorted(skeys, nkey, side="right")
+    col = qc[:, 0, None] + np.arange(-1, 2)  # (N, 3) the three columns
+    y_lo = np.maximum(qc[:, 1] - 1, 0)[:, None]
+    y_hi = np.minimum(qc[:, 1] + 1, ny_i - 1)[:, None]
+    valid = (col >= 0) & (col < nx) & (y_lo <= y_hi)
+    lo = np.searchsorted(skeys, col * ny_i + y_lo, side="left")
+    hi = np.searchsorted(skeys, col * ny_i + y_hi, side="right")
     counts = np.where(valid, hi - lo, 0).ravel()
     total = int(counts.sum())
-    rows = np.repeat(np.repeat(np.arange(q.shape[0]), 9), counts)
+    rows = np.repeat(np.repeat(np.arange(q.shape[0]), 3), counts)
     first = np.repeat(lo.ravel(), counts)
     within = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
     return rows, order[first + within]
 
 
 def _row_minima(rows: np.ndarray, site: np.ndarray, d: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Per query row: the smallest ``d`` and its site (the lowest site index among equal distances);
-    ``inf`` and 0 for a row without pairs."""
+    """Per query row (``rows`` grouped in increasing order): the smallest ``d`` and its site (the lowest site
+    index among equal distances); ``inf`` and 0 for a row without pairs."""
     best = np.full(n, np.inf)
     arg = np.zeros(n, dtype=np.int64)
     if rows.size:
-        perm = np.lexsort((site, d, rows))
-        r = rows[perm]
-        head = np.concatenate([[True], r[1:] != r[:-1]])
-        best[r[head]] = d[perm][head]
-        arg[r[head]] = site[perm][head]
+        head = np.flatnonzero(np.concatenate([[True], rows[1:] != rows[:-1]]))
+        r = rows[head]
+        best[r] = np.minimum.reduceat(d, head)
+        tied = np.where(d == best[rows], site, np.iinfo(np.int64).max)
+        arg[r] = np.minimum.reduceat(tied, head)
     return best, arg
 
 
