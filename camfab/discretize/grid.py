@@ -4,8 +4,9 @@ The deviation measurement of every fit asked ``scipy.spatial.cKDTree`` for its c
 ``scipy.spatial`` cost ~0.36 s of every ``camfab export`` (it pulls scipy.sparse, scipy.special and scipy.linalg).
 Here the sites are bucketed in square cells, each query takes the sites of the 3×3 cells around it, and its
 answer is certified exact when no site outside those cells can beat it (every such site is at least one cell
-away); queries left uncertified retry on a grid of 8× coarser cells, and the last ones are compared with every
-site (docs/decisions.md, "Start-up and export time").
+away); queries left uncertified retry on grids of 2×, 4×, … 32× coarser cells, and the last ones are compared
+with every site — or, when many queries lie far from every site (a fit far off its curve), first settled on a k-d tree's
+candidates, the only case that imports scipy.spatial (docs/decisions.md, "Start-up and export time").
 """
 from __future__ import annotations
 
@@ -16,9 +17,13 @@ import numpy as np
 __all__ = ["grid_nearest"]
 
 #: each level's cells are this many times the previous level's
-_GROWTH = 8.0
+_GROWTH = 2.0
 #: (query, site) pairs compared at once when a query is compared with every site
 _BRUTE_PAIRS = 2_000_000
+#: grids tried (each ``_GROWTH`` times coarser); then a k-d tree for many queries left, else every site
+_LEVELS = 6
+#: candidates per query of the k-d tree pass
+_KD_K = 32
 
 
 def _candidates(sites: np.ndarray, q: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray] | None:
@@ -95,7 +100,9 @@ def grid_nearest(q: np.ndarray, sites: np.ndarray, cell: float,
     extent = float(np.ptp(np.vstack([sites, q]), axis=0).max()) if n else 0.0
     todo = np.arange(n)
     cell = max(float(cell), 1e-12 * max(extent, 1.0))
-    while todo.size and cell < extent:
+    for _ in range(_LEVELS):
+        if not todo.size or cell >= extent:
+            break
         pairs = _candidates(sites, q[todo], cell)
         if pairs is None:
             break
@@ -106,6 +113,8 @@ def grid_nearest(q: np.ndarray, sites: np.ndarray, cell: float,
         best[todo[done]], arg[todo[done]] = d[done], j[done]
         todo = todo[~done]
         cell *= _GROWTH
+    if todo.size * m > _BRUTE_PAIRS:  # many queries far from every site: a k-d tree's candidates
+        todo = _kdtree_pass(q, sites, distance, reach, todo, best, arg)
     step = max(1, _BRUTE_PAIRS // max(m, 1))
     every = np.arange(m)
     for c in range(0, todo.size, step):  # what no grid certified: against every site
@@ -114,3 +123,22 @@ def grid_nearest(q: np.ndarray, sites: np.ndarray, cell: float,
         arg[sel] = d.argmin(axis=1)
         best[sel] = d[np.arange(sel.size), arg[sel]]
     return best, arg
+
+
+def _kdtree_pass(q: np.ndarray, sites: np.ndarray, distance: Callable[[np.ndarray, np.ndarray], np.ndarray],
+                 reach: float, todo: np.ndarray, best: np.ndarray, arg: np.ndarray) -> np.ndarray:
+    """Settle the queries ``todo`` on the ``_KD_K`` nearest sites of a k-d tree (filling ``best`` and ``arg``);
+    returns those whose answer the tree's candidates do not prove (the k-th site within the best distance plus
+    ``reach``).  Only queries far from every site come here (a fit far off its curve), so scipy.spatial is
+    imported only then."""
+    from scipy.spatial import cKDTree
+
+    k = min(_KD_K, sites.shape[0])
+    dm, idx = cKDTree(sites).query(q[todo], k=k)
+    dm, idx = dm.reshape(todo.size, k), idx.reshape(todo.size, k)
+    d = distance(np.repeat(q[todo], k, axis=0), idx.ravel()).reshape(todo.size, k)
+    j = np.lexsort((idx, d))[:, 0]  # per row: the smallest distance, the lowest site among equal ones
+    rows = np.arange(todo.size)
+    best[todo], arg[todo] = d[rows, j], idx[rows, j]
+    sure = (k == sites.shape[0]) | (dm[:, -1] - reach >= d[rows, j] * (1.0 + 1e-9))
+    return todo[~sure]

@@ -81,7 +81,9 @@ class _CurveProjector:
         self.n = sur.x.size - 1
         self.sites = sur.points[:-1] if self.curve.closed else sur.points
         step = np.diff(sur.points, axis=0)
-        self.cell = float(np.hypot(step[:, 0], step[:, 1]).max())
+        # twice the typical spacing: a query near the curve is settled in the finest grid; one far from it (or
+        # near a sparse stretch) on a coarser one
+        self.cell = 2.0 * float(np.median(np.hypot(step[:, 0], step[:, 1])))
 
     def nearest(self, x: np.ndarray) -> np.ndarray:
         """Index of the curve sample nearest to each ``x`` ``(N, 2)``."""

@@ -55,6 +55,8 @@ def test_grid_nearest_is_the_brute_force_nearest():
         (rng.normal(size=(500, 2)), rng.normal(size=(300, 2))),  # scattered
         (rng.normal(size=(500, 2)), 1e3 * rng.normal(size=(50, 2))),  # queries far outside the sites
         (np.c_[np.cos(t := np.linspace(0, 6, 1500)), np.sin(t)] * 40, rng.normal(scale=30, size=(200, 2))),
+        # a dense ring and far queries: the k-d tree pass
+        (np.c_[np.cos(t := np.linspace(0, 6, 20000)), np.sin(t)] * 40, rng.normal(scale=80, size=(200, 2))),
         (np.zeros((3, 2)), rng.normal(size=(20, 2))),  # all sites at one point
         (np.array([[1.0, 2.0]]), rng.normal(size=(5, 2))),
     ]:
