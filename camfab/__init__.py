@@ -11,7 +11,8 @@ angle, its files::
     >>> "ejemplo9rt" in camfab.examples()
     True
 
-Import submodules only for what this façade does not offer.  ``import camfab`` stays light: the pipeline
+Import submodules only for what this façade does not offer.  ``import camfab`` stays light (no numpy): the
+design names are imported on first use, the pipeline
 (and with it the exporters) is imported on first use of :func:`load`, :class:`Cam` or :func:`examples`, and
 heavy optional dependencies (cadquery, matplotlib) only by the artifacts that need them.
 
@@ -28,7 +29,6 @@ from __future__ import annotations
 import logging
 from typing import TYPE_CHECKING, Any
 
-from .design import LAWS, DesignSpec, MotionProgram, analyse_motion, build_program, design_from_dict
 from .errors import (
     ApiError,
     CamfabError,
@@ -40,10 +40,11 @@ from .errors import (
     Problem,
     SpecError,
 )
-from .formats import load_design
 from .version import __version__
 
 if TYPE_CHECKING:
+    from .design import LAWS, DesignSpec, MotionProgram, analyse_motion, build_program, design_from_dict
+    from .formats import load_design
     from .pipeline import Cam, examples, load
 
 __all__ = [
@@ -70,6 +71,9 @@ __all__ = [
 ]
 
 _LAZY = ("load", "examples", "Cam")
+#: the design names, imported on first use too: ``import camfab`` loads no numpy, so ``python -m camfab`` can set
+#: the BLAS thread count before numpy starts (docs/decisions.md, "Start-up and export time")
+_LAZY_DESIGN = ("LAWS", "DesignSpec", "MotionProgram", "analyse_motion", "build_program", "design_from_dict")
 
 logging.getLogger(__name__).addHandler(logging.NullHandler())
 
@@ -80,4 +84,16 @@ def __getattr__(name: str) -> Any:
         from . import pipeline
 
         return getattr(pipeline, name)
+    if name in _LAZY_DESIGN:
+        from . import design
+
+        return getattr(design, name)
+    if name == "load_design":
+        from .formats import load_design
+
+        return load_design
+    if name in ("design", "formats", "results", "errors", "geom2d"):  # as when __init__ imported them
+        import importlib
+
+        return importlib.import_module(f"{__name__}.{name}")
     raise AttributeError(f"module 'camfab' has no attribute {name!r}")

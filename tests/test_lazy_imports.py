@@ -1,6 +1,7 @@
 """``camfab check`` loads only what checking needs: none of the heavy libraries (plotting, pages, CAD,
 spreadsheets, meshes, scipy) and none of camfab's exporters — the guard behind its start-up time
-(docs/decisions.md "Lazy imports"); and the scipy-free Brent root finder camfab uses instead of
+(docs/decisions.md "Lazy imports"), nor the cam families and models its design does not use, with BLAS on one
+thread (docs/decisions.md "Start-up and export time"); and the scipy-free Brent root finder camfab uses instead of
 ``scipy.optimize.brentq`` gives scipy's roots bit for bit."""
 from __future__ import annotations
 
@@ -26,21 +27,32 @@ EXPORTERS = ("camfab.cad.export", "camfab.cad.dxf", "camfab.cad.step", "camfab.c
              "camfab.report.html", "camfab.package")
 
 _RUN = """
-import json, runpy, sys
+import json, os, runpy, sys
 sys.argv = ["camfab", *sys.argv[1:]]
 try:
     runpy.run_module("camfab", run_name="__main__", alter_sys=True)
 except SystemExit as e:
     code = e.code
-print(json.dumps({"code": code, "modules": sorted(sys.modules)}), file=sys.stderr)
+from threadpoolctl import threadpool_info
+blas = [p["num_threads"] for p in threadpool_info() if p["user_api"] == "blas"]
+print(json.dumps({"code": code, "modules": sorted(sys.modules), "blas_threads": blas,
+                  "env": {k: os.environ.get(k) for k in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS")}}),
+      file=sys.stderr)
 """
+#: the variables any BLAS reads for its thread count (none set: the command line's default applies)
+_THREAD_VARS = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "GOTO_NUM_THREADS")
+
+
+def _run(tmp_path: Path, *args: str, **env_over: str) -> dict:
+    env = {k: v for k, v in os.environ.items() if k not in _THREAD_VARS}
+    env.update(PYTHONPATH=str(ROOT), **env_over)
+    r = subprocess.run([sys.executable, "-c", _RUN, *args], cwd=tmp_path, env=env, capture_output=True,
+                       text=True, timeout=120)
+    return json.loads(r.stderr.strip().splitlines()[-1])
 
 
 def _modules_after(tmp_path: Path, *args: str) -> tuple[int, set[str]]:
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    r = subprocess.run([sys.executable, "-c", _RUN, *args], cwd=tmp_path, env=env, capture_output=True,
-                       text=True, timeout=120)
-    last = json.loads(r.stderr.strip().splitlines()[-1])
+    last = _run(tmp_path, *args)
     return last["code"], set(last["modules"])
 
 
@@ -79,3 +91,43 @@ def test_brentq_refuses_what_scipy_refuses():
     with pytest.raises(RuntimeError, match="converge"):
         brentq(lambda x: x, -1.0, 2.0, maxiter=1)
     assert brentq(lambda x: x, 0.0, 1.0) == 0.0  # a root at an end is returned as given
+
+
+#: camfab's modules a check of each design must not import (each is imported on first use by the designs that
+#: have it: the other cam families, the force/stress/vibration models without [dynamics], sizing)
+_FAMILIES = ("conjugate", "cylindrical", "curved", "groove", "symmetric", "wedge")
+_MODELS = ("dynamics", "strength", "vibration", "vibration_results", "sizing_plan", "sizing")
+_NOT_NEEDED = {
+    "ejemplo9rt": [*_FAMILIES, "faces", *_MODELS],
+    "ejemplo8da_conjugate": ["cylindrical", "curved", "groove", "wedge", "sizing_plan", "vibration"],
+    "constant_width": ["cylindrical", "curved", "groove", "wedge", "sizing_plan", "sizing", "vibration"],
+    "cylindrical_translating": ["conjugate", "curved", "groove", "symmetric", "wedge", *_MODELS],
+}
+
+
+@pytest.mark.parametrize("example", sorted(_NOT_NEEDED))
+def test_check_imports_only_its_own_family_and_models(tmp_path, example):
+    code, mods = _modules_after(tmp_path, "check", example)
+    assert code in (0, 1), code
+    loaded = sorted(m for m in _NOT_NEEDED[example] if f"camfab.design.{m}" in mods)
+    assert not loaded, f"`camfab check {example}` imported camfab.design.{loaded}"
+
+
+def test_import_camfab_loads_no_numpy():
+    """``import camfab`` is light: the command line sets BLAS's thread count before numpy starts."""
+    code = "import sys, camfab; camfab.__version__; print('numpy' in sys.modules)"
+    r = subprocess.run([sys.executable, "-c", code], env=dict(os.environ, PYTHONPATH=str(ROOT)), capture_output=True,
+                       text=True, timeout=60, check=True)
+    assert r.stdout.strip() == "False"
+
+
+def test_cli_runs_blas_on_one_thread_unless_the_user_says(tmp_path):
+    """``camfab`` sets OpenBLAS/OpenMP to one thread before numpy is imported (docs/decisions.md, "Start-up and
+    export time"); a thread count the user set (any BLAS variable) is left as it is."""
+    default = _run(tmp_path, "check", "ejemplo9rt")
+    assert default["env"] == {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+    assert default["blas_threads"] and set(default["blas_threads"]) == {1}
+    user = _run(tmp_path, "check", "ejemplo9rt", OMP_NUM_THREADS="2")
+    assert user["env"] == {"OPENBLAS_NUM_THREADS": None, "OMP_NUM_THREADS": "2"}
+    if (os.cpu_count() or 1) >= 2:  # OpenBLAS caps the count at the cores
+        assert set(user["blas_threads"]) == {2}

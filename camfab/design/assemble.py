@@ -7,19 +7,20 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import sys
+from typing import TYPE_CHECKING
 
 from ..errors import InputError
 from ..results import CheckReport, DynamicsReport, Finding
 from .checks import check
-from .cylindrical import CylindricalGeometry, cylinder_report
-from .dynamics import ContactDynamics, Loads, PairDynamics, analyse_dynamics, pair_of
 from .mechanisms import geometry_from_spec, mechanism_from_spec
 from .profile import CamGeometry
 from .spec import DesignSpec, DynamicsSpec
-from .strength import BALL, ROLLER, StrengthInput
-from .vibration import analyse_vibration
-from .vibration_results import VibrationReport
-from .vibration_spec import train_of
+
+if TYPE_CHECKING:  # the force, stress and vibration models are imported by the designs that have them
+    from .dynamics import ContactDynamics, Loads, PairDynamics
+    from .strength import StrengthInput
+    from .vibration_results import VibrationReport
 
 __all__ = ["mechanism_from_spec", "geometry_from_spec", "check_design", "knot_findings", "loads_from_spec",
            "dynamics_of", "dynamics_model", "is_form_closed", "vibration_of", "strength_input"]
@@ -33,8 +34,9 @@ def check_design(spec: DesignSpec, *, tool_radius_mm: float | None = None) -> Ch
                    allow_acceleration_jump=spec.cam.kind in ("constant_width", "constant_diameter"),
                    tool_radius_mm=tool_radius_mm, face_margin_mm=spec.face_margin_mm,
                    name=spec.name, speed=spec.speed, strength=strength_input(spec, geom))
-    if isinstance(geom, CylindricalGeometry):
-        report = cylinder_report(report, geom)
+    cylindrical = sys.modules.get(f"{__package__}.cylindrical")  # imported on first use by its families only
+    if cylindrical is not None and isinstance(geom, cylindrical.CylindricalGeometry):
+        report = cylindrical.cylinder_report(report, geom)
     extra = knot_findings(spec)
     if spec.dynamics is not None:
         dyn = dynamics_of(spec, geom)
@@ -52,6 +54,8 @@ def check_design(spec: DesignSpec, *, tool_radius_mm: float | None = None) -> Ch
 def loads_from_spec(d: DynamicsSpec) -> Loads:
     """``[dynamics]`` (units in the key names) → :class:`Loads` in SI units of the follower's
     coordinate (m, or rad for an arm)."""
+    from .dynamics import Loads
+
     per_deg = 180.0 / math.pi  # N·m per degree → per radian
     if d.motion == "oscillating":
         return Loads(d.inertia, d.spring_rate * per_deg, d.spring_preload, d.damping * per_deg, d.external,
@@ -70,6 +74,8 @@ def dynamics_model(spec: DesignSpec, geometry: CamGeometry) -> ContactDynamics |
     if spec.dynamics is None:
         raise InputError(f"{spec.name} has no [dynamics] section: add one (mass_kg or inertia_kg_m2, spring, loads) "
                          "for its force model")
+    from .dynamics import ContactDynamics, pair_of
+
     loads = loads_from_spec(spec.dynamics)
     if is_form_closed(spec):
         return pair_of(geometry, loads, spec.speed)
@@ -81,6 +87,8 @@ def dynamics_of(spec: DesignSpec, geometry: CamGeometry | None = None) -> Dynami
     if spec.dynamics is None:
         raise InputError(f"{spec.name} has no [dynamics] section: add one (mass_kg or inertia_kg_m2, spring, loads) "
                          "to analyse the forces")
+    from .dynamics import analyse_dynamics
+
     geom = geometry if geometry is not None else geometry_from_spec(spec)
     return analyse_dynamics(geom, loads_from_spec(spec.dynamics), spec.speed,
                             preload_unit=spec.dynamics.preload_unit,
@@ -93,6 +101,8 @@ def strength_input(spec: DesignSpec, geometry: CamGeometry) -> StrengthInput | N
     st = spec.strength
     if st is None:
         return None
+    from .strength import BALL, ROLLER, StrengthInput
+
     dyn = dynamics_model(spec, geometry) if spec.dynamics is not None else None
     return StrengthInput(dyn, st.cam, st.follower, st.width_mm, st.allowable_mpa, st.dynamic_rating_n,
                          BALL if st.ball_bearing else ROLLER, st.notes,
@@ -111,6 +121,9 @@ def vibration_of(spec: DesignSpec, geometry: CamGeometry | None = None) -> Vibra
     if spec.vibration is None or spec.dynamics is None:
         raise InputError(f"{spec.name} has no [vibration] (and [dynamics]) section: add one (the train's stiffness "
                          "and damping ratio) to analyse the follower's vibration")
+    from .vibration import analyse_vibration
+    from .vibration_spec import train_of
+
     geom = geometry if geometry is not None else geometry_from_spec(spec)
     return analyse_vibration(geom.profiles[0], loads_from_spec(spec.dynamics), train_of(spec.vibration), spec.speed,
                              harmonics=spec.vibration.harmonics)

@@ -20,7 +20,7 @@ from typing import Any
 from ..errors import Problem, SpecError
 from ..limits import MAX_LENGTH_MM, MAX_LIFT_MM, MAX_SEGMENTS, data_problems
 from ..units import DEG, RPM
-from .cylindrical import CylinderSpec, cylinder_section
+from .cylinder_spec import CylinderSpec, cylinder_section
 from .drawing import DrawingSpec, drawing_section
 from .kinds import CamKind, Direction, FollowerMotion, FollowerType, LiftUnit, Rotation
 from .knots import KnotFile, KnotTable, build_knot_table
@@ -41,7 +41,7 @@ from .shop import (
     manufacturing_section,
     outputs_section,
 )
-from .sizing_plan import SizingSpec, sizing_section
+from .sizing_spec import SizingSpec, sizing_section
 from .strength_spec import StrengthSpec, strength_section
 from .validator import Validator
 from .vibration_spec import VibrationSpec, vibration_section

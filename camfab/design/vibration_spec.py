@@ -13,11 +13,13 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from .kinds import CamKind, FollowerMotion
 from .validator import Validator
-from .vibration import Train
+
+if TYPE_CHECKING:
+    from .vibration import Train
 
 __all__ = ["VibrationSpec", "vibration_section", "train_of", "DAMPING_RATIO_MAX", "HARMONICS_MAX"]
 
@@ -48,6 +50,8 @@ class VibrationSpec:
 def train_of(spec: VibrationSpec) -> Train:
     """The :class:`~camfab.design.vibration.Train` in SI units of the follower's coordinate (N/m or N·m/rad)."""
     k = spec.stiffness * (180.0 / math.pi if spec.motion == FollowerMotion.OSCILLATING else 1e3)
+    from .vibration import Train  # the vibration model, imported by the designs that have [vibration]
+
     return Train(k, spec.damping_ratio)
 
 

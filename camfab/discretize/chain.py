@@ -9,6 +9,7 @@ import numpy as np
 
 from ..geom2d import TWO_PI, J, cross, dot, rotate, unit
 from .entities import LINE_SWEEP_RAD, MAX_ARC_SWEEP_RAD, arc_from, entity_distance, entity_point
+from .grid import grid_nearest
 
 __all__ = ["Chain", "merge_cocircular"]
 
@@ -51,10 +52,10 @@ class Chain:
     def distance(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Exact distance from each point of ``q`` ``(N, 2)`` to the chain, and the nearest entity.
 
-        A k-d tree on the midpoints of short sub-pieces of the entities (each
-        at most ``h`` long) proposes candidates; the answer is exact because a
-        point is re-checked with more candidates, and finally against every
-        entity, unless the nearest unexamined sub-piece is provably too far.
+        The entities are cut into short sub-pieces (each at most ``h`` long) whose midpoints are bucketed
+        on a grid (:func:`~camfab.discretize.grid.grid_nearest`); a point is compared with the entities of
+        the sub-pieces around it, and the answer is exact because a point is re-checked on coarser grids,
+        and finally against every entity, unless every unexamined sub-piece is provably too far.
         """
         q = np.asarray(q, dtype=float).reshape(-1, 2)
         h = max(float(np.median(self.length)), float(self.length.sum()) / (4 * self.n))
@@ -63,35 +64,9 @@ class Chain:
         j = np.arange(owner.size) - np.repeat(np.cumsum(parts) - parts, parts)
         u = self.length[owner] * (j + 0.5) / parts[owner]
         mid = entity_point(self.start[owner], self.tangent[owner], self.curvature[owner], u)
-        reach = 0.5 * float((self.length / parts).max())
-        from scipy.spatial import cKDTree  # lazy: scipy.spatial costs ~0.3 s of every command's start
-
-        tree = cKDTree(mid)
-        dist = np.full(q.shape[0], np.inf)
-        which = np.zeros(q.shape[0], dtype=int)
-        todo = np.arange(q.shape[0])
-        for k in (4, 64):
-            k = min(k, owner.size)
-            dm, idx = tree.query(q[todo], k=k)
-            dm, idx = dm.reshape(todo.size, k), owner[idx.reshape(todo.size, k)]
-            d = self._dist_to(q[todo, None], idx)
-            best = d.argmin(axis=1)
-            dist[todo] = d[np.arange(todo.size), best]
-            which[todo] = idx[np.arange(todo.size), best]
-            if k == owner.size:
-                return dist, which
-            todo = todo[dm[:, -1] - reach < dist[todo]]
-            if todo.size == 0:
-                return dist, which
-        step = max(1, 2_000_000 // self.n)
-        allidx = np.arange(self.n)[None, :]
-        for c in range(0, todo.size, step):
-            sel = todo[c:c + step]
-            dd = self._dist_to(q[sel, None], allidx)
-            b = dd.argmin(axis=1)
-            dist[sel] = dd[np.arange(sel.size), b]
-            which[sel] = b
-        return dist, which
+        piece = float((self.length / parts).max())
+        dist, part = grid_nearest(q, mid, piece, lambda x, p: self._dist_to(x, owner[p]), reach=0.5 * piece)
+        return dist, owner[part]
 
     def _dist_to(self, q: np.ndarray, idx: np.ndarray) -> np.ndarray:
         return entity_distance(q, self.start[idx], self.tangent[idx], self.curvature[idx],

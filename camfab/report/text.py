@@ -6,10 +6,10 @@ written here.
 from __future__ import annotations
 
 import math
+import sys
 
 import numpy as np
 
-from ..design.vibration_results import VibrationSummary
 from ..results import FORCE_CODES, IssueCode, Verdict
 from ..textsafe import plain
 
@@ -180,7 +180,8 @@ def _num(v) -> str:
 def _vibration_lines(report) -> list[str]:
     """The ``camfab check`` text lines of the follower vibration (none without ``[vibration]``)."""
     v = report.vibration
-    if not isinstance(v, VibrationSummary):
+    results = sys.modules.get("camfab.design.vibration_results")  # loaded by a design that has [vibration]
+    if results is None or not isinstance(v, results.VibrationSummary):
         return []
     sep = v.separation_speed
     f = v.contact_force
