@@ -7,12 +7,14 @@ r = Z (x = −σ·r·A in radians, z = X; σ = +1 cw), so each cutting move is s
 
 * **deviation** — every centre-pass point within ``tol`` of the exact pitch curve on its radius; every
   finishing-pass point (its lead-in and lead-out, the first and last move of the pass, left out) within ``tol``
-  of its flank's cutter path there: the pitch curve offset by ``w(r) − r_c`` towards the flank its comment
-  names (``DEVIATION``, the worst line of each pass);
+  of its flank's cutter path there: the axis of a radial cutter whose exact section on that cylinder (the
+  stretched circle of :mod:`camfab.design.roller_section`, h = r_c) touches the flank its comment names
+  (``DEVIATION``, the worst line of each pass);
 * **gouge** — the cutter's axis is radial and reaches from its tip to the outer radius: on six radii from the tip
-  to the outer surface, its section (a circle of radius r_c on that developed cylinder, as the design checks
-  model the roller) must stay in the groove, ``|s| + r_c ≤ w + tol`` with s the axis's distance from the exact
-  pitch curve there (``GOUGE``; every cutting move, plunges and leads included);
+  to the outer surface, its exact section there (centred on the axis's developed point) must stay in the groove:
+  its point facing each flank no more than ``tol`` past that flank's exact section
+  (:func:`~camfab.gcode.rotary_finish.cutter_penetration`; ``GOUGE``; every cutting move, plunges and leads
+  included);
 * **coverage** — the centre pass on the groove bottom and each flank's finishing pass run the whole 360° track:
   4096 probes of each exact path (cam angles 0 to the period) no farther than ``tol`` from the moves
   (``COVERAGE``); **depth** — nothing below the groove bottom (``TOO_DEEP``), the finishing passes and the last
@@ -36,7 +38,7 @@ import numpy as np
 
 from ..results import Finding, IssueCode
 from .model import Job
-from .rotary_finish import finishing_direction, flank_path, pitch_distance
+from .rotary_finish import cutter_penetration, finishing_direction, flank_path, pitch_distance
 from .rotary_read import RotaryMove, RotaryReadError, read_rotary
 from .verify import VerifyReport
 
@@ -159,11 +161,38 @@ def _deviation(ctx: _Context) -> tuple[float | None, float | None, list[Finding]
         keep |= np.array([int(i) in inner for i in ctx.finish.move], dtype=bool)
     f = ctx.finish.subset(keep)
     side = np.array([ctx.flank_of(mv[i].label) for i in f.move], dtype=float)
-    dev_f = np.abs(side * _by_radius(ctx.g, f, ctx.sigma) - (ctx.w(f.Z) - ctx.r_c)) if len(f.Z) else np.zeros(0)
-    dev_f[side == 0] = np.inf
+    dev_f = np.full(len(f.Z), np.inf)
+    for fl in (1, -1):
+        k = side == fl
+        if np.any(k):
+            dev_f[k] = _from_cutter_path(ctx, f.subset(k), fl)
     out += _worst_per_pass(dev_f, f, mv, ctx.tol, IssueCode.DEVIATION, "off its flank's exact cutter path by")
     best = lambda v: float(np.max(v)) if len(v) else None  # noqa: E731
     return best(dev_c), best(dev_f), out, len(set(f.move.tolist()))
+
+
+def _from_cutter_path(ctx: _Context, smp: _Samples, flank: int) -> np.ndarray:
+    """Distance (mm) of finishing samples from their flank's exact cutter path on each tip radius
+    (:func:`~camfab.gcode.rotary_finish.flank_path`): on the path the cutter's exact section touches the flank, so
+    the distance is, to first order, how far the section through the sample reaches past or falls short of it."""
+    out = np.zeros(len(smp.Z))
+    pts = smp.developed(ctx.sigma)
+    for rho in np.unique(np.round(smp.Z, 9)):
+        k = np.isclose(smp.Z, rho, rtol=0.0, atol=1e-9)
+        out[k] = np.abs(cutter_penetration(ctx.g, float(rho), flank, ctx.r_c, pts[k]))
+    return out
+
+
+def _penetration(ctx: _Context, smp: _Samples, r: np.ndarray) -> np.ndarray:
+    """How far (mm) the exact section on radius r of the radial cutter through each sample reaches past either
+    flank (:func:`~camfab.gcode.rotary_finish.cutter_penetration`)."""
+    pen = np.full(len(r), -np.inf)
+    pts = smp.developed(ctx.sigma, r)
+    for rho in np.unique(np.round(r, 9)):
+        k = np.isclose(r, rho, rtol=0.0, atol=1e-9)
+        for fl in (1, -1):
+            pen[k] = np.maximum(pen[k], cutter_penetration(ctx.g, float(rho), fl, ctx.r_c, pts[k]))
+    return pen
 
 
 def _gouge(ctx: _Context) -> tuple[float, dict | None, list[Finding]]:
@@ -173,7 +202,7 @@ def _gouge(ctx: _Context) -> tuple[float, dict | None, list[Finding]]:
     pen_all = np.full(len(smp.Z), -np.inf)
     for frac in _RADII:
         rho = smp.Z + frac * (ctx.r_o - smp.Z)
-        pen = np.abs(_by_radius(ctx.g, smp, ctx.sigma, rho)) + ctx.r_c - ctx.w(rho)
+        pen = _penetration(ctx, smp, rho)
         pen_all = np.maximum(pen_all, pen)
         if len(pen) and float(pen.max()) > worst:
             j = int(np.argmax(pen))
