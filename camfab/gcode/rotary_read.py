@@ -14,6 +14,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
+from ..errors import CamfabError
 from .posts.base import MM_PER_INCH
 
 __all__ = ["RotaryMove", "RotaryReadError", "read_rotary"]
@@ -25,8 +26,8 @@ _HARMLESS_G = {"17", "40", "49", "54", "55", "56", "57", "58", "59", "80", "90",
                "43", "28", "53"}
 
 
-class RotaryReadError(ValueError):
-    """A line the 4-axis back-plot cannot follow."""
+class RotaryReadError(CamfabError, ValueError):
+    """A line the 4-axis back-plot cannot follow (a camfab error, like the plate reader's ``GcodeError``)."""
 
     def __init__(self, line: int, message: str):
         super().__init__(f"line {line}: {message}")
