@@ -11,6 +11,11 @@ oscillating follower's roller axis stays parallel to +Y at X = −σ·e (``docs/
 oscillating follower's exact pitch curve"); its pin carries the arm, in the plane ``clearance`` above the cylinder,
 to the pivot at X = −σ·L, z = z₀ (pivot axis parallel to Y).  The shaft goes through the bore, or, without one,
 stands on both end faces.
+
+A rib (``[cylinder] feature = "rib"``): two rollers straddle it, ``roller_1`` facing the rib's +z flank and
+``roller_2`` its −z flank, each on its own radial axis shifted from the rib's mid-line (the pitch curve) by the
+axial offset its flank's check uses (:attr:`~camfab.design.cylindrical.DevelopedContact.shift`, ±(w/2 + R_r + b/2)),
+each with its pin, both pins carried by one slide (the rib's follower is translating only).
 """
 from __future__ import annotations
 
@@ -22,12 +27,12 @@ from typing import Any, cast
 
 import numpy as np
 
-from ..design.cylindrical import RollerShape, pitch_3d
+from ..design.cylindrical import Feature, RollerShape, pitch_3d
 from .assembly import canonical_order, to_assembly
 from .step import cadquery, canonical_reals
 from .stepheader import design_meta, header_dumps
 
-__all__ = ["CylinderParts", "parts", "dumps", "roller_axis", "axis_x"]
+__all__ = ["CylinderParts", "parts", "dumps", "roller_axis", "axis_x", "roller_axes"]
 
 
 @dataclass
@@ -54,8 +59,18 @@ def axis_x(geometry, phi: float) -> float:
     return float(p[0] * math.cos(a) - p[1] * math.sin(a))
 
 
+def roller_axes(geometry, phi: float) -> list[float]:
+    """Each roller axis's height z (mm) at cam angle ``phi`` (rad): the groove's one on the exact pitch curve; a
+    rib's two (the +z flank's roller first) shifted from it along the axis as the design's check of each rib flank
+    shifts its roller (:meth:`~camfab.design.cylindrical.CylindricalGeometry.at_radius`, ``shift``)."""
+    zc = roller_axis(geometry, phi)
+    if geometry.cylinder.feature is not Feature.RIB:
+        return [zc]
+    return [zc + geometry.at_radius(geometry.cylinder.radius_mm, flank).shift for flank in (1, -1)]
+
+
 def parts(spec, geometry, solid, phi: float) -> CylinderParts:
-    """The assembly's parts at cam angle ``phi`` (rad), the cam being ``solid`` (the grooved cylinder)."""
+    """The assembly's parts at cam angle ``phi`` (rad), the cam being ``solid`` (the grooved or ribbed cylinder)."""
     cq = cadquery()
     mech = geometry.mechanism
     cyl, clear = geometry.cylinder, spec.assembly.clearance_mm or 0.5
@@ -64,19 +79,23 @@ def parts(spec, geometry, solid, phi: float) -> CylinderParts:
     out.add("cam", solid, rot=math.degrees(-mech.sense * phi))
     r0, r1 = cyl.inner_radius_mm + clear, cyl.outer_radius_mm
     y0, y1 = math.sqrt(r0**2 - xa**2), math.sqrt(r1**2 - xa**2)  # where the axis (parallel to Y) meets them
-    y = cq.Vector(0, 1, 0)
-    if cyl.roller is RollerShape.CONICAL:
-        roller = cq.Solid.makeCone(rr * r0 / cyl.radius_mm, rr * r1 / cyl.radius_mm, y1 - y0, cq.Vector(xa, y0, zc), y)
-    else:
-        roller = cq.Solid.makeCylinder(rr, y1 - y0, cq.Vector(xa, y0, zc), y)
-    top = r1 + clear
-    out.add("roller", roller)
-    out.add("pin", cq.Solid.makeCylinder(0.4 * rr, top - y1, cq.Vector(xa, y1, zc), y))
+    y, top = cq.Vector(0, 1, 0), r1 + clear
+    axes = roller_axes(geometry, phi)
+    for k, z in enumerate(axes, start=1):
+        if cyl.roller is RollerShape.CONICAL:
+            roller = cq.Solid.makeCone(rr * r0 / cyl.radius_mm, rr * r1 / cyl.radius_mm, y1 - y0,
+                                       cq.Vector(xa, y0, z), y)
+        else:
+            roller = cq.Solid.makeCylinder(rr, y1 - y0, cq.Vector(xa, y0, z), y)
+        tag = f"_{k}" if len(axes) > 1 else ""  # a rib's two rollers: roller_1 (+z flank), roller_2 (−z flank)
+        out.add(f"roller{tag}", roller)
+        out.add(f"pin{tag}", cq.Solid.makeCylinder(0.4 * rr, top - y1, cq.Vector(xa, y1, z), y))
     if getattr(mech, "arm_length_mm", 0.0):
         _arm(cq, out, geometry, (xa, zc), top, rr)
-    else:
-        slide = max(2 * rr, 4.0)
-        out.add("slide", cq.Solid.makeBox(2 * slide, slide, 2 * slide, cq.Vector(xa - slide, top, zc - slide)))
+    else:  # one slide carrying every pin
+        slide, lo, hi = max(2 * rr, 4.0), min(axes), max(axes)
+        block = cq.Solid.makeBox(2 * slide, slide, hi - lo + 2 * slide, cq.Vector(xa - slide, top, lo - slide))
+        out.add("slide", block)
     out.add("shaft", _shaft(cq, spec, cyl))
     return out
 

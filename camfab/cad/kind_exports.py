@@ -108,13 +108,12 @@ def _cylinder_iges(cam: Any, req: Any) -> list[Artifact]:
 
 
 def _cylinder_assembly(cam: Any, req: Any) -> list[Artifact]:
-    """``<stem>_assembly.step`` (and ``_pose<k>`` for ``req.poses``): the grooved cylinder, its shaft and the
-    follower at ``req.angle`` degrees (:mod:`camfab.cad.cylinder_assembly`)."""
+    """``<stem>_assembly.step`` (and ``_pose<k>`` for ``req.poses``): the grooved (or ribbed) cylinder, its shaft
+    and the follower (a rib's: two rollers) at ``req.angle`` degrees (:mod:`camfab.cad.cylinder_assembly`)."""
     from ..errors import InputError
     from ..limits import MAX_POSES
     from .cylinder_assembly import dumps
 
-    refuse_feature(cam, "assembly")  # a rib: exit 2 naming [cylinder] feature
     if not math.isfinite(req.angle) or abs(req.angle) > 1e6:
         raise InputError(f"--angle {req.angle}: must be a finite number of at most 1e6 (degrees)")
     if not 0 <= req.poses <= MAX_POSES:

@@ -398,9 +398,9 @@ def cylinder_report(report: Any, geometry: CylindricalGeometry) -> Any:
 
 
 def feature_refusal(cylinder: CylinderSpec | None, output: str) -> str | None:
-    """Why ``output`` is not made for this cylinder's feature (a rib's 4-axis program and assembly), or None."""
-    if cylinder is None or cylinder.feature is not Feature.RIB or output not in ("gcode", "assembly"):
+    """Why ``output`` is not made for this cylinder's feature (a rib's 4-axis program), or None."""
+    if cylinder is None or cylinder.feature is not Feature.RIB or output not in ("gcode",):
         return None
-    what = "the 4-axis program mills" if output == "gcode" else "the assembly places one roller in"
+    what = "the 4-axis program mills"
     return ('not yet made for [cylinder] feature = "rib" (a rib gets dxf, step, stl, iges, xlsx, report, the '
             f'drawing and the checks; {what} feature = "groove" only)')
