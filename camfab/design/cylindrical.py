@@ -402,5 +402,5 @@ def feature_refusal(cylinder: CylinderSpec | None, output: str) -> str | None:
     if cylinder is None or cylinder.feature is not Feature.RIB or output not in ("gcode",):
         return None
     what = "the 4-axis program mills"
-    return ('not yet made for [cylinder] feature = "rib" (a rib gets dxf, step, stl, iges, xlsx, report, the '
+    return ('not yet made for [cylinder] feature = "rib" (a rib gets dxf, step, stl, iges, assembly, xlsx, report, the '
             f'drawing and the checks; {what} feature = "groove" only)')
