@@ -398,9 +398,10 @@ def cylinder_report(report: Any, geometry: CylindricalGeometry) -> Any:
 
 
 def feature_refusal(cylinder: CylinderSpec | None, output: str) -> str | None:
-    """Why ``output`` is not made for this cylinder's feature (a rib's 4-axis program and assembly), or None."""
-    if cylinder is None or cylinder.feature is not Feature.RIB or output not in ("gcode", "assembly"):
+    """Why ``output`` is not made for this cylinder's feature (a rib's assembly), or None.  A rib's 4-axis
+    program is made (:mod:`camfab.gcode.rib_program`)."""
+    if cylinder is None or cylinder.feature is not Feature.RIB or output != "assembly":
         return None
-    what = "the 4-axis program mills" if output == "gcode" else "the assembly places one roller in"
+    what = "the assembly places one roller in"
     return ('not yet made for [cylinder] feature = "rib" (a rib gets dxf, step, stl, iges, xlsx, report, the '
             f'drawing and the checks; {what} feature = "groove" only)')

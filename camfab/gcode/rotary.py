@@ -48,7 +48,8 @@ from .model import Job
 from .posts.base import MM_PER_INCH, Post
 from .rotary_finish import check_finishing_tool, finishing_direction, flank_path
 
-__all__ = ["ROTARY_POSTS", "rotary_samples", "rotary_levels", "rotary_gcode", "check_rotary_tool"]
+__all__ = ["ROTARY_POSTS", "rotary_samples", "rotary_levels", "rotary_gcode", "check_rotary_tool", "RotaryWriter",
+           "to_machine", "chord_error", "rotary_post"]
 
 #: the posts whose controllers have a rotary A axis and inverse-time feed (G93)
 ROTARY_POSTS = ("linuxcnc", "fanuc")
@@ -247,6 +248,10 @@ def _finishing(w: _Writer, geometry: Any, tol_fin: float, safe: float, clear: fl
 def rotary_gcode(geometry: Any, job: Job, tol: float, post: str | Post = "linuxcnc") -> tuple[bytes, int, float]:
     """The 4-axis program (module notes) as bytes, its number of cutting ``G1 X.. A..`` moves and the largest
     chord error (mm) of the written path on the developed cylinder of each level's radius (before rounding)."""
+    if geometry.cylinder.rib_width_mm is not None:  # a rib: camfab.gcode.rib_program
+        from .rib_program import rib_gcode
+
+        return rib_gcode(geometry, job, tol, post)
     p = _rotary_post(post)
     check_rotary_tool(geometry, job.tool_diameter_mm)
     cyl = geometry.cylinder
@@ -279,6 +284,14 @@ def rotary_gcode(geometry: Any, job: Job, tol: float, post: str | Post = "linuxc
     if p.percent:
         w.lines.append("%")
     return ("\n".join(w.lines) + "\n").encode("ascii"), moves + m, max(worst, e)
+
+
+#: the writer, the developed-to-machine map, the chord error and the post check, shared with the rib's program
+#: (:mod:`camfab.gcode.rib_program`)
+RotaryWriter = _Writer
+to_machine = _to_machine
+chord_error = _chord_error
+rotary_post = _rotary_post
 
 
 def cylinder_job(job: Job, geometry: Any) -> Job:
