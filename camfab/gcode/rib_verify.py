@@ -5,7 +5,9 @@ Read back and sampled as the groove's program (:mod:`camfab.gcode.rotary_verify`
 move a straight line on the developed cylinder of the tool tip's radius r = Z, x = −σ·r·A), then measured:
 
 * **deviation** — every finishing-pass point (leads left out) within ``tol`` of its rib flank's exact cutter path
-  on the root (:func:`~camfab.gcode.rotary_finish.flank_path`, the cutter outside the flank; ``DEVIATION``);
+  on the root (:func:`~camfab.gcode.rotary_finish.flank_path`, the cutter outside the flank), and above the root,
+  on the radii of the gouge check, its cutter's section within ``tol`` of the rib flank either way (material left
+  on the rib is an error too: the rollers clear it by half the backlash) (``DEVIATION``);
 * **gouge** — on six radii from each cutting point's tip to the rib's top, the radial cutter's exact section there
   (the stretched circle) no more than ``tol`` past the rib flank on the point's side (the flank the cutter's axis
   lies farther outside of; a point inside the rib gouges whichever side it picks) (``GOUGE``; every cutting move,
@@ -34,6 +36,7 @@ from .rotary_read import RotaryMove, RotaryReadError, read_rotary
 from .rotary_verify import (
     RotaryContext,
     RotaryVerifyReport,
+    Samples,
     feed_findings,
     from_cutter_path,
     is_lateral,
@@ -128,34 +131,51 @@ def rib_penetration(geometry: Any, r: float, r_c: float, axis: np.ndarray) -> np
     return out
 
 
-def _gouge(ctx: RotaryContext) -> tuple[float, dict | None, list[Finding]]:
-    smp, pen_all = ctx.cut, np.full(len(ctx.cut.Z), -np.inf)
-    worst, at = -math.inf, None
-    for frac in _RADII:
+def _penetrations(ctx: RotaryContext) -> np.ndarray:
+    """:func:`rib_penetration` of every cutting sample on the radii ``_RADII`` from its tip to the rib's top:
+    (len(_RADII), n)."""
+    smp = ctx.cut
+    out = np.full((len(_RADII), len(smp.Z)), -np.inf)
+    for i, frac in enumerate(_RADII):
         rho = smp.Z + frac * (ctx.r_o - smp.Z)
-        pts, pen = smp.developed(ctx.sigma, rho), np.full(len(rho), -np.inf)
+        pts = smp.developed(ctx.sigma, rho)
         for r in np.unique(np.round(rho, 9)):
             k = np.isclose(rho, r, rtol=0.0, atol=1e-9)
-            pen[k] = rib_penetration(ctx.g, float(r), ctx.r_c, pts[k])
-        pen_all = np.maximum(pen_all, pen)
-        if len(pen) and float(pen.max()) > worst:
-            j = int(np.argmax(pen))
-            worst = float(pen[j])
-            at = {"x": float(smp.X[j]), "y": 0.0, "z": float(smp.Z[j]), "a_deg": float(smp.A[j]),
-                  "radius_mm": float(rho[j]), "line": ctx.moves[smp.move[j]].line, "penetration_mm": worst}
-    found = worst_per_pass(pen_all, smp, ctx.moves, ctx.tol, IssueCode.GOUGE, "the cutter cuts into the rib by")
+            out[i, k] = rib_penetration(ctx.g, float(r), ctx.r_c, pts[k])
+    return out
+
+
+def _gouge(ctx: RotaryContext, pens: np.ndarray) -> tuple[float, dict | None, list[Finding]]:
+    """The cutter's exact section on every radius from its tip to the rib's top outside the rib."""
+    smp = ctx.cut
+    if not len(smp.Z):
+        return -math.inf, None, []
+    i, j = np.unravel_index(int(np.argmax(pens)), pens.shape)
+    worst = float(pens[i, j])
+    at = {"x": float(smp.X[j]), "y": 0.0, "z": float(smp.Z[j]), "a_deg": float(smp.A[j]),
+          "radius_mm": float(smp.Z[j] + _RADII[i] * (ctx.r_o - smp.Z[j])), "line": ctx.moves[smp.move[j]].line,
+          "penetration_mm": worst}
+    found = worst_per_pass(pens.max(axis=0), smp, ctx.moves, ctx.tol, IssueCode.GOUGE,
+                           "the cutter cuts into the rib by")
     return worst, (at if found else None), found
 
 
-def _finish_deviation(ctx: RotaryContext) -> tuple[float | None, list[Finding], int]:
-    """The finishing passes (their first and last lateral moves, the leads, left out) against their flank's exact
-    cutter path on the tip's radius."""
-    mv, fin = ctx.moves, ctx.finish
-    keep = np.zeros(len(fin.Z), dtype=bool)
-    for label in dict.fromkeys(mv[i].label for i in fin.move):
-        idx = sorted({int(i) for i in fin.move if mv[i].label == label and is_lateral(mv[i])})
-        keep |= np.isin(fin.move, idx[1:-1])
-    f = fin.subset(keep)
+def _finishing_samples(ctx: RotaryContext, smp: Samples) -> np.ndarray:
+    """Which samples of ``smp`` belong to a finishing pass, its first and last lateral moves (the leads) left out."""
+    mv = ctx.moves
+    keep = np.zeros(len(smp.Z), dtype=bool)
+    for label in dict.fromkeys(mv[i].label for i in smp.move if mv[i].label.startswith("finishing")):
+        idx = sorted({int(i) for i in smp.move if mv[i].label == label and is_lateral(mv[i])})
+        keep |= np.isin(smp.move, idx[1:-1])
+    return keep
+
+
+def _finish_deviation(ctx: RotaryContext, pens: np.ndarray) -> tuple[float | None, list[Finding], int]:
+    """The finishing passes (leads left out) against the exact cutter path of the flank their comment names on
+    the tip's radius, and, above it up to the rib's top, the cutter's section within ``tol`` of the rib flank
+    either way (past it, or short of it: material left on the rib)."""
+    mv = ctx.moves
+    f = ctx.finish.subset(_finishing_samples(ctx, ctx.finish))
     side = np.array([ctx.flank_of(mv[i].label) for i in f.move], dtype=float)
     dev = np.full(len(f.Z), np.inf)
     for fl in (1, -1):
@@ -163,7 +183,12 @@ def _finish_deviation(ctx: RotaryContext) -> tuple[float | None, list[Finding], 
         if np.any(k):
             dev[k] = from_cutter_path(ctx, f.subset(k), fl)
     found = worst_per_pass(dev, f, mv, ctx.tol, IssueCode.DEVIATION, "off its rib flank's exact cutter path by")
-    return (float(np.max(dev)) if len(dev) else None), found, len(set(f.move.tolist()))
+    up = _finishing_samples(ctx, ctx.cut)
+    above = np.abs(pens[1:, up]).max(axis=0) if np.any(up) else np.zeros(0)
+    found += worst_per_pass(above, ctx.cut.subset(up), mv, ctx.tol, IssueCode.DEVIATION,
+                            "strays from the rib flank above the root (past it or short of it) by")
+    worst = max([float(np.max(v)) for v in (dev, above) if len(v)], default=None)
+    return worst, found, len(set(f.move.tolist()))
 
 
 def _dense(moves: list[RotaryMove], ids: np.ndarray, sigma: float, r: float) -> np.ndarray:
@@ -280,8 +305,9 @@ def verify_rib_program(program: str | bytes, geometry: Any, job: Job, *, tol: fl
     if not len(ctx.finish.Z):
         problems.append(Finding.at_line(IssueCode.NO_FINISH_PASS, "no finishing pass (comments 'finishing pass "
                                         "+z/-z rib flank')", None))
-    dev, found, n_fin = _finish_deviation(ctx)
-    pen, gouge_at, gouges = _gouge(ctx)
+    pens = _penetrations(ctx)
+    dev, found, n_fin = _finish_deviation(ctx, pens)
+    pen, gouge_at, gouges = _gouge(ctx, pens)
     gap, cover, uncovered = _coverage(ctx)
     problems += found + gouges + uncovered + _depth(ctx) + feed_findings(ctx) + rapid_findings(ctx) + _directions(ctx)
     rough = [m for m in moves if m.label.startswith("roughing")]

@@ -174,6 +174,21 @@ def test_coverage_catches_a_deleted_roughing_ring(setup):
     assert 0.1 * want < rep.rotary["coverage"]["uncovered_area_mm2"] < want
 
 
+@pytest.mark.slow
+def test_a_too_large_cutter_leaves_material_verify_sees_it(setup, monkeypatch):
+    """With the cutter check bypassed, a 14 mm end mill's finishing passes, tangent to the flanks on the root, fall
+    short of them higher up (material left on the rib): verify finds it as ``DEVIATION`` above the root, not as a
+    gouge."""
+    from camfab.gcode import rib_program
+
+    geometry, job, tol, _ = setup
+    big = dataclasses.replace(job, tool_diameter_mm=14.0)
+    monkeypatch.setattr(rib_program, "check_rib_tool", lambda *a, **k: 0.0)
+    rep = _verify(setup, rotary_gcode(geometry, big, tol, "linuxcnc")[0], big)
+    assert rep.codes() == {"DEVIATION"} and not rep.gouge
+    assert all("above the root" in p.message for p in rep.problems) and rep.max_deviation_mm > 0.03
+
+
 def test_a_cutter_too_large_is_refused_naming_the_field(design, tmp_path, capsys):
     """A 14 mm end mill, radial and tangent to a flank on the root, cuts past the flank higher up (the rib's
     twist): exit 2 naming manufacturing.tool_diameter_mm and the diameters that fit; both ends of that range
