@@ -139,7 +139,7 @@ def check_rib_tool(geometry: Any, tool_radius: float, tol: float, phi: np.ndarra
     f_w = _overcut(geometry, w, phi)
     if f_w > budget:
         raise SpecError(Problem("manufacturing.tolerance_mm", tol,
-                                f"even an end mill of the roller's size cuts {f_w:.4f} mm past a rib flank (allowed "
+                                f"even an end mill of the rollers' size strays {f_w:.4f} mm from a rib flank (allowed "
                                 f"{budget:.4g} mm, half the tolerance)", "give a coarser tolerance"))
     slope = max((over - f_w) / max(abs(tool_radius - w), 1e-9), 1e-9)
     lo = _edge(geometry, w, -1, f_w, slope, budget, phi)
@@ -220,13 +220,7 @@ def _header(w: RotaryWriter, geometry: Any, levels: list[float], safe: float, to
                  f"feed: {job.feed_mm_min * w.k:.{w.fd}f} {u}/min at the tool tip as inverse time G93, "
                  f"plunge {job.plunge_feed_mm_min * w.k:.{w.fd}f} {u}/min", *job.notes):
         w.comment(text)
-    w.block(p.preamble(job.units))
-    if p.tool_change:
-        w.block([f"T{job.tool_number}", "M6"])
-    else:
-        w.comment(f"load T{job.tool_number}")
-    w.block([f"S{round(job.spindle_rpm)}", "M3"])
-    w.block([p.coolant_code(job.coolant, {})])
+    w.start()
 
 
 class _Cut:

@@ -32,7 +32,7 @@ from ..results import Finding, IssueCode
 from .model import Job
 from .rib_program import rib_direction, roughing_direction
 from .rotary_finish import cutter_contact
-from .rotary_read import RotaryMove, RotaryReadError, read_rotary
+from .rotary_read import RotaryMove
 from .rotary_verify import (
     RotaryContext,
     RotaryVerifyReport,
@@ -41,7 +41,7 @@ from .rotary_verify import (
     from_cutter_path,
     is_lateral,
     rapid_findings,
-    refused_report,
+    read_or_refused,
     worst_per_pass,
 )
 
@@ -291,13 +291,9 @@ def _directions(ctx: RotaryContext) -> list[Finding]:
 def verify_rib_program(program: str | bytes, geometry: Any, job: Job, *, tol: float) -> RotaryVerifyReport:
     """``camfab verify`` of a rib's 4-axis program (module notes); ``job`` cut to the rib's height
     (:func:`~camfab.gcode.rotary.cylinder_job`)."""
-    try:
-        text = program.decode("utf-8") if isinstance(program, bytes) else program
-        moves = read_rotary(text)
-    except UnicodeDecodeError as e:
-        return refused_report(f"not a text file: {e}", None, tol)
-    except RotaryReadError as e:
-        return refused_report(str(e), e.line, tol)
+    moves = read_or_refused(program, tol)
+    if isinstance(moves, RotaryVerifyReport):
+        return moves
     ctx = RotaryContext(geometry, job, tol, moves)
     problems: list[Finding] = []
     if not len(ctx.cut.Z):

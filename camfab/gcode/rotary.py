@@ -175,6 +175,17 @@ class _Writer:
         self.block(["G0", f"Z{self.L(clear)}"])
         self.block(["G1", f"Z{self.L(z)}", self.feed(self.job.plunge_feed_mm_min)])
 
+    def start(self) -> None:
+        """The post's preamble, the tool, the spindle (M3) and the coolant, after the header's comments."""
+        p, job = self.p, self.job
+        self.block(p.preamble(job.units))
+        if p.tool_change:
+            self.block([f"T{job.tool_number}", "M6"])
+        else:
+            self.comment(f"load T{job.tool_number}")
+        self.block([f"S{round(job.spindle_rpm)}", "M3"])
+        self.block([p.coolant_code(job.coolant, {})])
+
     def leave(self, safe: float) -> None:
         """Retract to the safe radius and unwind the table (the next pass starts at A0: no 360° jump)."""
         self.block(["G0", f"Z{self.L(safe)}"])
@@ -211,13 +222,7 @@ def _header(w: _Writer, geometry: Any, levels: list[float], safe: float, tol: fl
                  f"feed: {job.feed_mm_min * w.k:.{w.fd}f} {u}/min at the tool tip as inverse time G93, "
                  f"plunge {job.plunge_feed_mm_min * w.k:.{w.fd}f} {u}/min", *job.notes):
         w.comment(text)
-    w.block(p.preamble(job.units))
-    if p.tool_change:
-        w.block([f"T{job.tool_number}", "M6"])
-    else:
-        w.comment(f"load T{job.tool_number}")
-    w.block([f"S{round(job.spindle_rpm)}", "M3"])
-    w.block([p.coolant_code(job.coolant, {})])
+    w.start()
 
 
 def _finishing(w: _Writer, geometry: Any, tol_fin: float, safe: float, clear: float) -> tuple[int, float]:

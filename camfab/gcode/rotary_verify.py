@@ -43,7 +43,7 @@ from .rotary_read import RotaryMove, RotaryReadError, read_rotary
 from .verify import VerifyReport
 
 __all__ = ["RotaryVerifyReport", "verify_rotary_program", "RotaryContext", "Samples", "sample_moves", "worst_per_pass",
-           "feed_findings", "rapid_findings", "is_lateral", "refused_report", "from_cutter_path"]
+           "feed_findings", "rapid_findings", "is_lateral", "from_cutter_path", "read_or_refused"]
 
 #: sampling step of a move on its developed cylinder (mm), the coverage probes per target, and the radii (fractions
 #: from the tip to the outer surface) on which the radial cutter's section is checked
@@ -352,6 +352,18 @@ def _refused(message: str, line: int | None, tol: float) -> RotaryVerifyReport:
     return RotaryVerifyReport(None, False, None, (Finding.at_line(IssueCode.PARSE_ERROR, message, line),), tol)
 
 
+def read_or_refused(program: str | bytes, tol: float) -> list[RotaryMove] | RotaryVerifyReport:
+    """The program's moves (:func:`~camfab.gcode.rotary_read.read_rotary`), or the report refusing it
+    (``PARSE_ERROR``: not text, or a line the back-plot cannot follow)."""
+    try:
+        text = program.decode("utf-8") if isinstance(program, bytes) else program
+        return read_rotary(text)
+    except UnicodeDecodeError as e:
+        return _refused(f"not a text file: {e}", None, tol)
+    except RotaryReadError as e:
+        return _refused(str(e), e.line, tol)
+
+
 def verify_rotary_program(program: str | bytes, geometry: Any, job: Job, *, tol: float) -> RotaryVerifyReport:
     """``camfab verify`` of a cylindrical cam's 4-axis program (module notes); ``job`` cut to the groove's
     depth (:func:`~camfab.gcode.rotary.cylinder_job`)."""
@@ -359,13 +371,9 @@ def verify_rotary_program(program: str | bytes, geometry: Any, job: Job, *, tol:
         from .rib_verify import verify_rib_program
 
         return verify_rib_program(program, geometry, job, tol=tol)
-    try:
-        text = program.decode("utf-8") if isinstance(program, bytes) else program
-        moves = read_rotary(text)
-    except UnicodeDecodeError as e:
-        return _refused(f"not a text file: {e}", None, tol)
-    except RotaryReadError as e:
-        return _refused(str(e), e.line, tol)
+    moves = read_or_refused(program, tol)
+    if isinstance(moves, RotaryVerifyReport):
+        return moves
     ctx = _Context(geometry, job, tol, moves)
     problems: list[Finding] = []
     if not len(ctx.cut.Z):
@@ -399,5 +407,4 @@ worst_per_pass = _worst_per_pass
 feed_findings = _feeds
 rapid_findings = _rapids_and_end
 is_lateral = _lateral
-refused_report = _refused
 from_cutter_path = _from_cutter_path

@@ -24,42 +24,14 @@ from camfab.gcode.rib_program import check_rib_tool
 from camfab.gcode.rotary import cylinder_job, rotary_gcode
 from camfab.gcode.rotary_verify import verify_rotary_program
 from camfab.offset.cutter import concave_limit
+from tests.design.test_cylinder_rib import RIB_TOML as RIB_6MM
 
 RS274 = shutil.which("rs274")
 #: the rib of tests/design/test_cylinder_rib.py: pitch radius 40, height 10 (root 35, top 45), width 8, rollers
 #: of radius 6 with 0.1 backlash (w = 6.05 each side), a cycloidal rise of 20 mm over 140°, a dwell of 40° (the
 #: rib's mid-line at z = 50, its flanks at 46 and 54), a cycloidal return over 180°; travel centred on 80 mm
 TOOL_D = 12.1
-RIB_TOML = f"""name = "Ribbed"
-[cam]
-kind = "cylindrical"
-[cylinder]
-radius_mm = 40.0
-length_mm = 80.0
-feature = "rib"
-rib_width_mm = 8.0
-rib_height_mm = 10.0
-backlash_mm = 0.1
-[follower]
-type = "roller"
-motion = "translating"
-roller_radius_mm = 6.0
-[[motion]]
-law = "cycloidal"
-lift = 20.0
-angle_deg = 140.0
-[[motion]]
-law = "dwell"
-lift = 0.0
-angle_deg = 40.0
-[[motion]]
-law = "cycloidal"
-lift = -20.0
-angle_deg = 180.0
-[manufacturing]
-tolerance_mm = 0.01
-tool_diameter_mm = {TOOL_D}
-"""
+RIB_TOML = RIB_6MM.replace("tool_diameter_mm = 6.0", f"tool_diameter_mm = {TOOL_D}")
 
 
 @pytest.fixture(scope="module")
