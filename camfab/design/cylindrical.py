@@ -404,4 +404,4 @@ def feature_refusal(cylinder: CylinderSpec | None, output: str) -> str | None:
         return None
     what = "the assembly places one roller in"
     return ('not yet made for [cylinder] feature = "rib" (a rib gets dxf, step, stl, iges, xlsx, report, the '
-            f'drawing and the checks; {what} feature = "groove" only)')
+            f'drawing, the 4-axis program and the checks; {what} feature = "groove" only)')

@@ -56,11 +56,15 @@ def _verify(setup, text, job=None):
 
 
 @pytest.mark.skipif(RS274 is None, reason="LinuxCNC's rs274 interpreter is not installed (linuxcnc-uspace)")
-def test_rs274_runs_the_rib_program(setup, tmp_path):
+@pytest.mark.parametrize("post", ["linuxcnc", "fanuc"])
+def test_rs274_runs_the_rib_program(setup, tmp_path, post):
     """rs274 runs it to the end; no feed below the root radius; in the dwell (cam angles 142° to 178°, A = −θ for
     a cw cam) the finishing passes run exactly r_c beyond the flanks (z = 54 + 6.05 and 46 − 6.05); the feeds on
     the root reach past both ends of the cylinder."""
-    (tmp_path / "p.ngc").write_text(setup[3])
+    geometry, job, tol, text = setup
+    if post != "linuxcnc":
+        text = rotary_gcode(geometry, job, tol, post)[0].decode()
+    (tmp_path / "p.ngc").write_text(text)
     proc = subprocess.run([str(RS274), "-g", str(tmp_path / "p.ngc")], capture_output=True, text=True, timeout=300,
                           stdin=subprocess.DEVNULL)
     assert proc.returncode == 0, proc.stdout[-600:]
@@ -71,12 +75,12 @@ def test_rs274_runs_the_rib_program(setup, tmp_path):
     assert np.allclose(Y, 0.0) and Z.min() == pytest.approx(35.0, abs=1e-9)
     root = Z < 35.0 + 1e-9
     assert X[root].min() - TOOL_D / 2 < 0.0 and X[root].max() + TOOL_D / 2 > 80.0
-    text = setup[3]
-    n_fin = len(re.findall(r"^G1 ", text[text.index("(finishing pass"):], re.MULTILINE))  # the last feeds
+    up = text.upper()
+    n_fin = len(re.findall(r"^(N\d+ )?G1 ", up[up.index("(FINISHING PASS +Z"):], re.MULTILINE))  # the last feeds
     theta = np.mod(-A[-n_fin:], 360.0)
     dwell = (theta > 142.0) & (theta < 178.0)
     assert np.sum(dwell) >= 4 and np.all(Z[-n_fin:] == 35.0)
-    np.testing.assert_allclose(np.abs(X[-n_fin:][dwell] - 50.0), 4.0 + TOOL_D / 2, atol=setup[2])
+    np.testing.assert_allclose(np.abs(X[-n_fin:][dwell] - 50.0), 4.0 + TOOL_D / 2, atol=tol)
 
 
 @pytest.mark.slow
