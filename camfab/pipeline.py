@@ -433,11 +433,9 @@ def _gcode(cam: Cam, req: Request) -> list[Artifact]:
     job = gcode_job(cam.spec, tol=tol, overrides=req.machining)
     m = machining_of(cam.spec, req.machining)
     n = len(cam.geometry.profiles)
-    if cam.spec.cam.kind == "cylindrical":  # the 4-axis program of the groove (camfab.gcode.rotary)
-        from .cad.kind_exports import refuse_feature
+    if cam.spec.cam.kind == "cylindrical":  # the 4-axis program of the groove or rib (camfab.gcode.rotary)
         from .gcode.rotary import cylinder_job, rotary_gcode
 
-        refuse_feature(cam, "gcode")  # a rib: exit 2 naming [cylinder] feature
         data, moves, dev = rotary_gcode(cam.geometry, cylinder_job(job, cam.geometry), tol, req.post)
         return [Artifact(f"{safe_stem(cam.name)}.nc", data, "gcode", moves, dev, req.post)]
     if cam.spec.cam.kind == "groove":  # one program mills the slot of both flanks

@@ -18,7 +18,7 @@ from ..io import safe_stem
 from .artifact import Artifact
 
 __all__ = ["KIND_EXPORTERS", "KIND_CAD_OUTPUTS", "not_applicable_reason", "kind_exporter", "applicable", "applies",
-           "refuse_feature", "cylinder_solid"]
+           "cylinder_solid"]
 
 log = logging.getLogger("camfab.pipeline")
 
@@ -29,15 +29,6 @@ def _cylinder_dxf(cam: Any, req: Any) -> list[Artifact]:
 
     text, dev = developed_dxf(cam.geometry, tol=cam.tolerance(req.tol), name=cam.name)
     return [Artifact(f"{safe_stem(cam.name)}.dxf", text.encode("utf-8"), "dxf", deviation_mm=dev)]
-
-
-def refuse_feature(cam: Any, output: str) -> None:
-    """ExportError (exit 2) when the cylinder's ``feature`` has no ``output`` yet (a rib's solid)."""
-    from ..design.cylindrical import feature_refusal
-
-    why = feature_refusal(cam.spec.cylinder, output)
-    if why:
-        raise ExportError(f"{output}: {why}")
 
 
 #: each cam's cylinder solid by (tolerance, bore): built once per design and shared by its STEP, STL, IGES and
@@ -163,12 +154,8 @@ def kind_exporter(kind: str, out: str, default: Callable[[Any, Any], list[Artifa
 def applicable(cam: Any, outputs: Sequence[Any]) -> tuple[list[Any], dict[str, str]]:
     """``outputs`` split into those that apply to the cam's kind and, for the others, why not (each logged as
     a warning)."""
-    from ..design.cylindrical import feature_refusal
-
     keep = [o for o in outputs if applies(cam.spec.cam.kind, str(o))]
     why = {str(o): not_applicable_reason(cam.spec.cam.kind, str(o)) for o in outputs if o not in keep}
-    why |= {str(o): r for o in keep if (r := feature_refusal(getattr(cam.spec, "cylinder", None), str(o)))}
-    keep = [o for o in keep if str(o) not in why]
     for out, reason in why.items():
         log.warning("%s: %s skipped: %s", cam.name, out, reason)
     return keep, why

@@ -57,7 +57,7 @@ from .roller_section import RollerSection, envelope
 
 __all__ = ["RollerShape", "CylinderSpec", "cylinder_section", "DevelopedContact", "CylindricalGeometry",
            "CylindricalTranslating", "CylindricalOscillating", "CYLINDER_KEYS", "slip_ratio", "pitch_3d",
-           "FAMILIES", "cylinder_report", "radius_summary", "Feature", "feature_refusal"]
+           "FAMILIES", "cylinder_report", "radius_summary", "Feature"]
 
 # ---------------------------------------------------------------------------
 def _arm(mech: Any, S) -> tuple[np.ndarray, ...]:
@@ -395,12 +395,3 @@ def cylinder_report(report: Any, geometry: CylindricalGeometry) -> Any:
                "radii": radius_summary(geometry)}
     return dataclasses.replace(report, cylinder=summary, area_mm2=None, base_radius_mm=cyl.inner_radius_mm,
                                max_radius_mm=cyl.outer_radius_mm)
-
-
-def feature_refusal(cylinder: CylinderSpec | None, output: str) -> str | None:
-    """Why ``output`` is not made for this cylinder's feature (a rib's 4-axis program), or None."""
-    if cylinder is None or cylinder.feature is not Feature.RIB or output not in ("gcode",):
-        return None
-    what = "the 4-axis program mills"
-    return ('not yet made for [cylinder] feature = "rib" (a rib gets dxf, step, stl, iges, assembly, xlsx, report, the '
-            f'drawing and the checks; {what} feature = "groove" only)')

@@ -48,7 +48,8 @@ from .model import Job
 from .posts.base import MM_PER_INCH, Post
 from .rotary_finish import check_finishing_tool, finishing_direction, flank_path
 
-__all__ = ["ROTARY_POSTS", "rotary_samples", "rotary_levels", "rotary_gcode", "check_rotary_tool"]
+__all__ = ["ROTARY_POSTS", "rotary_samples", "rotary_levels", "rotary_gcode", "check_rotary_tool", "RotaryWriter",
+           "to_machine", "chord_error", "rotary_post"]
 
 #: the posts whose controllers have a rotary A axis and inverse-time feed (G93)
 ROTARY_POSTS = ("linuxcnc", "fanuc")
@@ -174,6 +175,17 @@ class _Writer:
         self.block(["G0", f"Z{self.L(clear)}"])
         self.block(["G1", f"Z{self.L(z)}", self.feed(self.job.plunge_feed_mm_min)])
 
+    def start(self) -> None:
+        """The post's preamble, the tool, the spindle (M3) and the coolant, after the header's comments."""
+        p, job = self.p, self.job
+        self.block(p.preamble(job.units))
+        if p.tool_change:
+            self.block([f"T{job.tool_number}", "M6"])
+        else:
+            self.comment(f"load T{job.tool_number}")
+        self.block([f"S{round(job.spindle_rpm)}", "M3"])
+        self.block([p.coolant_code(job.coolant, {})])
+
     def leave(self, safe: float) -> None:
         """Retract to the safe radius and unwind the table (the next pass starts at A0: no 360° jump)."""
         self.block(["G0", f"Z{self.L(safe)}"])
@@ -210,13 +222,7 @@ def _header(w: _Writer, geometry: Any, levels: list[float], safe: float, tol: fl
                  f"feed: {job.feed_mm_min * w.k:.{w.fd}f} {u}/min at the tool tip as inverse time G93, "
                  f"plunge {job.plunge_feed_mm_min * w.k:.{w.fd}f} {u}/min", *job.notes):
         w.comment(text)
-    w.block(p.preamble(job.units))
-    if p.tool_change:
-        w.block([f"T{job.tool_number}", "M6"])
-    else:
-        w.comment(f"load T{job.tool_number}")
-    w.block([f"S{round(job.spindle_rpm)}", "M3"])
-    w.block([p.coolant_code(job.coolant, {})])
+    w.start()
 
 
 def _finishing(w: _Writer, geometry: Any, tol_fin: float, safe: float, clear: float) -> tuple[int, float]:
@@ -247,6 +253,10 @@ def _finishing(w: _Writer, geometry: Any, tol_fin: float, safe: float, clear: fl
 def rotary_gcode(geometry: Any, job: Job, tol: float, post: str | Post = "linuxcnc") -> tuple[bytes, int, float]:
     """The 4-axis program (module notes) as bytes, its number of cutting ``G1 X.. A..`` moves and the largest
     chord error (mm) of the written path on the developed cylinder of each level's radius (before rounding)."""
+    if geometry.cylinder.rib_width_mm is not None:  # a rib: camfab.gcode.rib_program
+        from .rib_program import rib_gcode
+
+        return rib_gcode(geometry, job, tol, post)
     p = _rotary_post(post)
     check_rotary_tool(geometry, job.tool_diameter_mm)
     cyl = geometry.cylinder
@@ -279,6 +289,14 @@ def rotary_gcode(geometry: Any, job: Job, tol: float, post: str | Post = "linuxc
     if p.percent:
         w.lines.append("%")
     return ("\n".join(w.lines) + "\n").encode("ascii"), moves + m, max(worst, e)
+
+
+#: the writer, the developed-to-machine map, the chord error and the post check, shared with the rib's program
+#: (:mod:`camfab.gcode.rib_program`)
+RotaryWriter = _Writer
+to_machine = _to_machine
+chord_error = _chord_error
+rotary_post = _rotary_post
 
 
 def cylinder_job(job: Job, geometry: Any) -> Job:

@@ -41,7 +41,7 @@ from ..offset.cutter import concave_limit
 from ..offset.groove import flank_cutter_problem
 
 __all__ = ["cutter_contact", "flank_path", "flank_at", "cutter_penetration", "pitch_distance", "twist_overcut",
-           "check_finishing_tool", "finishing_direction", "TWIST_SHARE"]
+           "check_finishing_tool", "finishing_direction", "TWIST_SHARE", "largest_overcut", "refuse_off_radial_axis"]
 
 #: the share of the tolerance the twist overcut may take (the rest: the chords and the rounding)
 TWIST_SHARE = 0.5
@@ -236,3 +236,8 @@ def finishing_direction(flank: int, sense: int, climb: bool) -> int:
     milling keeps the material on the travel's right: the −z flank for σ = +1 going forwards."""
     forwards_is_climb = flank * sense < 0
     return 1 if forwards_is_climb == climb else -1
+
+
+#: shared with the rib's program (:mod:`camfab.gcode.rib_program`)
+largest_overcut = _largest_overcut
+refuse_off_radial_axis = _refuse_off_radial_axis

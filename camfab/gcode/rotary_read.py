@@ -5,9 +5,9 @@ rotary program of :mod:`camfab.gcode.rotary` may contain: ``G0``/``G1`` with X, 
 ``G94`` feed modes, ``G20``/``G21`` units (X, Z and the G94 feed in inches are converted to mm; A stays in
 degrees; a G93 F is 1/minutes in either), the modal codes of the posts' preambles, ``T``/``M6``, ``S``/``M3``,
 ``M4``, ``M5``, coolant ``M7``/``M8``/``M9``, ``G43 H``, line numbers, comments in parentheses or after ``;``.
-Each move remembers the last comment that opens with ``centre pass`` or ``finishing pass``, its feed mode
-and F, and the spindle state.  Anything else (an arc, relative distances, a Y off 0, an unknown word) is a
-:class:`RotaryReadError` naming the line.
+Each move remembers the last comment that opens with ``centre pass``, ``finishing pass`` or ``roughing pass``
+(a rib's), its feed mode and F, and the spindle state.  Anything else (an arc, relative distances, a Y off 0, an
+unknown word) is a :class:`RotaryReadError` naming the line.
 """
 from __future__ import annotations
 
@@ -120,7 +120,7 @@ def read_rotary(text: str) -> list[RotaryMove]:
     state, moves = _State(), []
     for n, raw in enumerate(text.splitlines(), start=1):
         for c in _COMMENT.findall(raw):
-            if c.strip().lower().startswith(("centre pass", "finishing pass")):
+            if c.strip().lower().startswith(("centre pass", "finishing pass", "roughing pass")):
                 state.label = c.strip().lower()
         code = _COMMENT.sub(" ", raw).split(";")[0].strip().upper()
         if not code or code == "%" or code.startswith("O"):

@@ -42,7 +42,8 @@ from .rotary_finish import cutter_penetration, finishing_direction, flank_path, 
 from .rotary_read import RotaryMove, RotaryReadError, read_rotary
 from .verify import VerifyReport
 
-__all__ = ["RotaryVerifyReport", "verify_rotary_program"]
+__all__ = ["RotaryVerifyReport", "verify_rotary_program", "RotaryContext", "Samples", "sample_moves", "worst_per_pass",
+           "feed_findings", "rapid_findings", "is_lateral", "from_cutter_path", "read_or_refused"]
 
 #: sampling step of a move on its developed cylinder (mm), the coverage probes per target, and the radii (fractions
 #: from the tip to the outer surface) on which the radial cutter's section is checked
@@ -351,16 +352,28 @@ def _refused(message: str, line: int | None, tol: float) -> RotaryVerifyReport:
     return RotaryVerifyReport(None, False, None, (Finding.at_line(IssueCode.PARSE_ERROR, message, line),), tol)
 
 
-def verify_rotary_program(program: str | bytes, geometry: Any, job: Job, *, tol: float) -> RotaryVerifyReport:
-    """``camfab verify`` of a cylindrical cam's 4-axis program (module notes); ``job`` cut to the groove's
-    depth (:func:`~camfab.gcode.rotary.cylinder_job`)."""
+def read_or_refused(program: str | bytes, tol: float) -> list[RotaryMove] | RotaryVerifyReport:
+    """The program's moves (:func:`~camfab.gcode.rotary_read.read_rotary`), or the report refusing it
+    (``PARSE_ERROR``: not text, or a line the back-plot cannot follow)."""
     try:
         text = program.decode("utf-8") if isinstance(program, bytes) else program
-        moves = read_rotary(text)
+        return read_rotary(text)
     except UnicodeDecodeError as e:
         return _refused(f"not a text file: {e}", None, tol)
     except RotaryReadError as e:
         return _refused(str(e), e.line, tol)
+
+
+def verify_rotary_program(program: str | bytes, geometry: Any, job: Job, *, tol: float) -> RotaryVerifyReport:
+    """``camfab verify`` of a cylindrical cam's 4-axis program (module notes); ``job`` cut to the groove's
+    depth (:func:`~camfab.gcode.rotary.cylinder_job`)."""
+    if geometry.cylinder.rib_width_mm is not None:  # a rib's program (camfab.gcode.rib_verify)
+        from .rib_verify import verify_rib_program
+
+        return verify_rib_program(program, geometry, job, tol=tol)
+    moves = read_or_refused(program, tol)
+    if isinstance(moves, RotaryVerifyReport):
+        return moves
     ctx = _Context(geometry, job, tol, moves)
     problems: list[Finding] = []
     if not len(ctx.cut.Z):
@@ -384,3 +397,14 @@ def verify_rotary_program(program: str | bytes, geometry: Any, job: Job, *, tol:
              "speed and the modal state")
     return RotaryVerifyReport(max(devs) if devs else None, bool(gouges), gouge_at, tuple(problems), tol,
                               gap if math.isfinite(gap) else None, n_fin, notes, summary)
+
+
+#: shared with the rib's verify (:mod:`camfab.gcode.rib_verify`)
+RotaryContext = _Context
+Samples = _Samples
+sample_moves = _sample
+worst_per_pass = _worst_per_pass
+feed_findings = _feeds
+rapid_findings = _rapids_and_end
+is_lateral = _lateral
+from_cutter_path = _from_cutter_path
