@@ -13,6 +13,8 @@ from camfab.design.mechanisms import geometry_from_spec
 from camfab.design.spec import design_from_dict
 from camfab.errors import SpecError
 
+from ..conftest import CYLINDER_ARM_MM, oscillating_cylinder
+
 
 def design(motion=None, follower=None, **cyl):
     c = {"radius_mm": 40.0, "length_mm": 80.0, "groove_depth_mm": 10.0, "backlash_mm": 0.1} | cyl
@@ -103,14 +105,9 @@ def test_oscillating_pitch_is_the_exact_arc():
     """The roller axis of an oscillating follower built in 3D (pivot axis parallel to the radial line at 0°, arm
     L, angle φ = S): it meets the cylinder r where the developed formula says, for both senses (not the
     small-angle z = L·φ, x = r·θ)."""
-    L = 60.0
+    L = CYLINDER_ARM_MM
     for rotation in ("cw", "ccw"):
-        spec = design_from_dict({"name": "b", "cam": {"kind": "cylindrical", "rotation": rotation},
-                                 "cylinder": {"radius_mm": 40.0, "length_mm": 90.0, "groove_depth_mm": 10.0},
-                                 "follower": {"type": "roller", "motion": "oscillating", "roller_radius_mm": 6.0,
-                                              "arm_length_mm": L},
-                                 "motion": [{"law": "poly345", "lift": 30.0, "angle_deg": 180.0},
-                                            {"law": "poly345", "lift": -30.0, "angle_deg": 180.0}]})
+        spec = design_from_dict(oscillating_cylinder(rotation))
         geom = geometry_from_spec(spec)
         sigma = 1 if rotation == "cw" else -1
         theta = np.linspace(0.0, 2 * math.pi, 73)
