@@ -43,7 +43,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -260,6 +260,9 @@ class PairDynamics:
         profile follower 2 touches half a turn later; 0 for a conjugate pair).
     """
 
+    #: the two contacts are a groove's flanks (:func:`~camfab.results.pair_names`)
+    flanks: ClassVar[bool] = False
+
     def __init__(self, first: ContactDynamics, second: ContactDynamics, shift: float = 0.0):
         self.first, self.second, self.shift = first, second, float(shift)
         self.contact, self.loads, self.speed = first.contact, first.loads, first.speed
@@ -288,6 +291,7 @@ class GrooveDynamics(PairDynamics):
     ``lever`` is the carrying flank's D, signed so that it is > 0 unless wedged."""
 
     names = ("the inner flank", "the outer flank")
+    flanks: ClassVar[bool] = True
 
     def __init__(self, first: ContactDynamics, second: ContactDynamics):
         super().__init__(first, second, 0.0)
@@ -417,7 +421,8 @@ def analyse_dynamics(geometry: CamGeometry, loads: Loads, speed: float, *, prelo
     if form_closed:
         rev = _reversals(ranges[1], ranges[2], c, getattr(dyn, "names", ("follower 1", "follower 2")))
         summary = DynamicsSummary(safety_force_n=None, second_contact_force=extreme("contact_force_2"),
-                                  load_reversals=tuple((a, b) for a, b, _ in rev), **common)
+                                  load_reversals=tuple((a, b) for a, b, _ in rev),
+                                  flanks=getattr(dyn, "flanks", False), **common)
         return DynamicsReport(summary, tuple(findings + [f for _, _, f in rev]))
     fs = loads.safety_force_n
     (at_pre, pre), (at_jump, r_jump) = found[("preload", True)], found[("jump", False)]
