@@ -163,7 +163,9 @@ def cylinder_lift_metadata(spec, geometry, step_deg: float, unit: str) -> dict[s
             "angle step": f"{step_deg:g} deg",
             "angle 0": "the start of the first [[motion]] segment, the follower's generator at x = 0",
             "lift": f"{lift}; 0 = the start of the law",
-            "z_mm": "the roller axis's position along the cylinder axis from its z = 0 end face (the pitch curve)",
+            "z_mm": ("the rib's mid-line (the follower's pitch point; its rollers either side)" if rib else
+                     "the roller axis's position")
+                    + " along the cylinder axis from its z = 0 end face (the pitch curve)",
             "pitch_x_mm": "the pitch point on the pitch cylinder developed: x = R·theta along the circumference",
             "plus_flank_x_mm, plus_flank_z_mm": f"contact point on the +z {'rib' if rib else 'groove'} flank, "
                                                  "developed on the pitch cylinder",

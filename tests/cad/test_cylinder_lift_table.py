@@ -84,3 +84,19 @@ def test_gcode_writes_the_cylinder_lift_table(tmp_path):
     assert main(["gcode", str(EXAMPLE), "-o", str(tmp_path / "b.nc"), "--lift-table", str(csv)]) in (0, 1)
     assert main(["run", str(EXAMPLE), "-o", str(tmp_path / "run"), "--outputs", "lift_table"]) in (0, 1)
     assert csv.read_bytes() == (tmp_path / "run" / "BarrelCam_lift.csv").read_bytes()
+
+
+def test_rib_lift_table_gives_the_rib_flanks(tmp_path):
+    """A rib (width 10 mm): z is its mid-line, the flanks 5 mm either side where it runs round (the dwells)."""
+    import tomllib
+
+    data = tomllib.loads(EXAMPLE.read_text(encoding="utf-8"))
+    data["cylinder"].pop("groove_depth_mm")
+    data["cylinder"].update(feature="rib", rib_width_mm=10.0, rib_height_mm=10.0)
+    run(Cam(design_from_dict(data)), tmp_path, Request(frozenset({Output.LIFT_TABLE}), force=True))
+    meta, head, rows = _read((tmp_path / "BarrelCam_lift.csv").read_text(encoding="utf-8"))
+    assert head == HEAD and any("rib's mid-line" in ln for ln in meta)
+    np.testing.assert_allclose(rows[:, 2], Z0 + exact(np.radians(rows[:, 0]), 40.0)["S"], atol=6e-7)
+    dwell = (rows[:, 0] >= 141) & (rows[:, 0] <= 179)
+    np.testing.assert_allclose(rows[dwell, 5] - rows[dwell, 2], 5.0, atol=1e-6)
+    np.testing.assert_allclose(rows[dwell, 2] - rows[dwell, 7], 5.0, atol=1e-6)
