@@ -270,8 +270,7 @@ def cmd_gcode(args: argparse.Namespace) -> int:
                  for i in range(len(arts))]
         files: dict[Path, bytes | str] = {n: a.data for n, a in zip(names, arts, strict=True)}
         if args.lift_table:
-            files[Path(args.lift_table)] = kind_exporter(cam.spec.cam.kind, "lift_table",
-                                                         pipeline.EXPORTERS[Output.LIFT_TABLE])(cam, req)[0].data
+            files[Path(args.lift_table)] = pipeline.EXPORTERS[Output.LIFT_TABLE](cam, req)[0].data
         write_all(files)  # the programs and the lift table: all or none
     for name, a in zip(names, arts, strict=True):
         print(f"wrote {name}: {req.post}, {a.entities} contour entities, max deviation {a.deviation_mm:.3g} mm "

@@ -107,21 +107,6 @@ def _cylinder_iges(cam: Any, req: Any) -> list[Artifact]:
     return [Artifact(f"{safe_stem(cam.name)}.igs", text.encode("ascii"), "iges", deviation_mm=dev)]
 
 
-def _cylinder_lift_table(cam: Any, req: Any) -> list[Artifact]:
-    """``<stem>_lift.csv``: angle, lift, the roller axis's z and both flanks developed on the pitch cylinder
-    (:func:`camfab.gcode.lift_table.cylinder_lift_columns`), every ``req.lift_step_deg``."""
-    import numpy as np
-
-    from ..gcode.lift_table import cylinder_lift_columns, cylinder_lift_metadata, lift_angles, lift_table_csv
-
-    ang = lift_angles(req.lift_step_deg)
-    unit = str(cam.geometry.axis.lift_unit)
-    lift = cam.geometry.program.evaluate(np.radians(ang), (0,))[0]
-    text = lift_table_csv(ang, lift, lift_unit=unit, columns=cylinder_lift_columns(cam.geometry, ang),
-                          meta=cylinder_lift_metadata(cam.spec, cam.geometry, req.lift_step_deg, unit))
-    return [Artifact(f"{safe_stem(cam.name)}_lift.csv", text.encode(), "lift_table")]
-
-
 def _cylinder_assembly(cam: Any, req: Any) -> list[Artifact]:
     """``<stem>_assembly.step`` (and ``_pose<k>`` for ``req.poses``): the grooved cylinder, its shaft and the
     follower at ``req.angle`` degrees (:mod:`camfab.cad.cylinder_assembly`)."""
@@ -151,11 +136,12 @@ def _cylinder_assembly(cam: Any, req: Any) -> list[Artifact]:
 
 #: cam kinds whose files are made by their own exporters, by output name; an output missing from a kind's
 #: entry does not apply to it (:func:`not_applicable_reason`); None: the pipeline's own stage, which handles the kind
-#: (the report and workbook; the 4-axis program of :mod:`camfab.gcode.rotary`, dispatched in ``pipeline._gcode``)
+#: (the report and workbook; the 4-axis program of :mod:`camfab.gcode.rotary`, dispatched in ``pipeline._gcode``;
+#: the lift table of :func:`camfab.gcode.lift_table.cylinder_lift_csv`, in ``pipeline._lift_table``)
 KIND_EXPORTERS: dict[str, dict[str, Callable[[Any, Any], list[Artifact]] | None]] = {
     "cylindrical": {"dxf": _cylinder_dxf, "step": _cylinder_step, "xlsx": None, "report": None,
                     "stl": _cylinder_stl, "gcode": None, "drawing": _cylinder_drawing, "pdf": _cylinder_pdf,
-                    "iges": _cylinder_iges, "assembly": _cylinder_assembly, "lift_table": _cylinder_lift_table},
+                    "iges": _cylinder_iges, "assembly": _cylinder_assembly, "lift_table": None},
 }
 
 #: a kind's own outputs that need cadquery: a run skips them with a warning when it is missing, as the STEP

@@ -24,7 +24,7 @@ from camfab.io import atomic_write
 from camfab.textsafe import plain
 
 __all__ = ["HEADER", "lift_table_csv", "lift_angles", "write_lift_table", "lift_metadata", "cylinder_lift_columns",
-           "cylinder_lift_metadata"]
+           "cylinder_lift_metadata", "cylinder_lift_csv"]
 
 #: the CSV header line
 HEADER = "angle_deg,lift_mm"
@@ -171,3 +171,13 @@ def cylinder_lift_metadata(spec, geometry, step_deg: float, unit: str) -> dict[s
                                                  "developed on the pitch cylinder",
             "minus_flank_x_mm, minus_flank_z_mm": f"contact point on the -z {'rib' if rib else 'groove'} flank, "
                                                    "developed on the pitch cylinder"}
+
+
+def cylinder_lift_csv(spec, geometry, step_deg: float) -> str:
+    """A cylindrical cam's lift table (docs/decisions.md, "Cylindrical cams: the lift table CSV"): every
+    ``step_deg`` from 0 below 360, the lift and :func:`cylinder_lift_columns`, after its metadata."""
+    ang = lift_angles(step_deg)
+    unit = str(geometry.axis.lift_unit)
+    lift = geometry.program.evaluate(np.radians(ang), (0,))[0]
+    return lift_table_csv(ang, lift, lift_unit=unit, columns=cylinder_lift_columns(geometry, ang),
+                          meta=cylinder_lift_metadata(spec, geometry, step_deg, unit))
