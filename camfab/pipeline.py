@@ -451,8 +451,11 @@ def _gcode(cam: Cam, req: Request) -> list[Artifact]:
 
 def _lift_table(cam: Cam, req: Request) -> list[Artifact]:
     from .gcode import lift_angles, lift_table_csv
-    from .gcode.lift_table import lift_metadata
+    from .gcode.lift_table import cylinder_lift_csv, lift_metadata
 
+    if cam.spec.cam.kind == "cylindrical":  # developed on the pitch cylinder
+        text = cylinder_lift_csv(cam.spec, cam.geometry, req.lift_step_deg)
+        return [Artifact(f"{safe_stem(cam.name)}_lift.csv", text.encode(), "lift_table")]
     prog = cam.spec.program()
     if not prog.axis.rotating:
         raise GeometryError("a polar lift table needs a rotating cam")

@@ -28,6 +28,7 @@ __all__ = [
     "Curvature",
     "PressureAngle",
     "FaceLength",
+    "pair_names",
     "Preload",
     "JumpSpeed",
     "DynamicsSummary",
@@ -389,6 +390,13 @@ class JumpSpeed:
         return {"value": _plain(self.value), "unit": self.unit, "at_deg": _plain(self.at)}
 
 
+def pair_names(flanks: bool) -> tuple[str, str]:
+    """The two contacts of a form-closed follower as tables and plots label them: a groove's one roller between its
+    inner and outer flank (``flanks``), else follower 1 and follower 2 (a conjugate pair, a constant-width or
+    -diameter cam)."""
+    return ("inner flank", "outer flank") if flanks else ("follower 1", "follower 2")
+
+
 @dataclass(frozen=True)
 class DynamicsSummary:
     """Follower forces at the design speed (N, N·m, J, W).
@@ -417,6 +425,8 @@ class DynamicsSummary:
         Form-closed followers: follower 2's contact force.
     load_reversals : tuple of (from, to) or None
         Form-closed followers: where the load passes to the other follower.
+    flanks : bool
+        A groove cam: the two contacts are its inner and outer flank (:attr:`contact_names`), not two followers.
     """
 
     form_closed: bool
@@ -431,6 +441,12 @@ class DynamicsSummary:
     jump_speed: JumpSpeed | None = None
     second_contact_force: Extreme | None = None
     load_reversals: tuple[tuple[float, float], ...] | None = None
+    flanks: bool = False
+
+    @property
+    def contact_names(self) -> tuple[str, str]:
+        """The labels of a form-closed follower's two contacts (:func:`pair_names`)."""
+        return pair_names(self.flanks)
 
     def to_dict(self) -> dict[str, Any]:
         """The ``dynamics`` object of ``check --json``."""

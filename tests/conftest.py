@@ -78,6 +78,22 @@ def base_design(**over):
     return d
 
 
+#: the arm of :func:`oscillating_cylinder` (mm)
+CYLINDER_ARM_MM = 60.0
+
+
+def oscillating_cylinder(rotation: str = "cw") -> dict:
+    """A cylindrical cam's design dict with an oscillating roller follower (arm :data:`CYLINDER_ARM_MM`, pivot
+    perpendicular to the axis): a groove 10 mm deep around a 40 mm pitch radius, poly345 30° up over 180° and
+    down over 180°."""
+    return {"name": "b", "cam": {"kind": "cylindrical", "rotation": rotation},
+            "cylinder": {"radius_mm": 40.0, "length_mm": 90.0, "groove_depth_mm": 10.0},
+            "follower": {"type": "roller", "motion": "oscillating", "roller_radius_mm": 6.0,
+                         "arm_length_mm": CYLINDER_ARM_MM},
+            "motion": [{"law": "poly345", "lift": 30.0, "angle_deg": 180.0},
+                       {"law": "poly345", "lift": -30.0, "angle_deg": 180.0}]}
+
+
 def _designs():
     from camfab.design.spec import design_from_dict
     from camfab.formats import load_design

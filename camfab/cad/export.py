@@ -41,15 +41,17 @@ def cam_shapes(geometry, *, tol: float, with_pitch: bool = True) -> CamShapes:
     """Arc-fit every profile of ``geometry`` within ``tol`` (measured)."""
     tol = validate_tol(tol)
     profiles, pitch, curves = [], [], []
-    for c in geometry.profiles:
+    groove = getattr(getattr(geometry, "mechanism", None), "cam_kind", None) == "groove"
+    for i, c in enumerate(geometry.profiles):
         curve = profile_curve(c)
         _require_continuous(curve, tol)
         profiles.append(arcs(curve, tol=tol))
         curves.append(curve)
-        pc = pitch_curve(c) if with_pitch and c.roller_radius > 0 else None
+        # a groove's flanks share one pitch curve, the inner flank's offset (the outer flank's offset by +w lies
+        # 2w off it: measured far from every sample, then fitted again, for nothing)
+        pc = pitch_curve(c) if with_pitch and c.roller_radius > 0 and not (groove and i > 0) else None
         if pc is not None:
             pitch.append(_pitch_loop(profiles[-1], c.roller_radius, pc, tol))
-    groove = getattr(getattr(geometry, "mechanism", None), "cam_kind", None) == "groove"
     return CamShapes(tuple(profiles), tuple(pitch), tuple(curves), tol, groove)
 
 

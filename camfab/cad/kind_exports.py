@@ -126,11 +126,12 @@ def _cylinder_assembly(cam: Any, req: Any) -> list[Artifact]:
 
 #: cam kinds whose files are made by their own exporters, by output name; an output missing from a kind's
 #: entry does not apply to it (:func:`not_applicable_reason`); None: the pipeline's own stage, which handles the kind
-#: (the report and workbook; the 4-axis program of :mod:`camfab.gcode.rotary`, dispatched in ``pipeline._gcode``)
+#: (the report and workbook; the 4-axis program of :mod:`camfab.gcode.rotary`, dispatched in ``pipeline._gcode``;
+#: the lift table of :func:`camfab.gcode.lift_table.cylinder_lift_csv`, in ``pipeline._lift_table``)
 KIND_EXPORTERS: dict[str, dict[str, Callable[[Any, Any], list[Artifact]] | None]] = {
     "cylindrical": {"dxf": _cylinder_dxf, "step": _cylinder_step, "xlsx": None, "report": None,
                     "stl": _cylinder_stl, "gcode": None, "drawing": _cylinder_drawing, "pdf": _cylinder_pdf,
-                    "iges": _cylinder_iges, "assembly": _cylinder_assembly},
+                    "iges": _cylinder_iges, "assembly": _cylinder_assembly, "lift_table": None},
 }
 
 #: a kind's own outputs that need cadquery: a run skips them with a warning when it is missing, as the STEP

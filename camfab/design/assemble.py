@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import sys
 from typing import TYPE_CHECKING
 
 from ..errors import InputError
@@ -34,9 +33,7 @@ def check_design(spec: DesignSpec, *, tool_radius_mm: float | None = None) -> Ch
                    allow_acceleration_jump=spec.cam.kind in ("constant_width", "constant_diameter"),
                    tool_radius_mm=tool_radius_mm, face_margin_mm=spec.face_margin_mm,
                    name=spec.name, speed=spec.speed, strength=strength_input(spec, geom))
-    cylindrical = sys.modules.get(f"{__package__}.cylindrical")  # imported on first use by its families only
-    if cylindrical is not None and isinstance(geom, cylindrical.CylindricalGeometry):
-        report = cylindrical.cylinder_report(report, geom)
+    report = geom.summarised(report)  # a cylindrical cam's cylinder summary
     extra = knot_findings(spec)
     if spec.dynamics is not None:
         dyn = dynamics_of(spec, geom)
@@ -65,7 +62,7 @@ def loads_from_spec(d: DynamicsSpec) -> Loads:
 
 
 def is_form_closed(spec: DesignSpec) -> bool:
-    """Conjugate, constant-width, constant-diameter and groove cams drive their follower both ways."""
+    """Conjugate, constant-width, constant-diameter, groove and cylindrical cams drive their follower both ways."""
     return spec.cam.kind.form_closed
 
 

@@ -150,6 +150,8 @@ class DesmodromicGeometry(CamGeometry):
     constant-width/diameter cams have one, touched by follower 2 at φ + π.
     """
 
+    form_closed: ClassVar[bool] = True
+
     @property
     def second_program(self):
         """Follower 2's law S₂ = h − S₁ of a conjugate pair (None for one profile)."""

@@ -128,6 +128,9 @@ class CylindricalGeometry(CamGeometry):
     cylinder (a rib's root, pitch and top), in that order (six :class:`DevelopedContact`, the +z flank first),
     each checked like a profile."""
 
+    #: the groove's two flanks (a rib's two rollers) drive the follower both ways
+    form_closed: ClassVar[bool] = True
+
     @property
     def cylinder(self) -> CylinderSpec:
         return self.mechanism.cylinder
@@ -141,6 +144,10 @@ class CylindricalGeometry(CamGeometry):
     def min_radius(self) -> float:
         """The radius of the groove bottom (mm)."""
         return self.cylinder.inner_radius_mm
+
+    def summarised(self, report: Any) -> Any:
+        """The check report with the cylinder's summary (:func:`cylinder_report`)."""
+        return cylinder_report(report, self)
 
     def at_radius(self, r: float, flank: int = 1) -> DevelopedContact:
         """The flank ``flank`` (+1: +z side, −1: −z side) on the developed cylinder of radius ``r``."""

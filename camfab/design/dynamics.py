@@ -41,10 +41,9 @@ angle; D does not depend on the speed).
 from __future__ import annotations
 
 import math
-import sys
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -261,6 +260,9 @@ class PairDynamics:
         profile follower 2 touches half a turn later; 0 for a conjugate pair).
     """
 
+    #: the two contacts are a groove's flanks (:func:`~camfab.results.pair_names`)
+    flanks: ClassVar[bool] = False
+
     def __init__(self, first: ContactDynamics, second: ContactDynamics, shift: float = 0.0):
         self.first, self.second, self.shift = first, second, float(shift)
         self.contact, self.loads, self.speed = first.contact, first.loads, first.speed
@@ -289,6 +291,7 @@ class GrooveDynamics(PairDynamics):
     ``lever`` is the carrying flank's D, signed so that it is > 0 unless wedged."""
 
     names = ("the inner flank", "the outer flank")
+    flanks: ClassVar[bool] = True
 
     def __init__(self, first: ContactDynamics, second: ContactDynamics):
         super().__init__(first, second, 0.0)
@@ -306,20 +309,16 @@ class GrooveDynamics(PairDynamics):
                               s1.curvature, s2.curvature)
 
 
-def _loaded_instance(geometry: Any, module: str, cls: str) -> bool:
-    """Whether ``geometry`` is a ``cls`` of the sibling ``module``, without importing it: an instance exists only
-    once its module is loaded (each family's module is imported on first use)."""
-    mod = sys.modules.get(f"{__package__}.{module}")
-    return mod is not None and isinstance(geometry, getattr(mod, cls))
-
-
 def pair_of(geometry: CamGeometry, loads: Loads, speed: float) -> PairDynamics:
     """The :class:`PairDynamics` of a desmodromic geometry (two profiles, or one touched twice), or the
     :class:`GrooveDynamics` of a groove cam."""
     profs = geometry.profiles
     first = ContactDynamics(profs[0], loads, speed)
-    if _loaded_instance(geometry, "groove", "GrooveGeometry"):
+    if geometry.flank_pair:
         return GrooveDynamics(first, ContactDynamics(profs[1], loads, speed))
+    if len(profs) > 2:
+        raise InputError(f"no force model for a {type(geometry).__name__} ({len(profs)} contacts): the dynamics "
+                         "take a conjugate pair, a constant-width or -diameter cam, or a disc groove")
     if len(profs) == 2:  # conjugate: follower 2 is the mirror image of a plain follower on a mirrored cam,
         # and every scalar (N, D, G, torque, power) is the same computed in that mirrored world
         return PairDynamics(first, ContactDynamics(getattr(profs[1], "_inner", profs[1]), loads, speed))
@@ -387,15 +386,12 @@ def analyse_dynamics(geometry: CamGeometry, loads: Loads, speed: float, *, prelo
 
     A force-closed (spring-loaded) follower is checked for jump and its safety force, with the
     preload and the speed at the limit; a form-closed follower (``form_closed``, default: the
-    geometry is desmodromic) reports both followers' forces and where the load passes between them.
+    geometry's ``form_closed``) reports both followers' forces and where the load passes between them.
     Every extreme is exact (refined between the motion's breakpoints); ranges are located by
     root refinement.  ``speed`` is ω (rad/s), or mm/s for a translating cam.
     """
     if form_closed is None:
-        # a desmodromic or groove geometry exists only once its module is loaded (imported on first use: a check
-        # of a spring-loaded cam need not import them)
-        form_closed = (_loaded_instance(geometry, "conjugate", "DesmodromicGeometry")
-                       or _loaded_instance(geometry, "groove", "GrooveGeometry"))
+        form_closed = geometry.form_closed
     if not form_closed and len(geometry.profiles) != 1:
         raise InputError(f"form_closed=False needs one profile, the geometry has {len(geometry.profiles)}: "
                          "a force-closed cam has one follower; pass form_closed=True for a conjugate pair")
@@ -425,7 +421,8 @@ def analyse_dynamics(geometry: CamGeometry, loads: Loads, speed: float, *, prelo
     if form_closed:
         rev = _reversals(ranges[1], ranges[2], c, getattr(dyn, "names", ("follower 1", "follower 2")))
         summary = DynamicsSummary(safety_force_n=None, second_contact_force=extreme("contact_force_2"),
-                                  load_reversals=tuple((a, b) for a, b, _ in rev), **common)
+                                  load_reversals=tuple((a, b) for a, b, _ in rev),
+                                  flanks=getattr(dyn, "flanks", False), **common)
         return DynamicsReport(summary, tuple(findings + [f for _, _, f in rev]))
     fs = loads.safety_force_n
     (at_pre, pre), (at_jump, r_jump) = found[("preload", True)], found[("jump", False)]

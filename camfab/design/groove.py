@@ -106,6 +106,9 @@ class OuterOscillatingFlank(_Outer, OscillatingRollerContact):
 class GrooveGeometry(CamGeometry):
     """A groove cam's geometry: profile 0 the inner flank, profile 1 the outer flank (one pitch curve)."""
 
+    form_closed: ClassVar[bool] = True
+    flank_pair: ClassVar[bool] = True
+
     @property
     def half_width_mm(self) -> float:
         """w = R_r + b/2: the distance of each flank from the pitch curve (mm)."""

@@ -47,8 +47,10 @@ class CamKind(StrEnum):
 
     @property
     def form_closed(self) -> bool:
-        """Conjugate, constant-width, constant-diameter and (disc) groove cams drive their follower both ways."""
-        return self in (CamKind.CONJUGATE, CamKind.CONSTANT_WIDTH, CamKind.CONSTANT_DIAMETER, CamKind.GROOVE)
+        """Conjugate, constant-width, constant-diameter, (disc) groove and cylindrical (groove or rib) cams drive
+        their follower both ways (each family's geometry class says the same: ``CamGeometry.form_closed``)."""
+        return self in (CamKind.CONJUGATE, CamKind.CONSTANT_WIDTH, CamKind.CONSTANT_DIAMETER, CamKind.GROOVE,
+                        CamKind.CYLINDRICAL)
 
     @property
     def symmetric(self) -> bool:

@@ -56,7 +56,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Any, ClassVar, Protocol
 
 import numpy as np
 
@@ -361,6 +361,13 @@ class CamGeometry:
         Every mechanism and motion/mechanism problem found, together.
     """
 
+    #: the cam drives its follower both ways (conjugate pair, constant width/diameter, groove, cylindrical
+    #: groove or rib): no return spring, no jump; equal to the families' ``CamKind.form_closed``
+    form_closed: ClassVar[bool] = False
+    #: one roller between two flanks of one pitch curve (a disc groove: profile 0 the inner flank, 1 the outer),
+    #: whose force model is :class:`~camfab.design.dynamics.GrooveDynamics`
+    flank_pair: ClassVar[bool] = False
+
     def __init__(self, mechanism: Any, program: MotionLike, *, bore_mm: float | None = None):
         kind = getattr(mechanism, "geometry_class", None)
         if kind is None or not isinstance(self, kind):
@@ -421,6 +428,11 @@ class CamGeometry:
     def initial_arm_angle_deg(self) -> float | None:
         a = self.initial_arm_angle
         return None if a is None else math.degrees(a)
+
+    def summarised(self, report: Any) -> Any:
+        """The check report (:class:`~camfab.results.CheckReport`) with this geometry's own summary: unchanged
+        here; a cylindrical cam adds its cylinder's radii, roller and slip."""
+        return report
 
     # ---- extremes and area --------------------------------------------
     def radius_extremes(self, profile: int = 0) -> Extremes:

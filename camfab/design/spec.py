@@ -511,6 +511,10 @@ def _dynamics(v: Validator, data: Mapping[str, Any], cam: CamSpec, fol: Follower
     if "dynamics" not in data:
         return None
     t = v.table(data, "dynamics")
+    if cam.kind == CamKind.CYLINDRICAL:  # six developed contacts, no force model yet
+        v.add("dynamics", "...", "a cylindrical cam has no force model yet",
+              "remove [dynamics] (and [vibration]); the geometry checks do not need it")
+        return None
     osc = fol.motion == FollowerMotion.OSCILLATING and cam.kind != CamKind.TRANSLATING
     own = _DYN_OSCILLATING if osc else _DYN_TRANSLATING
     _dynamics_keys(v, t, osc)

@@ -82,7 +82,7 @@ import numpy as np
 from ..design.kinds import ContactKind, FollowerType
 from ..design.tables import LiftTable, intervals, lift_table, sample_params
 from ..errors import InputError
-from ..results import JUMP_CODES, IssueCode, Severity, Verdict
+from ..results import JUMP_CODES, IssueCode, Severity, Verdict, pair_names
 from ..textsafe import xlsx_no_formulas, xlsx_put, xlsx_text
 
 __all__ = ["CAMDAS_COLUMNS", "FIXED_DATE", "LiftTable", "camdas_workbook", "camdas_columns", "conclusions",
@@ -251,9 +251,10 @@ def dynamics_columns(spec, geometry, *, step_deg: float = 1.0) -> tuple[list[str
     x = sample_params(geometry, step_deg)
     sm = dynamics_model(spec, geometry).evaluate(x)
     pair = sm.contact_force_2 is not None
+    a, b = pair_names(geometry.flank_pair)
     head = ["Cam angle (deg)" if geometry.closed else "Cam travel (mm)",
-            "Contact force, follower 1 (N)" if pair else "Contact force (N)",
-            *(["Contact force, follower 2 (N)"] if pair else []), "Friction force (N)",
+            f"Contact force, {a} (N)" if pair else "Contact force (N)",
+            *([f"Contact force, {b} (N)"] if pair else []), "Friction force (N)",
             "Bearing force (N)", "Drive torque (N·m)" if geometry.closed else "Drive force (N)", "Power (W)"]
     cols = [geometry.to_user(x), sm.contact_force, *([sm.contact_force_2] if pair else []), sm.friction_force,
             sm.bearing_force, sm.drive, sm.power]
@@ -279,7 +280,8 @@ def _stress_columns(spec, geometry, sm) -> list[tuple[str, np.ndarray]]:
     st = model.of_sample(sm)
     if st.stress_2 is None:
         return [("Contact stress (MPa)", st.stress)]
-    return [("Contact stress, follower 1 (MPa)", st.stress), ("Contact stress, follower 2 (MPa)", st.stress_2)]
+    a, b = pair_names(geometry.flank_pair)
+    return [(f"Contact stress, {a} (MPa)", st.stress), (f"Contact stress, {b} (MPa)", st.stress_2)]
 
 
 def dynamics_summary_rows(report) -> list[tuple[str, Any, str, float | None]]:
@@ -295,9 +297,10 @@ def dynamics_summary_rows(report) -> list[tuple[str, Any, str, float | None]]:
               ("Work per cycle", d.work_per_cycle_j, "J", None), ("Mean power", d.mean_power_w, "W", None)]
     if d.form_closed:
         cf2 = d.second_contact_force
-        return [("Maximum contact force, follower 1", cf.max, "N", cf.at_max),
-                ("Maximum contact force, follower 2", cf2.max, "N", cf2.at_max), *common,
-                *[("Load passes to the other follower", lo, "deg" if torque else "mm", None)
+        (a, b), other = d.contact_names, "flank" if d.flanks else "follower"
+        return [(f"Maximum contact force, {a}", cf.max, "N", cf.at_max),
+                (f"Maximum contact force, {b}", cf2.max, "N", cf2.at_max), *common,
+                *[(f"Load passes to the other {other}", lo, "deg" if torque else "mm", None)
                   for lo, _ in d.load_reversals or ()]]
     pre, js = d.preload_needed, d.jump_speed
     return [("Minimum contact force", cf.min, "N", cf.at_min),

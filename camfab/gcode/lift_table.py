@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -22,7 +23,8 @@ from camfab.errors import Problem, SpecError
 from camfab.io import atomic_write
 from camfab.textsafe import plain
 
-__all__ = ["HEADER", "lift_table_csv", "lift_angles", "write_lift_table", "lift_metadata"]
+__all__ = ["HEADER", "lift_table_csv", "lift_angles", "write_lift_table", "lift_metadata", "cylinder_lift_columns",
+           "cylinder_lift_metadata", "cylinder_lift_csv"]
 
 #: the CSV header line
 HEADER = "angle_deg,lift_mm"
@@ -50,7 +52,7 @@ def lift_angles(step_deg: float) -> np.ndarray:
 
 
 def lift_table_csv(angles_deg, lift_mm, *, lift_unit: str = "mm", radii_mm: Sequence | None = None,
-                   meta: Mapping[str, str] | None = None) -> str:
+                   meta: Mapping[str, str] | None = None, columns: Mapping[str, Any] | None = None) -> str:
     """The polar lift table as CSV text.
 
     Parameters
@@ -66,6 +68,9 @@ def lift_table_csv(angles_deg, lift_mm, *, lift_unit: str = "mm", radii_mm: Sequ
         profile, ``radius_cam1_mm``, ``radius_cam2_mm``, ... for several.
     meta : mapping of str to str, optional
         Metadata written first as ``# key: value`` lines (values made one line of plain text).
+    columns : mapping of str to array_like (n,), optional
+        More columns after the lift (and the radii), by header name (a cylindrical cam's axial position and
+        developed flanks: :func:`cylinder_lift_columns`).
 
     Returns
     -------
@@ -78,7 +83,8 @@ def lift_table_csv(angles_deg, lift_mm, *, lift_unit: str = "mm", radii_mm: Sequ
     """
     a = np.asarray(angles_deg, dtype=float).reshape(-1)
     lift = np.asarray(lift_mm(a) if callable(lift_mm) else lift_mm, dtype=float).reshape(-1)
-    radii = [np.asarray(r, dtype=float).reshape(-1) for r in (radii_mm or ())]
+    more = {k: np.asarray(v, dtype=float).reshape(-1) for k, v in (columns or {}).items()}
+    radii = [np.asarray(r, dtype=float).reshape(-1) for r in (radii_mm or ())] + list(more.values())
     problems = []
     if a.size == 0:
         problems.append(Problem("angles_deg", [], "must not be empty", "give at least one angle"))
@@ -97,7 +103,9 @@ def lift_table_csv(angles_deg, lift_mm, *, lift_unit: str = "mm", radii_mm: Sequ
     if problems:
         raise SpecError(problems)
     rows = [f"# {plain(k)}: {plain(v)}" for k, v in (meta or {}).items()]
-    names = ["radius_mm"] if len(radii) == 1 else [f"radius_cam{i + 1}_mm" for i in range(len(radii))]
+    n = len(radii) - len(more)
+    names = ["radius_mm"] if n == 1 else [f"radius_cam{i + 1}_mm" for i in range(n)]
+    names += list(more)
     rows.append(",".join(["angle_deg", f"lift_{lift_unit}", *names]))
     cols = [a.tolist(), lift.tolist(), *(r.tolist() for r in radii)]
     rows += [",".join(_f6(v) for v in row) for row in zip(*cols, strict=True)]
@@ -127,3 +135,49 @@ def lift_metadata(spec, step_deg: float, unit: str, n: int) -> dict[str, str]:
             "lift": f"{lift}; 0 = the follower on the base circle (its lowest position)",
             col: "distance from the cam centre to the contact point on the profile at that cam angle, mm"}
     return meta
+
+
+def cylinder_lift_columns(geometry, angles_deg) -> dict[str, np.ndarray]:
+    """A cylindrical cam's columns after the lift, on the pitch cylinder R developed (x = R·θ along its
+    circumference from the follower's generator at cam angle 0, z along the axis): the roller axis's z (``z_mm``,
+    the drawing sheet's ``Z mm``), the pitch point's x, and the contact point of the +z and the −z flank (a rib:
+    the flank facing each roller) as x, z."""
+    x = np.radians(np.asarray(angles_deg, dtype=float))
+    r = geometry.cylinder.radius_mm
+    plus, minus = geometry.at_radius(r, 1).evaluate(x), geometry.at_radius(r, -1).evaluate(x)
+    return {"z_mm": plus.pitch[:, 1], "pitch_x_mm": plus.pitch[:, 0],
+            "plus_flank_x_mm": plus.point[:, 0], "plus_flank_z_mm": plus.point[:, 1],
+            "minus_flank_x_mm": minus.point[:, 0], "minus_flank_z_mm": minus.point[:, 1]}
+
+
+def cylinder_lift_metadata(spec, geometry, step_deg: float, unit: str) -> dict[str, str]:
+    """The metadata lines of a cylindrical cam's lift table (:func:`cylinder_lift_columns`)."""
+    f, cyl = spec.follower, geometry.cylinder
+    lift = "arm angle of the oscillating follower, deg" if unit == "deg" else "follower travel along the axis, mm"
+    rib = str(cyl.feature) == "rib"
+    return {"table": "camfab cylindrical cam lift table", "design": spec.name,
+            "follower": f"{f.type.title}, {f.motion}", "roller radius": f"{f.roller_radius_mm:g} mm",
+            "pitch radius": f"{cyl.radius_mm:g} mm", "feature": str(cyl.feature),
+            "cam rotation": f"{spec.cam.rotation}",
+            "units": f"angle_deg in degrees, lift_{unit} in {unit}, positions in mm",
+            "angle step": f"{step_deg:g} deg",
+            "angle 0": "the start of the first [[motion]] segment, the follower's generator at x = 0",
+            "lift": f"{lift}; 0 = the start of the law",
+            "z_mm": ("the rib's mid-line (the follower's pitch point; its rollers either side)" if rib else
+                     "the roller axis's position")
+                    + " along the cylinder axis from its z = 0 end face (the pitch curve)",
+            "pitch_x_mm": "the pitch point on the pitch cylinder developed: x = R·theta along the circumference",
+            "plus_flank_x_mm, plus_flank_z_mm": f"contact point on the +z {'rib' if rib else 'groove'} flank, "
+                                                 "developed on the pitch cylinder",
+            "minus_flank_x_mm, minus_flank_z_mm": f"contact point on the -z {'rib' if rib else 'groove'} flank, "
+                                                   "developed on the pitch cylinder"}
+
+
+def cylinder_lift_csv(spec, geometry, step_deg: float) -> str:
+    """A cylindrical cam's lift table (docs/decisions.md, "Cylindrical cams: the lift table CSV"): every
+    ``step_deg`` from 0 below 360, the lift and :func:`cylinder_lift_columns`, after its metadata."""
+    ang = lift_angles(step_deg)
+    unit = str(geometry.axis.lift_unit)
+    lift = geometry.program.evaluate(np.radians(ang), (0,))[0]
+    return lift_table_csv(ang, lift, lift_unit=unit, columns=cylinder_lift_columns(geometry, ang),
+                          meta=cylinder_lift_metadata(spec, geometry, step_deg, unit))

@@ -194,7 +194,8 @@ def _highlights(spec, report) -> list[str]:
     dyn = report.dynamics
     if dyn is not None and dyn.form_closed:
         n = len(dyn.load_reversals or ())
-        out.append(f"Form-closed follower: the load passes between the followers {n} time{'s' if n != 1 else ''} "
+        between = "the groove's flanks" if dyn.flanks else "the followers"
+        out.append(f"Form-closed follower: the load passes between {between} {n} time{'s' if n != 1 else ''} "
                    "per cycle")
     elif dyn is not None:
         cf = dyn.contact_force
@@ -236,15 +237,16 @@ def _pair_rows(dyn: DynamicsSummary, report, xu: str) -> list[dict[str, Any]]:
     none, rows = table_cell(None), []
     second = dyn.second_contact_force
     assert second is not None  # a form-closed summary carries follower 2's contact force
-    for k, cf in ((1, dyn.contact_force), (2, second)):
-        rows.append(_row(f"Contact force, follower {k} (N)", table_cell(cf.max, cf.at_max, xu),
+    names, other = dyn.contact_names, "flank" if dyn.flanks else "follower"
+    for k, cf in ((0, dyn.contact_force), (1, second)):
+        rows.append(_row(f"Contact force, {names[k]} (N)", table_cell(cf.max, cf.at_max, xu),
                          table_cell(cf.min, cf.at_min, xu),
-                         "Form closure: the follower cannot leave the cam" if k == 1 else
-                         "Pushes where follower 1 cannot (the load has changed sides)"))
+                         "Form closure: the follower cannot leave the cam" if k == 0 else
+                         f"Pushes where the {names[0]} cannot (the load has changed sides)"))
     rev = dyn.load_reversals or ()
     where = ", ".join(f"{a:.1f}{xu}" for a, _ in rev) or "never"
     rows.append(_row("Load reversals", {**none, "text": str(len(rev))}, none,
-                     f"The load passes to the other follower at {where}: across a clearance the follower knocks"))
+                     f"The load passes to the other {other} at {where}: across a clearance the follower knocks"))
     return rows + _drive_rows(dyn, report, xu)
 
 

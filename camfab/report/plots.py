@@ -25,7 +25,7 @@ import numpy as np
 
 from ..design.kinds import ContactKind
 from ..errors import InputError
-from ..results import Extreme, IssueCode
+from ..results import Extreme, IssueCode, pair_names
 from ..textsafe import mpl_text
 from ._common import CURVATURE_CODES, Axis, axis_of, finding_spans, fmt, fmt_at, sample_grid
 from .figpool import figure_with_axes
@@ -498,9 +498,10 @@ def dynamics_figure(spec, geometry, report, *, n: int = _N):
         fig, (ax, ax2) = figure_with_axes("dynamics", 9.0, 6.4,
                                           lambda f: f.subplots(2, 1, sharex=True, height_ratios=(3, 2)))
         force, lim = _finite_view(sm.contact_force, locking)
-        ax.plot(x * axis.scale, force, color="C0", label="follower 1" if pair else "contact force N")
+        names = pair_names(geometry.flank_pair)
+        ax.plot(x * axis.scale, force, color="C0", label=names[0] if pair else "contact force N")
         if pair:
-            ax.plot(x * axis.scale, sm.contact_force_2, color="C1", label="follower 2")
+            ax.plot(x * axis.scale, sm.contact_force_2, color="C1", label=names[1])
             _mark_extremes(ax, dyn.second_contact_force if dyn else None, "N", xu, "0.1", lim, max_only=True)
         ax.axhline(0.0, color="0.1", lw=0.9, label="N = 0" if pair else "N = 0 (jump limit)")
         if fs:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from ..results import IssueCode
+from ..results import IssueCode, pair_names
 from ..textsafe import mpl_text
 from ._common import axis_of, finding_spans, fmt_at, sample_grid
 from .plots import boundaries, new_figure, plot_style, shade, x_axis
@@ -46,11 +46,12 @@ def contact_stress_figure(spec, geometry, report, *, n: int = 1441):
         fig = new_figure(9.0, 3.6)
         ax = fig.subplots()
         pair = sm.stress_2 is not None
+        names = pair_names(geometry.flank_pair)
         ax.plot(x * axis.scale, np.where(np.isfinite(sm.stress), sm.stress, np.nan), color="C0",
-                label="follower 1" if pair else "contact stress")
+                label=names[0] if pair else "contact stress")
         if sm.stress_2 is not None:
             ax.plot(x * axis.scale, np.where(np.isfinite(sm.stress_2), sm.stress_2, np.nan), color="C1",
-                    label="follower 2")
+                    label=names[1])
         ax.axhline(inp.allowable_mpa, color="#d62728", lw=1.0, ls="--", label=f"allowable {inp.allowable_mpa:g} MPa")
         shade(ax, finding_spans(report.findings, (IssueCode.CONTACT_STRESS_ABOVE_LIMIT,), axis),
               label="above the allowable")

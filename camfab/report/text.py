@@ -156,9 +156,10 @@ def _dynamics_rows(dyn, codes) -> list[tuple[str, str, str, str]]:
     cf, rows = dyn.contact_force, []
     if dyn.form_closed:
         cf2, rev = dyn.second_contact_force, len(dyn.load_reversals or ())
-        rows.append(("Contact force, follower 1 (N)", _num(cf.max), _num(cf.min), "form-closed: no jump"))
-        rows.append(("Contact force, follower 2 (N)", _num(cf2.max), _num(cf2.min),
-                     f"the load changes follower {rev} time{'s' if rev != 1 else ''} per turn"))
+        (a, b), other = dyn.contact_names, "flank" if dyn.flanks else "follower"
+        rows.append((f"Contact force, {a} (N)", _num(cf.max), _num(cf.min), "form-closed: no jump"))
+        rows.append((f"Contact force, {b} (N)", _num(cf2.max), _num(cf2.min),
+                     f"the load changes {other} {rev} time{'s' if rev != 1 else ''} per turn"))
     else:
         rows.append(("Contact force (N)", _num(cf.max), _num(cf.min),
                      "below the safety force or jumping: see findings" if codes & set(FORCE_CODES) else

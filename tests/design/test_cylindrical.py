@@ -13,6 +13,8 @@ from camfab.design.mechanisms import geometry_from_spec
 from camfab.design.spec import design_from_dict
 from camfab.errors import SpecError
 
+from ..conftest import CYLINDER_ARM_MM, oscillating_cylinder
+
 
 def design(motion=None, follower=None, **cyl):
     c = {"radius_mm": 40.0, "length_mm": 80.0, "groove_depth_mm": 10.0, "backlash_mm": 0.1} | cyl
@@ -103,14 +105,9 @@ def test_oscillating_pitch_is_the_exact_arc():
     """The roller axis of an oscillating follower built in 3D (pivot axis parallel to the radial line at 0°, arm
     L, angle φ = S): it meets the cylinder r where the developed formula says, for both senses (not the
     small-angle z = L·φ, x = r·θ)."""
-    L = 60.0
+    L = CYLINDER_ARM_MM
     for rotation in ("cw", "ccw"):
-        spec = design_from_dict({"name": "b", "cam": {"kind": "cylindrical", "rotation": rotation},
-                                 "cylinder": {"radius_mm": 40.0, "length_mm": 90.0, "groove_depth_mm": 10.0},
-                                 "follower": {"type": "roller", "motion": "oscillating", "roller_radius_mm": 6.0,
-                                              "arm_length_mm": L},
-                                 "motion": [{"law": "poly345", "lift": 30.0, "angle_deg": 180.0},
-                                            {"law": "poly345", "lift": -30.0, "angle_deg": 180.0}]})
+        spec = design_from_dict(oscillating_cylinder(rotation))
         geom = geometry_from_spec(spec)
         sigma = 1 if rotation == "cw" else -1
         theta = np.linspace(0.0, 2 * math.pi, 73)
@@ -174,16 +171,16 @@ def test_cylinder_table_required_and_refused():
 
 def test_run_writes_the_dxf_and_names_what_does_not_apply(tmp_path):
     """`camfab run` on the example: check.json with the cylinder summary, the developed DXF, and every output not
-    made for this kind listed with its reason (no crash, nothing silently left out)."""
+    made for this kind listed with its reason (no crash, nothing silently left out): none since the lift table is
+    made too (a rib's: tests/design/test_cylinder_rib.py)."""
     import json
 
     from camfab import pipeline
 
     cam = pipeline.load("cylindrical_translating")
     res = cam.run(tmp_path, ["dxf", "xlsx", "gcode", "lift_table"])
-    assert sorted(res.files) == ["BarrelCam.dxf", "BarrelCam.nc", "BarrelCam.xlsx", "check.json"]
-    assert set(res.not_applicable) == {"lift_table"}
-    assert all("cylindrical" in why for why in res.not_applicable.values())
+    assert sorted(res.files) == ["BarrelCam.dxf", "BarrelCam.nc", "BarrelCam.xlsx", "BarrelCam_lift.csv", "check.json"]
+    assert res.not_applicable == {}
     check = json.loads((tmp_path / "check.json").read_text())
     assert check["cylinder"]["radii"][0]["radius_mm"] == 35.0
     assert check["pressure_angle_deg"]["max"] == pytest.approx(check["cylinder"]["radii"][0]["pressure_angle_max_deg"])

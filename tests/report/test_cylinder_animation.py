@@ -20,7 +20,7 @@ from camfab.design.spec import design_from_dict
 from camfab.formats import load_design
 from camfab.report.animation import animation_data
 from camfab.report.cylinder_animation import cylinder_animation_data
-from tests.conftest import EXAMPLES
+from tests.conftest import CYLINDER_ARM_MM, EXAMPLES, oscillating_cylinder
 from tests.report.test_cylinder_outputs import Z0, exact
 
 
@@ -63,13 +63,8 @@ def test_cylinder_frames_follow_the_motion_law_between_the_groove_edges():
 
 @pytest.mark.parametrize("rotation", ["cw", "ccw"])
 def test_oscillating_roller_moves_on_its_arc(rotation):
-    L = 60.0
-    spec = design_from_dict({"name": "b", "cam": {"kind": "cylindrical", "rotation": rotation},
-                             "cylinder": {"radius_mm": 40.0, "length_mm": 90.0, "groove_depth_mm": 10.0},
-                             "follower": {"type": "roller", "motion": "oscillating", "roller_radius_mm": 6.0,
-                                          "arm_length_mm": L},
-                             "motion": [{"law": "poly345", "lift": 30.0, "angle_deg": 180.0},
-                                        {"law": "poly345", "lift": -30.0, "angle_deg": 180.0}]})
+    L = CYLINDER_ARM_MM
+    spec = design_from_dict(oscillating_cylinder(rotation))
     geom, d = _data(spec)
     sigma = 1 if rotation == "cw" else -1
     theta = np.asarray(d["frames"]["angle"])
