@@ -91,6 +91,11 @@ def figure_bytes(fig, fmt: str = "png") -> bytes:
         if fmt == "png":
             fig.savefig(buf, format="png", metadata={"Software": None})
         elif fmt == "svg":
+            from .svgfig import figure_svg
+
+            fast = figure_svg(fig) if fig.get_layout_engine() is None else None  # written by hand (svgfig.py)
+            if fast is not None:
+                return fast
             fig.savefig(buf, format="svg", metadata={"Date": None})
         else:
             raise InputError(f"'{fmt}' is not a valid option, must be one of: png, svg")
