@@ -113,6 +113,7 @@ class _Writer:
         self.pt = self.dpi / 72.0
         self.out: list[str] = []
         self.renderer = fig.canvas.get_renderer()
+        self.tick_cache: dict[int, tuple[np.ndarray, list[str]]] = {}
 
     # -- helpers -------------------------------------------------------------------------------------------
     def y(self, v):
@@ -251,7 +252,7 @@ class _Writer:
         self.out.append("</g>")
 
     def artist(self, a, ax, clip: str) -> None:
-        from matplotlib.collections import PolyCollection
+        from matplotlib.collections import LineCollection, PolyCollection
         from matplotlib.lines import Line2D
         from matplotlib.patches import FancyArrowPatch, Patch
         from matplotlib.text import Annotation, Text
@@ -265,6 +266,8 @@ class _Writer:
             self.patch(a, clipped)
         elif isinstance(a, PolyCollection):
             self.polys(a, clipped)
+        elif type(a) is LineCollection:
+            self.segments(a, clipped)
         elif isinstance(a, Annotation):
             self.annotation(a, ax)
         elif isinstance(a, Text):
@@ -288,6 +291,19 @@ class _Writer:
         stroke = self.line_attrs(a.get_edgecolor(), a.get_linewidth(), a.get_linestyle(), None)
         fill = _paint("fill", a.get_facecolor()) if a.get_fill() else 'fill="none"'
         self.out.append(f'<path d="{d}" {fill} {stroke}{clipped}/>')
+
+    def segments(self, a: Any, clipped: str) -> None:
+        """A line collection (the segment junctions): one path per segment, each with its colour and style."""
+        colors, widths, styles = a.get_color(), a.get_linewidth(), a.get_linestyle()
+        trans = a.get_transform()
+        for i, seg in enumerate(a.get_segments()):
+            if len(seg) < 2:
+                continue
+            xy = trans.transform(np.asarray(seg, dtype=float))
+            xy[:, 1] = self.h - xy[:, 1]
+            attrs = self.line_attrs(colors[i % len(colors)], widths[i % len(widths)], "-", styles[i % len(styles)])
+            if attrs:
+                self.out.append(f'<path d="{_polyline(xy)}" fill="none" {attrs}{clipped}/>')
 
     def polys(self, a: Any, clipped: str) -> None:
         faces, edges = a.get_facecolor(), a.get_edgecolor()
@@ -351,6 +367,13 @@ class _Writer:
 
     # -- axes furniture --------------------------------------------------------------------------------------
     def _ticks(self, axis) -> tuple[np.ndarray, list[str]]:
+        """The major ticks inside the view and their labels (computed once per axis and save)."""
+        got = self.tick_cache.get(id(axis))
+        if got is None:
+            got = self.tick_cache[id(axis)] = self._new_ticks(axis)
+        return got
+
+    def _new_ticks(self, axis) -> tuple[np.ndarray, list[str]]:
         lo, hi = sorted(axis.get_view_interval())
         span = (hi - lo) or 1.0
         locs = np.asarray(axis.get_majorticklocs(), dtype=float)
