@@ -105,6 +105,19 @@ def _path_d(path, trans, height: float) -> str:
     return "".join(out)
 
 
+def _shown(text: str) -> str:
+    """The characters matplotlib shows for a text without mathtext: ``\\$`` is a dollar sign
+    (:func:`camfab.textsafe.mpl_text` escapes them); control characters, which XML cannot hold, become spaces.
+    A text matplotlib would parse as mathtext is not drawn here."""
+    from matplotlib import cbook
+
+    from ..textsafe import plain
+
+    if cbook.is_math_text(text):
+        raise _Unsupported("mathtext")
+    return "\n".join(plain(line) for line in text.split("\n")).replace("\\$", "$")
+
+
 class _Writer:
     def __init__(self, fig):
         self.fig = fig
@@ -127,6 +140,7 @@ class _Writer:
             return
         if ha not in _ANCHOR or va not in _VA:
             raise _Unsupported(f"alignment {ha}/{va}")
+        s = _shown(s)
         px = size * self.pt
         lines = s.split("\n")
         attrs = [f'x="{_num(x)}"', f'y="{_num(self.y(y))}"', f'font-size="{_num(px)}"',
