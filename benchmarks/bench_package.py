@@ -8,6 +8,10 @@ dwell-compatible laws; random geometry scaled to pass the checks), then times
 --jobs 1 and --jobs 2, each into a fresh folder.  Reports wall time, peak resident memory (the parent and
 its worker processes) and the speed-up.
 
+``--stages`` instead builds the cams in one process per checkout (this one and each ``--root``), alternating
+rounds, and prints each stage's CPU time per cam (``time.process_time``; the manifest's timings are wall time,
+which a loaded machine inflates); ``--profile`` adds a cProfile of one cam (after a first, as in a worker).
+
 ``--fsync`` instead times the built-in examples' package (every output but STEP, one process) with fsync on
 (``camfab.io.DURABLE``, the default) and off, alternating, and reports what the durability costs
 (docs/decisions.md, "Faults: staging, locks, durability").
@@ -18,6 +22,7 @@ the measure least disturbed on a shared machine) and the stage CPU summed over t
 only that count; ``--root DIR`` runs the camfab found in DIR (a checkout to compare with).
 
 Run:  python3 benchmarks/bench_package.py [--cams 100] [--jobs 1,2] [--no-step | --step-only] [--root DIR]
+      python3 benchmarks/bench_package.py --stages [--cams 20] [--root DIR ...] [--repeat 2] [--profile]
       python3 benchmarks/bench_package.py --fsync [--repeat 3]
 """
 from __future__ import annotations
@@ -105,6 +110,60 @@ print(rc, time.perf_counter() - t)
 """
 
 
+#: one process builds every design of a folder (every artifact but STEP, as a package worker does) and prints
+#: the CPU seconds of each stage summed over the cams, as JSON; with a second argument, a cProfile of the last cam
+STAGES_CHILD = """
+import json, sys, time, types
+from pathlib import Path
+import camfab.pipeline as pl
+from camfab.formats import load_design
+pl.time = types.SimpleNamespace(perf_counter=time.process_time)  # the stage timings in CPU seconds
+total, cams = {}, sorted(Path(sys.argv[1]).glob("*.toml"))
+c0 = time.process_time()
+for k, path in enumerate(cams):
+    t = time.process_time()
+    spec = load_design(path)
+    req = pl.Request.from_design(spec, sys.argv[2].split(","), post="linuxcnc")
+    cam = pl.Cam(spec)
+    res = pl.RunResult(cam.name, "", tol=cam.tolerance(req.tol))
+    total["load"] = total.get("load", 0.0) + time.process_time() - t
+    if len(sys.argv) > 3 and k == len(cams) - 1:
+        import cProfile, pstats
+        prof = cProfile.Profile()
+        prof.runcall(pl.build_files, cam, req, res, lambda m: None)
+        pstats.Stats(prof, stream=sys.stderr).sort_stats("cumulative").print_stats(int(sys.argv[3]))
+    else:
+        pl.build_files(cam, req, res, lambda m: None)
+    for key, v in res.timings.items():
+        total[key] = total.get(key, 0.0) + v
+total["all"] = time.process_time() - c0
+print(json.dumps({k: v / len(cams) for k, v in total.items()}))
+"""
+
+
+def stage_cpu(src: Path, roots: list[str], repeat: int, profile: int) -> None:
+    """Per-stage CPU seconds per cam of each checkout, best of ``repeat`` alternating rounds."""
+    import os
+
+    best: dict[str, dict[str, float]] = {r: {} for r in roots}
+    for _ in range(repeat):
+        for r in roots:
+            env = dict(os.environ, PYTHONPATH=r, OMP_NUM_THREADS="1")
+            args = [sys.executable, "-c", STAGES_CHILD, str(src), OUTPUTS] + ([str(profile)] if profile else [])
+            p = subprocess.run(args, capture_output=True, text=True, env=env, cwd=src)
+            if p.returncode:
+                sys.exit(p.stderr)
+            for k, v in json.loads(p.stdout.splitlines()[-1]).items():
+                best[r][k] = min(best[r].get(k, v), v)
+            if profile:
+                print(f"--- cProfile of one cam, {r}\n" + "\n".join(p.stderr.splitlines()[:profile + 40]))
+    keys = sorted({k for b in best.values() for k in b}, key=lambda k: -best[roots[0]].get(k, 0.0))
+    print(f"CPU s per cam (best of {repeat}, one process, OMP_NUM_THREADS=1)")
+    print(f"{'stage':<12}" + "".join(f"{Path(r).name[-14:]:>16}" for r in roots))
+    for k in keys:
+        print(f"{k:<12}" + "".join(f"{best[r].get(k, 0.0):>16.3f}" for r in roots))
+
+
 def fsync_cost(repeat: int) -> None:
     from camfab.formats import EXAMPLES_DIR
 
@@ -128,11 +187,15 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cams", "--n", dest="n", type=int, default=100, help="generated cams (default 100)")
     ap.add_argument("--jobs", default="1,2", help="process counts to run, comma-separated (default 1,2)")
-    ap.add_argument("--root", default=None, help="run the camfab found in this checkout")
+    ap.add_argument("--root", default=None, action="append",
+                    help="run the camfab found in this checkout (--stages: repeat it to compare several)")
     ap.add_argument("--no-step", action="store_true", help="only the set without STEP")
     ap.add_argument("--step-only", action="store_true", help="only the set with STEP")
     ap.add_argument("--fsync", action="store_true", help="the cost of fsync on the built-in examples' package")
-    ap.add_argument("--repeat", type=int, default=3, help="rounds of --fsync")
+    ap.add_argument("--repeat", type=int, default=3, help="rounds of --fsync or --stages")
+    ap.add_argument("--stages", action="store_true", help="per-stage CPU per cam in one process, per checkout")
+    ap.add_argument("--profile", type=int, default=0, metavar="N",
+                    help="--stages: also a cProfile of one cam, its N largest cumulative entries")
     a = ap.parse_args()
     if a.fsync:
         fsync_cost(a.repeat)
@@ -143,6 +206,10 @@ def main() -> None:
         src.mkdir()
         for i in range(a.n):
             (src / f"bench{i:03d}.toml").write_text(design(i, rng))
+        if a.stages:
+            here = str(Path(__file__).resolve().parents[1])
+            stage_cpu(src, [here, *(a.root or [])], a.repeat, a.profile)
+            return
         print(f"{a.n} generated cams")
         print(f"{'outputs':<16}{'jobs':>5}{'wall s':>9}{'s/cam':>8}{'peak MB':>9}{'speed-up':>10}  result")
         sets = [] if a.step_only else [("all but STEP", OUTPUTS)]
@@ -150,7 +217,8 @@ def main() -> None:
         for label, outputs in sets:
             base = None
             for jobs in (int(j) for j in a.jobs.split(",")):
-                wall, peak, res = run(src, Path(tmp) / f"out_{label[:3]}_{jobs}", jobs, outputs, a.root)
+                wall, peak, res = run(src, Path(tmp) / f"out_{label[:3]}_{jobs}", jobs, outputs,
+                                      a.root[-1] if a.root else None)
                 base = base or wall
                 print(f"{label:<16}{jobs:>5}{wall:>9.1f}{wall / a.n:>8.2f}{peak:>9.0f}{base / wall:>9.2f}x  {res}")
                 if jobs == 2:

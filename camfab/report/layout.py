@@ -11,19 +11,38 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["fixed_layout"]
+__all__ = ["fixed_layout", "text_size"]
 
 #: breathing room at each figure edge and between stacked axes (points)
 _EDGE_PT = 5.0
+
+
+#: measured text sizes by (text, font, dpi): the tick labels and axis labels of one report's plots recur in the
+#: next design's (matplotlib measures with FreeType on every call)
+_SIZES: dict[tuple, tuple[float, float]] = {}
 
 
 def _size(renderer, text: str, prop) -> tuple[float, float]:
     """(width, height) of ``text`` in points."""
     if not text:
         return 0.0, 0.0
-    w, h, _ = renderer.get_text_width_height_descent(text, prop, ismath=False)
-    k = 72.0 / renderer.dpi
-    return w * k, h * k
+    key = (text, tuple(prop.get_family()), prop.get_style(), prop.get_variant(), prop.get_weight(),
+           prop.get_stretch(), prop.get_size_in_points(), prop.get_file(), renderer.dpi)
+    got = _SIZES.get(key)
+    if got is None:
+        w, h, _ = renderer.get_text_width_height_descent(text, prop, ismath=False)
+        k = 72.0 / renderer.dpi
+        if len(_SIZES) > 20000:
+            _SIZES.clear()
+        got = _SIZES[key] = (w * k, h * k)
+    return got
+
+
+def text_size(renderer, text: str, size: float) -> tuple[float, float]:
+    """(width, height) in points of ``text`` in the current default font at ``size`` points."""
+    from matplotlib.font_manager import FontProperties
+
+    return _size(renderer, text, FontProperties(size=size))
 
 
 def _tick_labels(axis) -> list[str]:

@@ -91,6 +91,11 @@ def figure_bytes(fig, fmt: str = "png") -> bytes:
         if fmt == "png":
             fig.savefig(buf, format="png", metadata={"Software": None})
         elif fmt == "svg":
+            from .svgfig import figure_svg
+
+            fast = figure_svg(fig) if fig.get_layout_engine() is None else None  # written by hand (svgfig.py)
+            if fast is not None:
+                return fast
             fig.savefig(buf, format="svg", metadata={"Date": None})
         else:
             raise InputError(f"'{fmt}' is not a valid option, must be one of: png, svg")
@@ -99,9 +104,15 @@ def figure_bytes(fig, fmt: str = "png") -> bytes:
 
 # ---------------------------------------------------------------------------
 def boundaries(ax, prog, axis: Axis) -> None:
-    """Faint vertical lines at the segment junctions."""
-    for x in np.asarray(prog.junctions_x, dtype=float)[1:-1]:
-        ax.axvline(x * axis.scale, color="0.45", lw=0.6, ls=":", zorder=0.5)
+    """Faint vertical lines at the segment junctions: one collection, from the bottom of the axes to the top (not
+    in the data limits: every caller fixes the x view with :func:`x_axis`)."""
+    from matplotlib.collections import LineCollection
+
+    xs = np.asarray(prog.junctions_x, dtype=float)[1:-1] * axis.scale
+    if len(xs):
+        segs = np.stack([np.column_stack([xs, np.zeros_like(xs)]), np.column_stack([xs, np.ones_like(xs)])], axis=1)
+        ax.add_collection(LineCollection(list(segs), colors="0.45", linewidths=0.6, linestyles=":", zorder=0.5,
+                                         transform=ax.get_xaxis_transform()), autolim=False)
 
 
 def x_axis(ax, axis: Axis) -> None:
