@@ -35,7 +35,7 @@ import numpy as np
 from ..geom2d import cross
 from .chain import Chain
 from .curve import ParametricCurve
-from .measure import measure_deviation
+from .measure import measure_deviation, measure_fit
 from .results import Deviation
 from .surrogate import HermiteSurrogate
 from .tolerance import WRITE_ROOM_MM, within
@@ -100,7 +100,8 @@ def certified_deviation(chain: Chain, curve: ParametricCurve, sur: HermiteSurrog
     gap = min(CERTIFY_SHARE * tol, 0.5 * (tol - WRITE_ROOM_MM - expected))
     n = samples_for(K, vmax, curve.period, gap)
     if n is not None and n < DEFAULT_SAMPLES:
-        dev = measure_deviation(chain, curve, samples=n)
-        if within(dev.max + sample_gap(K, vmax, curve.period, n), tol):
+        g = sample_gap(K, vmax, curve.period, n)
+        dev = measure_fit(chain, curve, sur, n, g)
+        if within(dev.max + g, tol):
             return dev
     return measure_deviation(chain, curve)
