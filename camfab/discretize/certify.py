@@ -56,9 +56,11 @@ def _curve_bounds(sur: HermiteSurrogate) -> tuple[float, float]:
     """``(max |κ|, max |P′|)`` of the stand-in at both ends and the midpoint of every interval (each inside its
     own smooth piece: one-sided at breakpoints), enlarged by :data:`_SAFETY`."""
     a, b = sur.x[:-1], sur.x[1:]
-    t = np.concatenate([a, 0.5 * (a + b), b])
-    piece = np.tile(sur.piece, 3)
-    d, dd = sur.derivative(t, piece), sur.second_derivative(t, piece)
+    # each interval's own cubic at offsets 0, (a + b)/2 - a and b - a (at b the next interval's start agrees to
+    # rounding: the stand-in is C¹ inside a piece), evaluated from the coefficients without locating the cubics
+    u = np.concatenate([np.zeros_like(a), 0.5 * (a + b) - a, b - a])[:, None]
+    c = np.tile(sur.coef, (1, 3, 1))
+    d, dd = c[1] + u * (2 * c[2] + 3 * u * c[3]), 2 * c[2] + 6 * u * c[3]
     v = np.hypot(d[:, 0], d[:, 1])
     with np.errstate(divide="ignore", invalid="ignore"):
         k = np.abs(cross(d, dd)) / v ** 3
