@@ -124,10 +124,10 @@ def _run_tree(root: Path, index: int, repeat: int) -> dict:
     return json.loads(out.strip().splitlines()[-1])
 
 
-def compare(root: Path, repeat: int, rounds: int) -> None:
-    """Every case with this tree and ``root`` alternating in fresh processes: best CPU time of each."""
+def compare(root: Path, repeat: int, rounds: int, which: list[int]) -> None:
+    """The cases ``which`` with this tree and ``root`` alternating in fresh processes: best CPU time of each."""
     here = HERE.parent
-    for index in range(3):
+    for index in which:
         runs: dict = {"new": [], "old": []}
         for _ in range(rounds):
             runs["old"].append(_run_tree(root, index, repeat))
@@ -145,13 +145,15 @@ def main(argv=None) -> None:
                     "1000 segments: a tenth)")
     ap.add_argument("--root", type=Path, help="compare with the camfab of this tree (alternating processes)")
     ap.add_argument("--rounds", type=int, default=3, help="alternations with --root")
+    ap.add_argument("--cases", default="0,1,2", help="with --root: the cases compared (0 issue cam, 1 constant "
+                    "width, 2 1000 segments)")
     ap.add_argument("--case", type=int, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.case is not None:
         print(json.dumps(measure_case(args.case, args.repeat)))
         return
     if args.root is not None:
-        compare(args.root.resolve(), args.repeat, args.rounds)
+        compare(args.root.resolve(), args.repeat, args.rounds, [int(c) for c in args.cases.split(",")])
         return
     for label, curves, tol, rep in cases(args.repeat):
         report(label, curves, tol, rep)
