@@ -5,16 +5,24 @@
 - the constant-width example (``camfab/examples/constant_width.toml``) at its 1 µm: both profiles;
 - 1000 cycloidal segments of ±0.001 mm over 0.36° each (``bench_limits.py``'s smooth case) at 1 µm.
 
-Every figure is CPU time (``time.process_time``, the fit's own process; BLAS is on one thread inside the fit)
-averaged over ``--repeat`` runs after one warm-up run: on a shared machine wall time is noisy.  The deviation
+Every figure is CPU time (``time.process_time``, the fit's own process; BLAS is on one thread inside the fit),
+the best of ``--repeat`` fits after one warm-up fit: on a shared machine wall time is noisy.  The deviation
 printed is the fit's own measurement, and next to it an independent re-measurement with ten times the curve
 samples (``measure_deviation(..., samples=200 000)``).
 
-Run:  PYTHONPATH=. python3 benchmarks/bench_fit.py [--repeat 20]
+``--root DIR`` compares with the camfab of another tree (e.g. ``--root /work/main``): every case runs in a fresh
+process per tree, the trees alternating ``--rounds`` times, and the best CPU time of each tree is printed with
+both fits' arc counts and deviations (and whether the arcs are the same bit for bit).
+
+Run:  PYTHONPATH=. python3 benchmarks/bench_fit.py [--repeat 20] [--root /work/main --rounds 3]
 """
 from __future__ import annotations
 
 import argparse
+import hashlib
+import json
+import os
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -65,13 +73,38 @@ def segments_design(n: int, lift: float) -> str:
 
 
 def cpu_per_fit(curves: list[ParametricCurve], tol: float, repeat: int) -> tuple[float, list]:
-    """CPU seconds of one fit of every curve (mean of ``repeat`` after a warm-up) and the fits."""
+    """CPU seconds of one fit of every curve (best of ``repeat`` after a warm-up) and the fits."""
     fits = [arcs(c, tol=tol) for c in curves]
-    t0 = time.process_time()
+    best = float("inf")
     for _ in range(repeat):
+        t0 = time.process_time()
         for c in curves:
             arcs(c, tol=tol)
-    return (time.process_time() - t0) / repeat, fits
+        best = min(best, time.process_time() - t0)
+    return best, fits
+
+
+def cases(repeat: int) -> list[tuple[str, list[ParametricCurve], float, int]]:
+    """``(label, curves, tol, repeats)`` of the three benchmark cases."""
+    import camfab
+
+    examples = Path(camfab.__file__).resolve().parent / "examples"
+    cw = design_curves((examples / "constant_width.toml").read_text(), examples)
+    return [("issue-15 roller cam, 1 µm", [issue_cam_curve()], 1e-3, repeat),
+            ("constant-width example, 1 µm", cw, 1e-3, max(1, repeat // 4)),
+            ("1000 cycloidal segments ±0.001 mm, 1 µm", design_curves(segments_design(1000, 0.001), HERE), 1e-3,
+             max(1, repeat // 10))]
+
+
+def measure_case(index: int, repeat: int) -> dict:
+    """One case measured in this process: CPU time, arcs, deviations and a hash of the arcs' bytes."""
+    label, curves, tol, rep = cases(repeat)[index]
+    cpu, fits = cpu_per_fit(curves, tol, rep)
+    digest = hashlib.sha256(b"".join(f.chain().start.tobytes() + f.chain().curvature.tobytes()
+                                     + f.chain().length.tobytes() for f in fits)).hexdigest()[:12]
+    return {"label": label, "cpu": cpu, "arcs": "+".join(str(f.n_entities) for f in fits),
+            "dev": max(f.max_deviation for f in fits), "hash": digest,
+            "indep": max(measure_deviation(f, c, samples=200_000).max for f, c in zip(fits, curves, strict=True))}
 
 
 def report(label: str, curves: list[ParametricCurve], tol: float, repeat: int) -> None:
@@ -82,18 +115,48 @@ def report(label: str, curves: list[ParametricCurve], tol: float, repeat: int) -
     print(f"{label:<44} {n:>9} arcs  dev {dev:.3e} (indep. {indep:.3e}) mm  {1e3 * cpu:9.1f} ms CPU", flush=True)
 
 
+def _run_tree(root: Path, index: int, repeat: int) -> dict:
+    """:func:`measure_case` in a fresh process importing camfab from ``root``."""
+    env = dict(os.environ, PYTHONPATH=str(root))
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    out = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--case", str(index), "--repeat",
+                          str(repeat)], env=env, check=True, capture_output=True, text=True).stdout
+    return json.loads(out.strip().splitlines()[-1])
+
+
+def compare(root: Path, repeat: int, rounds: int, which: list[int]) -> None:
+    """The cases ``which`` with this tree and ``root`` alternating in fresh processes: best CPU time of each."""
+    here = HERE.parent
+    for index in which:
+        runs: dict = {"new": [], "old": []}
+        for _ in range(rounds):
+            runs["old"].append(_run_tree(root, index, repeat))
+            runs["new"].append(_run_tree(here, index, repeat))
+        old, new = (min(runs[k], key=lambda r: r["cpu"]) for k in ("old", "new"))
+        same = "same arcs" if old["hash"] == new["hash"] else "arcs differ"
+        print(f"{new['label']:<44} old {old['arcs']:>9} arcs dev {old['dev']:.4e} (indep. {old['indep']:.4e}) "
+              f"{1e3 * old['cpu']:8.1f} ms | new {new['arcs']:>9} arcs dev {new['dev']:.4e} "
+              f"(indep. {new['indep']:.4e}) {1e3 * new['cpu']:8.1f} ms CPU  ({same})", flush=True)
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeat", type=int, default=20, help="fits averaged (the 1000-segment case: a fifth)")
+    ap.add_argument("--repeat", type=int, default=20, help="fits timed, the best kept (constant width: a quarter, "
+                    "1000 segments: a tenth)")
+    ap.add_argument("--root", type=Path, help="compare with the camfab of this tree (alternating processes)")
+    ap.add_argument("--rounds", type=int, default=3, help="alternations with --root")
+    ap.add_argument("--cases", default="0,1,2", help="with --root: the cases compared (0 issue cam, 1 constant "
+                    "width, 2 1000 segments)")
+    ap.add_argument("--case", type=int, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
-    report("issue-15 roller cam, 1 µm", [issue_cam_curve()], 1e-3, args.repeat)
-    import camfab
-
-    examples = Path(camfab.__file__).resolve().parent / "examples"
-    cw = design_curves((examples / "constant_width.toml").read_text(), examples)
-    report("constant-width example, 1 µm", cw, 1e-3, max(1, args.repeat // 4))
-    report("1000 cycloidal segments ±0.001 mm, 1 µm", design_curves(segments_design(1000, 0.001), HERE), 1e-3,
-           max(1, args.repeat // 10))
+    if args.case is not None:
+        print(json.dumps(measure_case(args.case, args.repeat)))
+        return
+    if args.root is not None:
+        compare(args.root.resolve(), args.repeat, args.rounds, [int(c) for c in args.cases.split(",")])
+        return
+    for label, curves, tol, rep in cases(args.repeat):
+        report(label, curves, tol, rep)
 
 
 if __name__ == "__main__":

@@ -35,7 +35,7 @@ import numpy as np
 from ..geom2d import cross
 from .chain import Chain
 from .curve import ParametricCurve
-from .measure import measure_deviation
+from .measure import measure_deviation, measure_fit
 from .results import Deviation
 from .surrogate import HermiteSurrogate
 from .tolerance import WRITE_ROOM_MM, within
@@ -56,9 +56,11 @@ def _curve_bounds(sur: HermiteSurrogate) -> tuple[float, float]:
     """``(max |κ|, max |P′|)`` of the stand-in at both ends and the midpoint of every interval (each inside its
     own smooth piece: one-sided at breakpoints), enlarged by :data:`_SAFETY`."""
     a, b = sur.x[:-1], sur.x[1:]
-    t = np.concatenate([a, 0.5 * (a + b), b])
-    piece = np.tile(sur.piece, 3)
-    d, dd = sur.derivative(t, piece), sur.second_derivative(t, piece)
+    # each interval's own cubic at offsets 0, (a + b)/2 - a and b - a (at b the next interval's start agrees to
+    # rounding: the stand-in is C¹ inside a piece), evaluated from the coefficients without locating the cubics
+    u = np.concatenate([np.zeros_like(a), 0.5 * (a + b) - a, b - a])[:, None]
+    c = np.tile(sur.coef, (1, 3, 1))
+    d, dd = c[1] + u * (2 * c[2] + 3 * u * c[3]), 2 * c[2] + 6 * u * c[3]
     v = np.hypot(d[:, 0], d[:, 1])
     with np.errstate(divide="ignore", invalid="ignore"):
         k = np.abs(cross(d, dd)) / v ** 3
@@ -100,7 +102,8 @@ def certified_deviation(chain: Chain, curve: ParametricCurve, sur: HermiteSurrog
     gap = min(CERTIFY_SHARE * tol, 0.5 * (tol - WRITE_ROOM_MM - expected))
     n = samples_for(K, vmax, curve.period, gap)
     if n is not None and n < DEFAULT_SAMPLES:
-        dev = measure_deviation(chain, curve, samples=n)
-        if within(dev.max + sample_gap(K, vmax, curve.period, n), tol):
+        g = sample_gap(K, vmax, curve.period, n)
+        dev = measure_fit(chain, curve, sur, n, g)
+        if within(dev.max + g, tol):
             return dev
     return measure_deviation(chain, curve)

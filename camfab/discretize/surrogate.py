@@ -9,7 +9,17 @@ import numpy as np
 
 from .curve import ParametricCurve, derivatives_at, points_at
 
-__all__ = ["HermiteSurrogate", "fit_surrogate", "SURROGATE_FRACTION", "SURROGATE_MAX_NODES"]
+__all__ = ["HermiteSurrogate", "sample_nodes", "fit_surrogate", "SURROGATE_FRACTION", "SURROGATE_MAX_NODES"]
+
+
+def sample_nodes(curve: ParametricCurve, n: int, min_count: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """``(x, counts)``: about ``n`` parameters shared out by parameter length, at least ``min_count`` equal
+    intervals per smooth piece (``counts`` of them), every breakpoint and ``period`` among them."""
+    lo, hi = curve.pieces
+    counts = np.maximum(min_count, np.ceil(n * (hi - lo) / curve.period)).astype(int)
+    x = np.append(np.concatenate([l_ + (h_ - l_) * np.arange(c) / c
+                                  for l_, h_, c in zip(lo, hi, counts, strict=True)]), curve.period)
+    return x, counts
 
 
 class HermiteSurrogate:
@@ -23,9 +33,7 @@ class HermiteSurrogate:
     def __init__(self, curve: ParametricCurve, n: int = 4096, min_count: int = 4, *, x: np.ndarray | None = None):
         lo, hi = curve.pieces
         if x is None:
-            counts = np.maximum(min_count, np.ceil(n * (hi - lo) / curve.period)).astype(int)
-            x = np.append(np.concatenate([l_ + (h_ - l_) * np.arange(c) / c
-                                          for l_, h_, c in zip(lo, hi, counts, strict=True)]), curve.period)
+            x, counts = sample_nodes(curve, n, min_count)
         else:  # explicit nodes (every breakpoint among them, increasing)
             x = np.asarray(x, dtype=float)
             counts = np.diff(np.searchsorted(x, curve.breakpoints))

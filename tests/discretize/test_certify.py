@@ -8,8 +8,9 @@ import pytest
 
 from camfab.design.assemble import geometry_from_spec
 from camfab.design.spec import design_from_dict
-from camfab.discretize import arcs, points_at
+from camfab.discretize import ParametricCurve, arcs, measure_deviation, points_at
 from camfab.discretize.certify import CERTIFY_SHARE, certified_deviation, sample_gap, samples_for, semiconcavity
+from camfab.discretize.measure import measure_fit
 from camfab.discretize.surrogate import HermiteSurrogate, fit_surrogate
 from camfab.formats import load_design
 from camfab.offset.cutter import profile_curve
@@ -84,3 +85,47 @@ def test_no_finite_bound_means_no_shortcut():
     assert samples_for(float("inf"), 1.0, 1.0, 1e-3) is None
     assert samples_for(1.0, 1.0, 1.0, 0.0) is None
     assert sample_gap(2.0, 3.0, 1.0, 30) == pytest.approx(2.0 * 0.1 ** 2 / 8)
+
+
+def _scaled(curve, factor):
+    """``curve`` scaled about the origin: a fit of ``curve`` lies up to ``(factor - 1)·radius`` off it."""
+    return ParametricCurve(lambda t: factor * curve.point(t), curve.breakpoints, curve.period,
+                           lambda t: factor * curve.derivative(t), curve.closed)
+
+
+@pytest.mark.parametrize("factor", [1.0, 1.0 + 2e-5])
+def test_fit_measurement_agrees_with_the_general_one(factor):
+    """The fit's own measurement (one exact call at the certified samples, the chain projected on the fit's
+    stand-in, each sample against its own entity and neighbours) against ``measure_deviation`` (its own stand-in,
+    grid search over every entity, polished feet): the same maximum, on the fit and on a chain 1–2.5 tol off."""
+    base = issue15_curve()
+    chain = arcs(base, tol=TOL).chain()
+    curve = _scaled(base, factor)
+    sur = fit_surrogate(curve, TOL)[0]
+    K, vmax = semiconcavity(sur, chain, TOL)
+    n = samples_for(K, vmax, curve.period, CERTIFY_SHARE * TOL)
+    gap = sample_gap(K, vmax, curve.period, n)
+    fit = measure_fit(chain, curve, sur, n, gap)
+    general = measure_deviation(chain, curve)
+    assert fit.max == pytest.approx(general.max, rel=1e-6)
+    assert fit.curve_to_entities == pytest.approx(general.curve_to_entities, rel=1e-6)
+    # chain to curve: 8 maxima refined on 17-point grids (not 32 on 33): a few parts in 10⁶ lower at most
+    assert fit.entities_to_curve == pytest.approx(general.entities_to_curve, rel=1e-5)
+    assert (fit.max > 1.5 * TOL) == (factor > 1.0)  # the off chain is really off
+
+
+@pytest.mark.slow
+def test_fit_measurement_bounds_a_dense_check_off_the_curve():
+    """A chain 1–2.5 tol off the curve: the fit's measurement plus the certificate's gap bounds the dense
+    independent maximum (10⁶ exact points, point-to-arc distances), and matches it."""
+    base = issue15_curve()
+    res = arcs(base, tol=TOL)
+    curve = _scaled(base, 1.0 + 2e-5)
+    sur = fit_surrogate(curve, TOL)[0]
+    K, vmax = semiconcavity(sur, res.chain(), TOL)
+    n = samples_for(K, vmax, curve.period, CERTIFY_SHARE * TOL)
+    gap = sample_gap(K, vmax, curve.period, n)
+    fit = measure_fit(res.chain(), curve, sur, n, gap)
+    independent = check_arcs(res, Dense(curve, 10**6))
+    assert independent <= fit.max + gap
+    assert fit.max == pytest.approx(independent, rel=1e-5)
