@@ -117,10 +117,15 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
     """
     say = progress or (lambda msg: None)
     formats = [f for f in FORMATS if f in set(formats)]
+    groove = getattr(getattr(geometry, "mechanism", None), "cam_kind", None) == "groove"
+    if shapes is None and formats == ["stl"] and not groove:
+        # the mesh is fitted within tol/2 of each curve below: the fit within tol would not be used
+        curves = tuple(profile_curves(geometry, validate_tol(tol)))
+        return _stl_artifacts(spec, curves, _plate(spec), tol, say)
     if shapes is None:
         say(f"fitting arcs within {tol:g} mm")
         shapes = cam_shapes(geometry, tol=tol, with_pitch="dxf" in formats)
-    if getattr(getattr(geometry, "mechanism", None), "cam_kind", None) == "groove":
+    if groove:
         from .groove import groove_artifacts  # one plate, two flanks: camfab.cad.groove
 
         return groove_artifacts(spec, geometry, formats, shapes=shapes, tol=tol, dxf_flavour=dxf_flavour,
@@ -132,13 +137,7 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
         say("DXF")
         out.append(_dxf(spec, geometry, shapes, plate, tol, dxf_flavour, tool_paths))
     if "stl" in formats:
-        for i, curve in enumerate(shapes.curves):
-            say(f"STL{_suffix(i, n)}")
-            # arcs within tol/2 of the curve, flattened within tol/2 of the arcs: within tol overall
-            fine = arcs(curve, tol=tol / 2)
-            dev = float(measure_deviation(fine.flatten(tol / 2), curve).max)
-            data = stl.dumps(fine, plate, tol=tol / 2, name=spec.name)
-            out.append(Artifact(f"{safe_stem(spec.name)}{_suffix(i, n)}.stl", data, "stl", None, dev))
+        out += _stl_artifacts(spec, shapes.curves, plate, tol, say)
     if "step" in formats:
         loops, devs = solid_outlines(shapes, tol)
         for i, (loop, dev) in enumerate(zip(loops, devs, strict=True)):
@@ -152,6 +151,29 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
             out.append(Artifact(f"{safe_stem(spec.name)}_pair.step", text.encode("utf-8"), "step",
                                 sum(lp.n_entities for lp in loops), max(devs),
                                 "both cams positioned along the shaft"))
+    return out
+
+
+def profile_curves(geometry, tol: float) -> list:
+    """The exact profile curves of ``geometry`` (:func:`~camfab.offset.cutter.profile_curve`), each refused
+    when it still jumps by more than ``tol``."""
+    curves = [profile_curve(c) for c in geometry.profiles]
+    for curve in curves:
+        _require_continuous(curve, tol)
+    return curves
+
+
+def _stl_artifacts(spec, curves, plate: PlateSpec, tol: float, say: Callable[[str], None]) -> list[Artifact]:
+    """One STL per profile curve: arcs within tol/2 of the curve, flattened within tol/2 of the arcs (within
+    tol overall), the deviation of the flattened polyline measured."""
+    out = []
+    n = len(curves)
+    for i, curve in enumerate(curves):
+        say(f"STL{_suffix(i, n)}")
+        fine = arcs(curve, tol=tol / 2)
+        dev = float(measure_deviation(fine.flatten(tol / 2), curve).max)
+        data = stl.dumps(fine, plate, tol=tol / 2, name=spec.name)
+        out.append(Artifact(f"{safe_stem(spec.name)}{_suffix(i, n)}.stl", data, "stl", None, dev))
     return out
 
 

@@ -14,7 +14,8 @@ from ..geom2d import ArcChain
 from ..textsafe import plain
 from .plate import PlateSpec
 
-__all__ = ["plate_triangles", "stl_bytes", "dumps"]
+__all__ = ["plate_triangles", "prism_triangles", "cap_triangles", "wall_triangles", "is_closed_surface",
+           "stl_bytes", "dumps"]
 
 #: one binary STL facet: unit normal, three vertices, the (unused) attribute byte count
 FACET = np.dtype([("normal", "<f4", (3,)), ("vertices", "<f4", (3, 3)), ("attribute", "<u2")])
@@ -40,9 +41,9 @@ def _rings(body) -> list[np.ndarray]:
     return out
 
 
-def prism_triangles(rings: list[np.ndarray], height: float) -> np.ndarray:
-    """Triangles ``(m, 3, 3)`` of the prism over a face (exterior ring counter-clockwise, holes clockwise)
-    from z = 0 to z = ``height``, every triangle counter-clockwise seen from outside."""
+def cap_triangles(rings: list[np.ndarray], z: float, *, up: bool) -> np.ndarray:
+    """Triangles ``(k, 3, 3)`` of the flat face bounded by ``rings`` (the exterior first, then the holes) at
+    height ``z`` (earcut: no new vertices), counter-clockwise seen from +z when ``up``, else from −z."""
     try:
         import mapbox_earcut as earcut
     except ImportError as exc:  # pragma: no cover - exercised only without the dependency
@@ -53,16 +54,39 @@ def prism_triangles(rings: list[np.ndarray], height: float) -> np.ndarray:
     a, b, c = xy[tri[:, 0]], xy[tri[:, 1]], xy[tri[:, 2]]
     cw = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]) < 0
     tri[cw] = tri[cw][:, ::-1]  # counter-clockwise seen from +z
-    z0, z1 = np.zeros((len(xy), 1)), np.full((len(xy), 1), float(height))
-    bottom, top = np.hstack([xy, z0]), np.hstack([xy, z1])
-    caps = [top[tri], bottom[tri[:, ::-1]]]
-    walls = []
-    for r in rings:  # the material lies left of every edge: a wall's outward normal points right
-        p, q = r, np.roll(r, -1, axis=0)
-        p0, q0 = np.column_stack([p, z0[:len(r)]]), np.column_stack([q, z0[:len(r)]])
-        p1, q1 = np.column_stack([p, z1[:len(r)]]), np.column_stack([q, z1[:len(r)]])
-        walls += [np.stack([p0, q0, q1], axis=1), np.stack([p0, q1, p1], axis=1)]
-    return np.concatenate(caps + walls)
+    xyz = np.column_stack([xy, np.full(len(xy), float(z))])
+    return xyz[tri if up else tri[:, ::-1]]
+
+
+def wall_triangles(ring: np.ndarray, z0: float, z1: float) -> np.ndarray:
+    """Triangles ``(2n, 3, 3)`` of the wall from z0 to z1 (> z0) along the closed ring ``(n, 2)``, facing the
+    right of its direction: outward for a counter-clockwise exterior or a clockwise hole of the material."""
+    p, q = ring, np.roll(ring, -1, axis=0)
+    lo, hi = np.full((len(ring), 1), float(z0)), np.full((len(ring), 1), float(z1))
+    p0, q0, p1, q1 = np.hstack([p, lo]), np.hstack([q, lo]), np.hstack([p, hi]), np.hstack([q, hi])
+    return np.concatenate([np.stack([p0, q0, q1], axis=1), np.stack([p0, q1, p1], axis=1)])
+
+
+def prism_triangles(rings: list[np.ndarray], height: float) -> np.ndarray:
+    """Triangles ``(m, 3, 3)`` of the prism over a face (exterior ring counter-clockwise, holes clockwise)
+    from z = 0 to z = ``height``, every triangle counter-clockwise seen from outside."""
+    caps = [cap_triangles(rings, height, up=True), cap_triangles(rings, 0.0, up=False)]
+    return np.concatenate(caps + [wall_triangles(r, 0.0, height) for r in rings])
+
+
+def is_closed_surface(triangles: np.ndarray) -> bool:
+    """True when the triangles, their vertices identified by exact coordinates, form closed surfaces with a
+    consistent winding: every directed edge appears once and its reverse once (what trimesh calls watertight
+    and winding-consistent)."""
+    tri = np.ascontiguousarray(triangles, dtype=np.float64)
+    _, ids = np.unique(tri.reshape(-1, 3), axis=0, return_inverse=True)
+    ids = ids.reshape(-1, 3).astype(np.int64)
+    n = int(ids.max()) + 1 if ids.size else 0
+    heads, tails = ids, np.roll(ids, -1, axis=1)
+    edges = (heads * n + tails).ravel()
+    reverse = (tails * n + heads).ravel()
+    uniq = np.unique(edges)
+    return bool(ids.size) and len(uniq) == len(edges) and bool(np.isin(reverse, uniq).all())
 
 
 def plate_triangles(outline: ArcChain, plate: PlateSpec, *, tol: float) -> np.ndarray:

@@ -10,7 +10,6 @@ motion program, and mechanism geometry is checked by :mod:`camfab.design.mechani
 """
 from __future__ import annotations
 
-import difflib
 import functools
 import math
 from collections.abc import Mapping, Sequence
@@ -481,6 +480,8 @@ def _segment(v: Validator, r: Mapping[str, Any], p: str, span_key: str) -> Segme
     law = r.get("law", "dwell" if r.get("lift", 0) == 0 else None)
     laws = law_names()
     if law not in laws:
+        import difflib  # only for a misspelt name
+
         close = difflib.get_close_matches(str(law), laws, n=1)
         v.add(f"{p}.law", law, "unknown motion law" if law is not None else "is required",
               f"did you mean '{close[0]}'?" if close else "use one of: " + ", ".join(laws))

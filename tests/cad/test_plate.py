@@ -129,3 +129,18 @@ def test_offset_refuses_corners_and_vanishing_arcs():
     assert square.offset_g1(0.1) is None  # corners need rounding arcs
     assert _stadium().offset_g1(-15.0) is None  # the half circles would shrink to radius 0
     assert _regular_arc_loop(10.0).offset_g1(-9.0).area() == pytest.approx(math.pi, rel=1e-12)
+
+
+def test_closed_surface_test_finds_a_hole_and_a_flipped_triangle():
+    """The watertightness test the groove plate's mesh must pass agrees with trimesh on a good mesh, a mesh with
+    a triangle missing and one with a triangle flipped."""
+    trimesh = pytest.importorskip("trimesh")
+    from camfab.cad import stl
+
+    tri = stl.plate_triangles(_stadium(), PlateSpec(6.0, 10.0, True), tol=1e-2)
+    flipped = tri.copy()
+    flipped[5] = flipped[5][::-1]
+    for t, closed in ((tri, True), (tri[1:], False), (flipped, False)):
+        assert stl.is_closed_surface(t) is closed
+        mesh = trimesh.Trimesh(t.reshape(-1, 3), np.arange(3 * len(t)).reshape(-1, 3))  # merges equal vertices
+        assert (mesh.is_watertight and mesh.is_winding_consistent) is closed
