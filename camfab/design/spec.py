@@ -14,18 +14,17 @@ import functools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import Problem, SpecError
 from ..limits import MAX_LENGTH_MM, MAX_LIFT_MM, MAX_SEGMENTS, data_problems
 from ..units import DEG, RPM
-from .cylinder_spec import CylinderSpec, cylinder_section
 from .drawing import DrawingSpec, drawing_section
 from .kinds import CamKind, Direction, FollowerMotion, FollowerType, LiftUnit, Rotation
 from .knots import KnotFile, KnotTable, build_knot_table
 from .laws import law_names
 from .mechanisms import MECHANISMS, mechanism_class, mechanism_from_spec
-from .optimise_spec import OptimiseSpec, optimise_section
+from .optional_sections import optional_sections
 from .program import TWO_PI, MotionProgram, SegmentInput, build_program
 from .resolve import END_KEYS
 from .shop import (
@@ -40,10 +39,14 @@ from .shop import (
     manufacturing_section,
     outputs_section,
 )
-from .sizing_spec import SizingSpec, sizing_section
+from .sizing_spec import SizingSpec
 from .strength_spec import StrengthSpec, strength_section
 from .validator import Validator
-from .vibration_spec import VibrationSpec, vibration_section
+
+if TYPE_CHECKING:  # the readers of these sections are imported only by designs that have them
+    from .cylinder_spec import CylinderSpec
+    from .optimise_spec import OptimiseSpec
+    from .vibration_spec import VibrationSpec
 
 __all__ = [
     "CamSpec",
@@ -343,10 +346,8 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
     return DesignSpec(name.strip(), cam, fol, motion, table, mfg, out, pressure_angle_limit_deg=pa,
                       description=str(data.get("description", "")), source=source, face_margin_mm=margin,
                       dynamics=dyn, machining=machining, assembly=assembly, drawing=drawing, strength=strength,
-                      vibration=vibration_section(v, data, cam.kind, fol.motion),
-                      sizing=sizing_section(v, v.table(data, "sizing")),
-                      optimise=optimise_section(v, v.table(data, "optimise")) if "optimise" in data else None,
-                      cylinder=cylinder_section(v, v.table(data, "cylinder"), cam.kind))
+                      **optional_sections(v, data, cam.kind, fol.motion))
+
 
 
 # ---------------------------------------------------------------------------
