@@ -40,12 +40,12 @@ from .shop import (
     outputs_section,
 )
 from .sizing_spec import SizingSpec
-from .strength_spec import StrengthSpec, strength_section
 from .validator import Validator
 
 if TYPE_CHECKING:  # the readers of these sections are imported only by designs that have them
     from .cylinder_spec import CylinderSpec
     from .optimise_spec import OptimiseSpec
+    from .strength_spec import StrengthSpec
     from .vibration_spec import VibrationSpec
 
 __all__ = [
@@ -339,10 +339,14 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
     margin = v.number(checks, "face_margin_mm", "checks", 0.0, lo=0.0, hi=1e4)
     dyn = _dynamics(v, data, cam, fol)
     groove = fol.groove_depth_mm if cam.kind == CamKind.GROOVE else None  # the flanks: as high as the groove
-    strength = strength_section(v, data, thickness_mm=groove or mfg.thickness_mm,
-                                manufacturing_material=mfg.material, assembly_roller_width_mm=assembly.roller_width_mm,
-                                applies="dynamics" in data,
-                                face="the groove depth" if groove else "the plate thickness")
+    strength = None  # without these sections there is nothing to read or check: materials not imported
+    if not {"strength", "materials", "dynamics"}.isdisjoint(data):
+        from .strength_spec import strength_section
+
+        strength = strength_section(v, data, thickness_mm=groove or mfg.thickness_mm, applies="dynamics" in data,
+                                    manufacturing_material=mfg.material,
+                                    assembly_roller_width_mm=assembly.roller_width_mm,
+                                    face="the groove depth" if groove else "the plate thickness")
     return DesignSpec(name.strip(), cam, fol, motion, table, mfg, out, pressure_angle_limit_deg=pa,
                       description=str(data.get("description", "")), source=source, face_margin_mm=margin,
                       dynamics=dyn, machining=machining, assembly=assembly, drawing=drawing, strength=strength,
