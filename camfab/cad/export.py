@@ -118,10 +118,12 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
     say = progress or (lambda msg: None)
     formats = [f for f in FORMATS if f in set(formats)]
     groove = getattr(getattr(geometry, "mechanism", None), "cam_kind", None) == "groove"
-    if shapes is None and formats == ["stl"] and not groove:
-        # the mesh is fitted within tol/2 of each curve below: the fit within tol would not be used
+    if shapes is None and formats == ["stl"]:
+        # the mesh is fitted within tol/2 of each curve below: the fit within tol (and the pitch) would not be used
         curves = tuple(profile_curves(geometry, validate_tol(tol)))
-        return _stl_artifacts(spec, curves, _plate(spec), tol, say)
+        if not groove:
+            return _stl_artifacts(spec, curves, _plate(spec), tol, say)
+        shapes = CamShapes((), (), curves, tol, True)  # the groove plate's mesh reads the curves alone
     if shapes is None:
         say(f"fitting arcs within {tol:g} mm")
         shapes = cam_shapes(geometry, tol=tol, with_pitch="dxf" in formats)
