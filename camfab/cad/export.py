@@ -3,7 +3,7 @@
 Everything is built in memory first and written only when every requested
 artifact succeeded, each file atomically, so an error never leaves partial
 output.  Only the stages a job asks for run (cadquery is imported only for
-STEP, trimesh only for STL, tool paths only when a cutter is given).  Every
+STEP, shapely and earcut only for STL, tool paths only when a cutter is given).  Every
 writer takes the profiles as :class:`~camfab.geom2d.ArcChain` values.
 """
 from __future__ import annotations
