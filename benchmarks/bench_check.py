@@ -14,13 +14,15 @@ cost of a check must not grow with how steep the design is (docs/decisions.md, "
 imports, reading, checking, printing) for every built-in example: CPU time (user + system, from
 ``getrusage`` of the child, the measure a loaded machine disturbs least) and wall time, best of ``--repeat``,
 against the goal of 0.35 s (issue 15).  ``--root DIR`` runs the camfab found in DIR instead (a checkout to
-compare with).  ``--process --export`` times ``python -m camfab export EXAMPLE --dxf`` and ``--stl`` (``--force``,
-into a temporary folder) the same way, against the goal of 1 s each (STEP, IGES and the assembly are outside the
-goal: they import cadquery/OCP, ~3 s on their own; README "Benchmarks").  The child processes run without
-``PYTHONDONTWRITEBYTECODE`` (bytecode cached in a temporary ``PYTHONPYCACHEPREFIX``, as an installed package has
-it) and one untimed warm-up run per command fills that cache.
+compare with); ``--against DIR`` times this tree and DIR in alternating rounds (one run of every example each), so
+that both see the same load, and prints both.  ``--process --export`` times ``python -m camfab export EXAMPLE
+--dxf`` and ``--stl`` (``--force``, into a temporary folder) the same way, against the goal of 1 s each (STEP,
+IGES and the assembly are outside the goal: they import cadquery/OCP, ~3 s on their own; README "Benchmarks").
+The child processes run without ``PYTHONDONTWRITEBYTECODE`` (bytecode cached in a temporary
+``PYTHONPYCACHEPREFIX``, as an installed package has it) and one untimed warm-up run per command fills that cache.
 
-Run:  python3 benchmarks/bench_check.py [--repeat 7] [--baseline | --steep | --process [--export] [--root DIR]]
+Run:  python3 benchmarks/bench_check.py [--repeat 7] [--baseline | --steep | --process [--export] [--root DIR]
+      [--against DIR]]
 """
 from __future__ import annotations
 
@@ -135,10 +137,11 @@ PROCESS_TARGET_S = 0.35
 EXPORT_TARGET_S = 1.0
 
 
-def process_timings(repeat: int, root: str | None, export: tuple[str, ...] = ()
-                    ) -> dict[str, tuple[float, float]]:
+def process_timings(repeat: int, root: str | None, export: tuple[str, ...] = (), cache: str | None = None,
+                    warm: bool = True) -> dict[str, tuple[float, float]]:
     """{example: (best CPU s, best wall s)} of ``python -m camfab check EXAMPLE`` as a whole process, or of
-    ``python -m camfab export EXAMPLE <export...> --force -o TMP`` when ``export`` names the output flags."""
+    ``python -m camfab export EXAMPLE <export...> --force -o TMP`` when ``export`` names the output flags.
+    ``cache``: a bytecode folder kept by the caller; ``warm``: one untimed run of each first."""
     import os
     import resource
     import shutil
@@ -148,7 +151,8 @@ def process_timings(repeat: int, root: str | None, export: tuple[str, ...] = ()
     # bytecode cached as in an installed package (a checkout run with PYTHONDONTWRITEBYTECODE would
     # compile every module on every start); one untimed run per example fills the cache.  The runs start in
     # `cache`, not in a checkout, whose ./camfab `python -m` would import first.
-    cache = tempfile.mkdtemp(prefix="camfab-pyc-")
+    own = cache is None
+    cache = cache or tempfile.mkdtemp(prefix="camfab-pyc-")
     env = dict(os.environ, PYTHONPATH=root or str(HERE.parent), PYTHONPYCACHEPREFIX=cache)
     env.pop("PYTHONDONTWRITEBYTECODE", None)
     examples = [name for name, _ in _api()[0]]
@@ -157,7 +161,7 @@ def process_timings(repeat: int, root: str | None, export: tuple[str, ...] = ()
         cpu = wall = math.inf
         folder = os.path.join(cache, "out")
         args = ["export", name, *export, "--force", "-o", folder] if export else ["check", name]
-        for i in range(repeat + 1):
+        for i in range(0 if warm else 1, repeat + 1):
             shutil.rmtree(folder, ignore_errors=True)
             before = resource.getrusage(resource.RUSAGE_CHILDREN)
             t0 = time.perf_counter()
@@ -169,15 +173,50 @@ def process_timings(repeat: int, root: str | None, export: tuple[str, ...] = ()
             after = resource.getrusage(resource.RUSAGE_CHILDREN)
             cpu = min(cpu, after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
         out[name] = (cpu, wall)
-    shutil.rmtree(cache, ignore_errors=True)
+    if own:
+        shutil.rmtree(cache, ignore_errors=True)
     return out
 
 
-def process(repeat: int, root: str | None, export: bool = False) -> None:
+def _alternating(repeat: int, root: str | None, against: str, flags: tuple[str, ...]
+                 ) -> tuple[dict[str, tuple[float, float]], dict[str, tuple[float, float]]]:
+    """Both trees' :func:`process_timings`, in ``repeat`` alternating rounds of one run each (best of the
+    rounds): on a loaded machine both see the same load."""
+    import shutil
+    import tempfile
+
+    mine: dict[str, tuple[float, float]] = {}
+    other: dict[str, tuple[float, float]] = {}
+    caches = {id(mine): tempfile.mkdtemp(prefix="camfab-pyc-"), id(other): tempfile.mkdtemp(prefix="camfab-pyc-")}
+    try:
+        for k in range(repeat + 1):  # round 0 fills the bytecode caches, untimed
+            for tree, out in ((root, mine), (against, other)):
+                t = process_timings(1 if k else 0, tree, flags, caches[id(out)], warm=not k)
+                for name, (cpu, wall) in t.items():
+                    best = out.get(name, (math.inf, math.inf)) if k else (math.inf, math.inf)
+                    out[name] = (min(best[0], cpu), min(best[1], wall))
+    finally:
+        for c in caches.values():
+            shutil.rmtree(c, ignore_errors=True)
+    return mine, other
+
+
+def process(repeat: int, root: str | None, export: bool = False, against: str | None = None) -> None:
     print("child processes without PYTHONDONTWRITEBYTECODE (bytecode cached as installed), "
           "one untimed warm-up run each")
     for flags in ([("--dxf",), ("--stl",)] if export else [()]):
         goal = EXPORT_TARGET_S if export else PROCESS_TARGET_S
+        if against is not None:
+            t, old = _alternating(repeat, root, against, flags)
+            what = f"export EXAMPLE {' '.join(flags)}" if export else "check EXAMPLE"
+            print(f"python -m camfab {what}, this tree against {against}, alternating, best of {repeat}; "
+                  f"goal <= {goal:g} s CPU")
+            for name, (cpu, _) in t.items():
+                print(f"  {name:28}{old[name][0]:7.3f} -> {cpu:6.3f} s CPU" + ("" if cpu <= goal else "  MISSED"))
+            worst = max(c for c, _ in t.values())
+            print(f"slowest {max(c for c, _ in old.values()):.3f} -> {worst:.3f} s CPU: "
+                  f"{'MET' if worst <= goal else 'MISSED'}")
+            continue
         t = process_timings(repeat, root, flags)
         what = f"export EXAMPLE {' '.join(flags)}" if export else "check EXAMPLE"
         print(f"python -m camfab {what} as a process, best of {repeat}; goal <= {goal:g} s CPU")
@@ -197,9 +236,11 @@ def main() -> None:
     ap.add_argument("--process", action="store_true", help="time `python -m camfab check` as a whole process")
     ap.add_argument("--root", default=None, help="with --process: the checkout whose camfab runs")
     ap.add_argument("--export", action="store_true", help="with --process: time `export --dxf` and `--stl`")
+    ap.add_argument("--against", default=None, metavar="DIR",
+                    help="with --process: also time the checkout DIR, alternating with this tree")
     a = ap.parse_args()
     if a.process:
-        process(a.repeat, a.root, a.export)
+        process(a.repeat, a.root, a.export, a.against)
         return
     if a.steep:
         steep(a.repeat)

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import contextlib
 import errno
-import hashlib
 import io
 import os
 import re
@@ -73,6 +72,8 @@ def safe_stem(name: str) -> str:
     if not stem:
         return "cam"
     if len(stem) > STEM_MAX:
+        import hashlib  # only for a long name (it loads OpenSSL: ~5 ms of every start)
+
         digest = hashlib.sha256(name.encode("utf-8", "surrogatepass")).hexdigest()[:8]
         stem = f"{stem[:STEM_MAX - 9]}_{digest}"
     base, dot, rest = stem.partition(".")

@@ -363,7 +363,10 @@ def _dxf(cam: Cam, req: Request) -> list[Artifact]:
 
 def _stl(cam: Cam, req: Request) -> list[Artifact]:
     tol = cam.tolerance(req.tol)
-    return build_artifacts(cam.spec, cam.geometry, ["stl"], tol=tol, shapes=cam.shapes(tol))
+    if tol in cam._shapes:
+        return build_artifacts(cam.spec, cam.geometry, ["stl"], tol=tol, shapes=cam.shapes(tol))
+    require_followable(cam.check())  # as cam.shapes does; the mesh needs the curves, not the fit within tol
+    return build_artifacts(cam.spec, cam.geometry, ["stl"], tol=tol)
 
 
 def _step(cam: Cam, req: Request) -> list[Artifact]:

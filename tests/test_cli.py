@@ -125,3 +125,23 @@ units = { angle = "deg", s = "mm", v = "mm/deg", a = "mm/deg2" }
     data = json.loads(capsys.readouterr().out)
     codes = [f["code"] for f in data["findings"]]
     assert "KNOT_INCONSISTENT" in codes
+
+
+@pytest.mark.parametrize("argv", [["--help"], ["-v", "--help"], ["chek", "x"], ["check", "ejemplo9rt", "--bogus"],
+                                  ["check"], ["-v", "export", "--help"], ["gcode", "--post", "nope", "x"]])
+def test_the_parser_of_one_command_answers_as_the_full_parser(argv, capsys):
+    """``main`` builds only the parser of the command being run: help, usage and errors are the same text as
+    with every command's parser."""
+    from camfab.cli import COMMANDS, build_parser
+
+    def answer(parser):
+        with pytest.raises(SystemExit) as exc:
+            parser.parse_args(argv)
+        out = capsys.readouterr()
+        return exc.value.code, out.out, out.err
+
+    full, one = answer(build_parser()), answer(build_parser(argv))
+    assert one == full
+    assert full[0] in (0, 2) and (full[1] or full[2])
+    if argv[-1] == "--help" and len(argv) > 1 and argv[-2] in COMMANDS:
+        assert f"usage: camfab {argv[-2]}" in full[1]

@@ -98,3 +98,13 @@ def test_integrate_stops_on_what_cannot_be_integrated():
     """NaN (an undefined integrand) is not split for ever: the result says so, quickly."""
     assert math.isnan(integrate(lambda x: np.where(x > 1.0, np.nan, x), [0.0, 2.0]))
     assert math.isfinite(integrate(lambda x: 1.0 / (x - 1.0) ** 2, [0.0, 2.0]))  # work bounded, not hung
+
+
+def test_the_written_out_gauss_legendre_rule_is_numpys():
+    """The quadrature's 20-point rule, written out so that a check does not import numpy.polynomial, is
+    ``leggauss(20)`` bit for bit, and integrates x¹⁸ over [-1, 1] exactly (2/19)."""
+    from camfab.quadrature import GAUSS_LEGENDRE_20
+
+    x, w = np.polynomial.legendre.leggauss(20)
+    assert np.array_equal(GAUSS_LEGENDRE_20[0], x) and np.array_equal(GAUSS_LEGENDRE_20[1], w)
+    assert float(np.sum(GAUSS_LEGENDRE_20[1] * GAUSS_LEGENDRE_20[0] ** 18)) == pytest.approx(2 / 19, rel=1e-14)

@@ -1,1 +1,1 @@
-"""CAD exports: plate geometry (bulge loops), STL (trimesh), STEP (cadquery, imported lazily)."""
+"""CAD exports: plate geometry (bulge loops), STL (numpy and earcut), STEP (cadquery, imported lazily)."""

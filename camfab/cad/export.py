@@ -3,7 +3,7 @@
 Everything is built in memory first and written only when every requested
 artifact succeeded, each file atomically, so an error never leaves partial
 output.  Only the stages a job asks for run (cadquery is imported only for
-STEP, trimesh only for STL, tool paths only when a cutter is given).  Every
+STEP, shapely and earcut only for STL, tool paths only when a cutter is given).  Every
 writer takes the profiles as :class:`~camfab.geom2d.ArcChain` values.
 """
 from __future__ import annotations
@@ -119,10 +119,17 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
     """
     say = progress or (lambda msg: None)
     formats = [f for f in FORMATS if f in set(formats)]
+    groove = getattr(getattr(geometry, "mechanism", None), "cam_kind", None) == "groove"
+    if shapes is None and formats == ["stl"]:
+        # the mesh is fitted within tol/2 of each curve below: the fit within tol (and the pitch) would not be used
+        curves = tuple(profile_curves(geometry, validate_tol(tol)))
+        if not groove:
+            return _stl_artifacts(spec, curves, _plate(spec), tol, say)
+        shapes = CamShapes((), (), curves, tol, True)  # the groove plate's mesh reads the curves alone
     if shapes is None:
         say(f"fitting arcs within {tol:g} mm")
         shapes = cam_shapes(geometry, tol=tol, with_pitch="dxf" in formats)
-    if getattr(getattr(geometry, "mechanism", None), "cam_kind", None) == "groove":
+    if groove:
         from .groove import groove_artifacts  # one plate, two flanks: camfab.cad.groove
 
         return groove_artifacts(spec, geometry, formats, shapes=shapes, tol=tol, dxf_flavour=dxf_flavour,
@@ -134,13 +141,7 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
         say("DXF")
         out.append(_dxf(spec, geometry, shapes, plate, tol, dxf_flavour, tool_paths))
     if "stl" in formats:
-        for i, curve in enumerate(shapes.curves):
-            say(f"STL{_suffix(i, n)}")
-            # arcs within tol/2 of the curve, flattened within tol/2 of the arcs: within tol overall
-            fine = arcs(curve, tol=tol / 2)
-            dev = float(measure_deviation(fine.flatten(tol / 2), curve).max)
-            data = stl.dumps(fine, plate, tol=tol / 2, name=spec.name)
-            out.append(Artifact(f"{safe_stem(spec.name)}{_suffix(i, n)}.stl", data, "stl", None, dev))
+        out += _stl_artifacts(spec, shapes.curves, plate, tol, say)
     if "step" in formats:
         loops, devs = solid_outlines(shapes, tol)
         for i, (loop, dev) in enumerate(zip(loops, devs, strict=True)):
@@ -154,6 +155,29 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
             out.append(Artifact(f"{safe_stem(spec.name)}_pair.step", text.encode("utf-8"), "step",
                                 sum(lp.n_entities for lp in loops), max(devs),
                                 "both cams positioned along the shaft"))
+    return out
+
+
+def profile_curves(geometry, tol: float) -> list:
+    """The exact profile curves of ``geometry`` (:func:`~camfab.offset.cutter.profile_curve`), each refused
+    when it still jumps by more than ``tol``."""
+    curves = [profile_curve(c) for c in geometry.profiles]
+    for curve in curves:
+        _require_continuous(curve, tol)
+    return curves
+
+
+def _stl_artifacts(spec, curves, plate: PlateSpec, tol: float, say: Callable[[str], None]) -> list[Artifact]:
+    """One STL per profile curve: arcs within tol/2 of the curve, flattened within tol/2 of the arcs (within
+    tol overall), the deviation of the flattened polyline measured."""
+    out = []
+    n = len(curves)
+    for i, curve in enumerate(curves):
+        say(f"STL{_suffix(i, n)}")
+        fine = arcs(curve, tol=tol / 2)
+        dev = float(measure_deviation(fine.flatten(tol / 2), curve).max)
+        data = stl.dumps(fine, plate, tol=tol / 2, name=spec.name)
+        out.append(Artifact(f"{safe_stem(spec.name)}{_suffix(i, n)}.stl", data, "stl", None, dev))
     return out
 
 

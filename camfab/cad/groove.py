@@ -18,7 +18,7 @@ import numpy as np
 
 from ..design.kinds import CamKind
 from ..discretize import arcs, measure_deviation
-from ..errors import GeometryError, MissingDependencyError
+from ..errors import GeometryError
 from ..geom2d import ArcChain
 from ..io import safe_stem
 from ..offset.groove import groove_tool_paths
@@ -111,36 +111,13 @@ def _ring(loop: ArcChain, tol: float) -> np.ndarray:
     return pts if area > 0 else pts[::-1]
 
 
-def _wall(ring: np.ndarray, z0: float, z1: float, outward: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Quads (as triangles) between z0 and z1 along a counter-clockwise ring, facing away from its inside
-    (``outward``) or towards it."""
-    n = len(ring)
-    v = np.vstack([np.c_[ring, np.full(n, z0)], np.c_[ring, np.full(n, z1)]])
-    i = np.arange(n)
-    j = (i + 1) % n
-    f = np.vstack([np.c_[i, j, j + n], np.c_[i, j + n, i + n]])
-    return v, (f if outward else f[:, ::-1])
-
-
-def _cap(poly, z: float, up: bool) -> tuple[np.ndarray, np.ndarray]:
-    import trimesh
-
-    v2, f = trimesh.creation.triangulate_polygon(poly, engine="earcut")
-    v = np.c_[v2, np.full(len(v2), z)]
-    # earcut's triangles run counter-clockwise (normal +z) for a shapely polygon
-    return v, (f if up else f[:, ::-1])
-
-
 def groove_mesh(outline: ArcChain, inner: ArcChain, outer: ArcChain, plate: PlateSpec, depth_mm: float, *,
-                tol: float):
-    """A watertight ``trimesh.Trimesh`` of the groove plate: caps at z = 0 (around the groove), at the groove's
-    floor z = depth and at z = thickness, and the walls of the rim, the bore and both flanks."""
-    try:
-        import trimesh
-        from shapely.geometry import Polygon
-    except ImportError as exc:  # pragma: no cover
-        raise MissingDependencyError("STL export needs trimesh and mapbox_earcut: pip install trimesh "
-                                     "mapbox_earcut") from exc
+                tol: float) -> np.ndarray:
+    """The triangles ``(m, 3, 3)`` of a watertight mesh of the groove plate (:mod:`camfab.cad.stl`): caps at
+    z = 0 (around the groove), at the groove's floor z = depth and at z = thickness, and the walls of the rim,
+    the bore and both flanks."""
+    from .stl import cap_triangles, is_closed_surface, wall_triangles
+
     if plate.hub_diameter_mm and plate.hub_length_mm:
         raise GeometryError("STL export of a plate with a hub is not supported yet; "
                             "remove manufacturing.hub_diameter_mm for the STL or use STEP")
@@ -150,32 +127,26 @@ def groove_mesh(outline: ArcChain, inner: ArcChain, outer: ArcChain, plate: Plat
     holes = [bore[::-1]] if bore is not None else []
     t = plate.thickness_mm
     parts = [
-        _cap(Polygon(rim, holes), t, True),                       # the back face
-        _cap(Polygon(rim, [fout[::-1]]), 0.0, False),            # the front face outside the groove
-        _cap(Polygon(fin, holes), 0.0, False),                   # the front face inside the groove
-        _cap(Polygon(fout, [fin[::-1]]), depth_mm, False),       # the groove's floor, facing the opening
-        _wall(rim, 0.0, t, True),
-        _wall(fout, 0.0, depth_mm, False),                       # the outer flank faces the groove (inward)
-        _wall(fin, 0.0, depth_mm, True),                         # the inner flank faces the groove (outward)
+        cap_triangles([rim, *holes], t, up=True),                # the back face
+        cap_triangles([rim, fout[::-1]], 0.0, up=False),         # the front face outside the groove
+        cap_triangles([fin, *holes], 0.0, up=False),             # the front face inside the groove
+        cap_triangles([fout, fin[::-1]], depth_mm, up=False),    # the groove's floor, facing the opening
+        wall_triangles(rim, 0.0, t),                             # rings counter-clockwise: a wall faces out
+        wall_triangles(fout[::-1], 0.0, depth_mm),               # the outer flank faces the groove (inward)
+        wall_triangles(fin, 0.0, depth_mm),                      # the inner flank faces the groove (outward)
     ]
     if bore is not None:
-        parts.append(_wall(bore, 0.0, t, False))
-    verts, faces, base = [], [], 0
-    for v, f in parts:
-        verts.append(v)
-        faces.append(f + base)
-        base += len(v)
-    mesh = trimesh.Trimesh(np.vstack(verts), np.vstack(faces), process=False)
-    mesh.merge_vertices()
-    if not mesh.is_watertight:
+        parts.append(wall_triangles(bore[::-1], 0.0, t))
+    tri = np.concatenate(parts)
+    if not is_closed_surface(tri):
         raise GeometryError("the groove plate's mesh is not watertight (a flank too close to the rim or the bore?)")
-    return mesh
+    return tri
 
 
-def _stl_bytes(mesh, name: str, tol: float) -> bytes:
-    data = mesh.export(file_type="stl")
-    head = f"camfab {plain(name)} units=mm tol={tol:g} groove".encode("ascii", "replace")[:80].ljust(80, b" ")
-    return head + data[80:]
+def _stl_bytes(triangles: np.ndarray, name: str, tol: float) -> bytes:
+    from .stl import stl_bytes
+
+    return stl_bytes(triangles, f"camfab {plain(name)} units=mm tol={tol:g} groove")
 
 
 def groove_width_note(geometry) -> str:

@@ -10,23 +10,21 @@ motion program, and mechanism geometry is checked by :mod:`camfab.design.mechani
 """
 from __future__ import annotations
 
-import difflib
 import functools
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import Problem, SpecError
 from ..limits import MAX_LENGTH_MM, MAX_LIFT_MM, MAX_SEGMENTS, data_problems
 from ..units import DEG, RPM
-from .cylinder_spec import CylinderSpec, cylinder_section
 from .drawing import DrawingSpec, drawing_section
 from .kinds import CamKind, Direction, FollowerMotion, FollowerType, LiftUnit, Rotation
 from .knots import KnotFile, KnotTable, build_knot_table
 from .laws import law_names
 from .mechanisms import MECHANISMS, mechanism_class, mechanism_from_spec
-from .optimise_spec import OptimiseSpec, optimise_section
+from .optional_sections import optional_sections
 from .program import TWO_PI, MotionProgram, SegmentInput, build_program
 from .resolve import END_KEYS
 from .shop import (
@@ -41,10 +39,14 @@ from .shop import (
     manufacturing_section,
     outputs_section,
 )
-from .sizing_spec import SizingSpec, sizing_section
-from .strength_spec import StrengthSpec, strength_section
+from .sizing_spec import SizingSpec
 from .validator import Validator
-from .vibration_spec import VibrationSpec, vibration_section
+
+if TYPE_CHECKING:  # the readers of these sections are imported only by designs that have them
+    from .cylinder_spec import CylinderSpec
+    from .optimise_spec import OptimiseSpec
+    from .strength_spec import StrengthSpec
+    from .vibration_spec import VibrationSpec
 
 __all__ = [
     "CamSpec",
@@ -337,17 +339,19 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
     margin = v.number(checks, "face_margin_mm", "checks", 0.0, lo=0.0, hi=1e4)
     dyn = _dynamics(v, data, cam, fol)
     groove = fol.groove_depth_mm if cam.kind == CamKind.GROOVE else None  # the flanks: as high as the groove
-    strength = strength_section(v, data, thickness_mm=groove or mfg.thickness_mm,
-                                manufacturing_material=mfg.material, assembly_roller_width_mm=assembly.roller_width_mm,
-                                applies="dynamics" in data,
-                                face="the groove depth" if groove else "the plate thickness")
+    strength = None  # without these sections there is nothing to read or check: materials not imported
+    if not {"strength", "materials", "dynamics"}.isdisjoint(data):
+        from .strength_spec import strength_section
+
+        strength = strength_section(v, data, thickness_mm=groove or mfg.thickness_mm, applies="dynamics" in data,
+                                    manufacturing_material=mfg.material,
+                                    assembly_roller_width_mm=assembly.roller_width_mm,
+                                    face="the groove depth" if groove else "the plate thickness")
     return DesignSpec(name.strip(), cam, fol, motion, table, mfg, out, pressure_angle_limit_deg=pa,
                       description=str(data.get("description", "")), source=source, face_margin_mm=margin,
                       dynamics=dyn, machining=machining, assembly=assembly, drawing=drawing, strength=strength,
-                      vibration=vibration_section(v, data, cam.kind, fol.motion),
-                      sizing=sizing_section(v, v.table(data, "sizing")),
-                      optimise=optimise_section(v, v.table(data, "optimise")) if "optimise" in data else None,
-                      cylinder=cylinder_section(v, v.table(data, "cylinder"), cam.kind))
+                      **optional_sections(v, data, cam.kind, fol.motion))
+
 
 
 # ---------------------------------------------------------------------------
@@ -481,6 +485,8 @@ def _segment(v: Validator, r: Mapping[str, Any], p: str, span_key: str) -> Segme
     law = r.get("law", "dwell" if r.get("lift", 0) == 0 else None)
     laws = law_names()
     if law not in laws:
+        import difflib  # only for a misspelt name
+
         close = difflib.get_close_matches(str(law), laws, n=1)
         v.add(f"{p}.law", law, "unknown motion law" if law is not None else "is required",
               f"did you mean '{close[0]}'?" if close else "use one of: " + ", ".join(laws))

@@ -5,7 +5,6 @@ Each problem names the field path, the value, the rule and a fix; the caller rai
 """
 from __future__ import annotations
 
-import difflib
 import math
 from collections.abc import Mapping
 from enum import StrEnum
@@ -28,6 +27,8 @@ class Validator:
     def keys(self, table: Mapping[str, Any], allowed: tuple[str, ...], path: str) -> None:
         for k in table:
             if k not in allowed:
+                import difflib  # only for a misspelt name
+
                 close = difflib.get_close_matches(k, allowed, n=1)
                 fix = f"did you mean '{close[0]}'?" if close else "allowed keys: " + ", ".join(allowed)
                 self.add(f"{path}.{k}" if path else k, table[k], "unknown key", fix)

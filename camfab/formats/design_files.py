@@ -1,7 +1,6 @@
 """Design files of either format, chosen by suffix (TOML or xlsx), and the built-in examples by name."""
 from __future__ import annotations
 
-import difflib
 from pathlib import Path
 
 from ..design.spec import DesignSpec
@@ -45,6 +44,8 @@ def resolve_design_path(name: str | Path) -> Path:
         if stem.lower() == str(name).lower():
             return EXAMPLES_DIR / f"{stem}.toml"
     if not p.suffix and len(p.parts) == 1:
+        import difflib  # only for a misspelt name
+
         close = difflib.get_close_matches(str(name).lower(), names, n=3, cutoff=0.6)
         hint = "did you mean " + " or ".join(f"'{c}'" for c in close) + "? " if close else ""
         raise SpecError(Problem("file", str(name), "no such design file or built-in example",

@@ -61,15 +61,29 @@ def test_stl_watertight_volume_within_chordal_bound():
 
     outline, plate = _regular_arc_loop(), PlateSpec(10.0, 12.0, True)
     for tol in (1e-2, 1e-3):
-        mesh = stl.plate_mesh(outline, plate, tol=tol)
+        data = stl.dumps(outline, plate, tol=tol, name="x")
+        assert data == stl.dumps(outline, plate, tol=tol, name="x")
+        assert data[:80].startswith(b"camfab x units=mm")
+        assert len(data) == 84 + 50 * int.from_bytes(data[80:84], "little")  # binary STL, one facet per 50 B
+        mesh = trimesh.load(trimesh.util.wrap_as_stream(data), file_type="stl")  # trimesh reads the file back
         assert mesh.is_watertight and mesh.is_winding_consistent and mesh.volume > 0
         exact = plate_volume(outline, plate)
         perimeter = 2 * math.pi * 40 + 2 * math.pi * 6 + 20
-        assert exact - perimeter * tol * plate.thickness_mm <= mesh.volume <= exact
-    data = stl.dumps(outline, plate, tol=1e-3, name="x")
-    assert data == stl.dumps(outline, plate, tol=1e-3, name="x")
-    back = trimesh.load(trimesh.util.wrap_as_stream(data), file_type="stl")
-    assert back.is_watertight
+        # float32 vertices: the volume to within the chordal bound, and a rounding of ~1e-7 relative
+        assert exact - perimeter * tol * plate.thickness_mm <= mesh.volume <= exact * (1 + 1e-6)
+        # the written normals are the faces' outward unit normals
+        assert np.allclose(mesh.face_normals, np.frombuffer(data[84:], stl.FACET)["normal"], atol=1e-6)
+        assert mesh.bounds[0][2] == 0.0 and mesh.bounds[1][2] == pytest.approx(plate.thickness_mm)
+
+
+def test_stl_refuses_a_bore_through_the_rim():
+    pytest.importorskip("shapely")
+    from camfab.cad import stl
+
+    with pytest.raises(GeometryError, match=r"bore_mm = 32\) leaves several pieces"):
+        stl.plate_triangles(_stadium(), PlateSpec(5.0, 32.0, False), tol=1e-3)  # 30 mm wide: cut in two
+    with pytest.raises(GeometryError, match="leaves nothing"):
+        stl.plate_triangles(circle_loop(10.0), PlateSpec(5.0, 30.0, False), tol=1e-3)
 
 
 @pytest.mark.slow
@@ -115,3 +129,18 @@ def test_offset_refuses_corners_and_vanishing_arcs():
     assert square.offset_g1(0.1) is None  # corners need rounding arcs
     assert _stadium().offset_g1(-15.0) is None  # the half circles would shrink to radius 0
     assert _regular_arc_loop(10.0).offset_g1(-9.0).area() == pytest.approx(math.pi, rel=1e-12)
+
+
+def test_closed_surface_test_finds_a_hole_and_a_flipped_triangle():
+    """The watertightness test the groove plate's mesh must pass agrees with trimesh on a good mesh, a mesh with
+    a triangle missing and one with a triangle flipped."""
+    trimesh = pytest.importorskip("trimesh")
+    from camfab.cad import stl
+
+    tri = stl.plate_triangles(_stadium(), PlateSpec(6.0, 10.0, True), tol=1e-2)
+    flipped = tri.copy()
+    flipped[5] = flipped[5][::-1]
+    for t, closed in ((tri, True), (tri[1:], False), (flipped, False)):
+        assert stl.is_closed_surface(t) is closed
+        mesh = trimesh.Trimesh(t.reshape(-1, 3), np.arange(3 * len(t)).reshape(-1, 3))  # merges equal vertices
+        assert (mesh.is_watertight and mesh.is_winding_consistent) is closed
