@@ -353,7 +353,6 @@ def _validate(v: Validator, data: Mapping[str, Any], source: str | None) -> Desi
                       **optional_sections(v, data, cam.kind, fol.motion))
 
 
-
 # ---------------------------------------------------------------------------
 def _cam(v: Validator, t: Mapping[str, Any]) -> CamSpec:
     v.keys(t, _CAM_KEYS, "cam")
