@@ -7,7 +7,7 @@ flank on ``PROFILE_2`` (the disc cams' layers), each an arc chain within the tol
 x = 2πR) on ``OUTLINE``.
 
 STEP: the cylinder (outer radius R + depth/2, length along +Z from z = 0) minus the groove, a loft
-(``BRepOffsetAPI_ThruSections``) through sections at the interpolated cam angles (:func:`sweep_points`: as many
+(``BRepOffsetAPI_ThruSections``) through sections at the interpolated cam angles (:func:`loft_sections`: as many
 as the periodic B-spline through the exact 3D pitch curve needs to lie within the tolerance, measured), closed by
 its first section: each section, in the plane normal to the pitch curve, holds the exact flank points of
 :data:`SECTION_RADII` radii from the groove bottom to past the outer surface (each flank developed on its own
@@ -33,11 +33,12 @@ from .dxf import LAYERS, ezdxf_module, write_deterministic
 from .step import cadquery, solid_dumps
 
 __all__ = ["developed_curves", "developed_dxf", "grooved_cylinder", "cylinder_solid", "cylinder_step", "cylinder_stl",
-           "solid_mesh", "solid_stl", "sweep_points", "SWEEP_POINTS"]
+           "solid_mesh", "solid_stl", "loft_sections", "track_loft", "LOFT_SECTIONS"]
 
-#: sections of the groove's loft (per turn) to begin with: the points the periodic B-spline through the 3D pitch
-#: curve passes through, doubled (at most 4 times) until it lies within the tolerance (cost: 4.7 s CPU at 48)
-SWEEP_POINTS = 48
+#: sections of the groove's (and the rib's) loft per turn to begin with: the points the periodic B-spline through
+#: the 3D pitch curve passes through, doubled (at most 4 times) until it lies within the tolerance (cost: 4.7 s CPU
+#: at 48)
+LOFT_SECTIONS = 48
 #: how far past the outer surface the groove tool reaches (mm), so the cut leaves no skin
 CLEARANCE_MM = 1.0
 #: radii (groove bottom to past the outer surface) at which each section holds the exact flank points
@@ -95,20 +96,21 @@ def _wrap(geometry: CylindricalGeometry, r: float, xz: np.ndarray) -> np.ndarray
     return np.stack([r * np.cos(a), r * np.sin(a), xz[:, 1]], axis=1)
 
 
-def _crossing(geometry: CylindricalGeometry, r: float, flank: int, grid: np.ndarray, plane: tuple) -> np.ndarray:
-    """The point of the exact flank ``flank`` on the cylinder r where it crosses the plane (point, unit normal)
-    near the plane's cam angle: bracketed on ``grid`` (cam angles), then refined by secant steps."""
-    contact = geometry.at_radius(r, flank)
+def _crossing(geometry: CylindricalGeometry, r: float, contact, grid: tuple, plane: tuple) -> np.ndarray:
+    """The point of the exact flank ``contact`` (its contact curve on the cylinder r) where it crosses the plane
+    (point, unit normal) near the plane's cam angle: bracketed on ``grid`` (cam angles and the flank's wrapped
+    points there), then refined by secant steps."""
     p0, normal, theta = plane
+    angles, on_grid = grid
 
     def side(x):
         return (_wrap(geometry, r, contact.evaluate(np.atleast_1d(x)).point) - p0) @ normal
 
-    d = side(grid)
-    near = np.abs((grid - theta + math.pi) % (2 * math.pi) - math.pi) < 0.6
+    d = (on_grid - p0) @ normal
+    near = np.abs((angles - theta + math.pi) % (2 * math.pi) - math.pi) < 0.6
     i = int(np.nonzero(near & (np.sign(d) != np.sign(np.roll(d, -1))))[0][0])
-    g0, g1 = grid[i], grid[(i + 1) % grid.size] + (2 * math.pi if i + 1 == grid.size else 0.0)
-    d0, d1 = d[i], d[(i + 1) % grid.size]
+    g0, g1 = angles[i], angles[(i + 1) % angles.size] + (2 * math.pi if i + 1 == angles.size else 0.0)
+    d0, d1 = d[i], d[(i + 1) % angles.size]
     for _ in range(4):
         if d1 == d0:
             break
@@ -130,22 +132,21 @@ def groove_sections(geometry: CylindricalGeometry, n: int, radii: np.ndarray) ->
     points = pitch_3d(geometry, theta)
     grid = np.linspace(0.0, geometry.period, 20000, endpoint=False)
     out = np.empty((n, 2, len(radii), 3))
-    for k in range(n):
-        for f, flank in enumerate((1, -1)):
-            for j, r in enumerate(radii):
-                out[k, f, j] = _crossing(geometry, float(r), flank, grid, (points[k], along[k], theta[k]))
+    for f, flank in enumerate((1, -1)):
+        for j, r in enumerate(map(float, radii)):
+            contact = geometry.at_radius(r, flank)
+            on_grid = (grid, _wrap(geometry, r, contact.evaluate(grid).point))  # evaluated once for all sections
+            for k in range(n):
+                out[k, f, j] = _crossing(geometry, r, contact, on_grid, (points[k], along[k], theta[k]))
     return theta, out
 
 
-def grooved_cylinder(geometry: CylindricalGeometry, *, n: int = SWEEP_POINTS, bore_mm: float = 0.0):
+def grooved_cylinder(geometry: CylindricalGeometry, *, n: int = LOFT_SECTIONS, bore_mm: float = 0.0):
     """The grooved cylinder as a cadquery Solid (see the module notes)."""
     cq = cadquery()
     cyl = geometry.cylinder
     r_far = cyl.outer_radius_mm + CLEARANCE_MM
-    radii = np.linspace(cyl.inner_radius_mm, r_far, SECTION_RADII)
-    _, sections = groove_sections(geometry, n, radii)
-    wires = [cq.Wire.makePolygon([_vec(cq, p) for p in (*sec[0], *sec[1][::-1])], close=True) for sec in sections]
-    groove = _split_closed(cq, cq.Solid.makeLoft([*wires, wires[0]], False))  # the first section closes the loop
+    groove = track_loft(geometry, n, np.linspace(cyl.inner_radius_mm, r_far, SECTION_RADII))
     body = cq.Solid.makeCylinder(cyl.outer_radius_mm, cyl.length_mm, cq.Vector(0, 0, 0), cq.Vector(0, 0, 1))
     solid = body.cut(groove)
     if bore_mm > 0:
@@ -154,6 +155,16 @@ def grooved_cylinder(geometry: CylindricalGeometry, *, n: int = SWEEP_POINTS, bo
         raise ExportError(f"the grooved cylinder is not a valid solid (OCC's checker): groove {cyl.groove_depth_mm:g} "
                           "mm deep swept around the pitch curve. Check the design for an undercut")
     return solid
+
+
+def track_loft(geometry: CylindricalGeometry, n: int, radii: np.ndarray):
+    """The loft (``BRepOffsetAPI_ThruSections``, smooth) through the track's n sections (:func:`groove_sections`
+    on ``radii``, each the polygon up the +z flank and down the −z flank), closed by its first section, its closed
+    faces split in two: the groove's tool and the rib's body (:mod:`camfab.cad.rib`)."""
+    cq = cadquery()
+    _, sections = groove_sections(geometry, n, radii)
+    wires = [cq.Wire.makePolygon([_vec(cq, p) for p in (*sec[0], *sec[1][::-1])], close=True) for sec in sections]
+    return _split_closed(cq, cq.Solid.makeLoft([*wires, wires[0]], False))  # the first section closes the loop
 
 
 def _split_closed(cq, solid):
@@ -167,9 +178,9 @@ def _split_closed(cq, solid):
     return cq.Shape.cast(divide.Result())
 
 
-def path_deviation(geometry: CylindricalGeometry, n: int = SWEEP_POINTS, samples: int = 500) -> float:
-    """Largest distance (mm) from the exact 3D pitch curve to the B-spline the STEP sweeps along, measured at
-    ``samples`` points between the interpolated ones."""
+def path_deviation(geometry: CylindricalGeometry, n: int = LOFT_SECTIONS, samples: int = 500) -> float:
+    """Largest distance (mm) from the exact 3D pitch curve to the periodic B-spline through its points at the n
+    sections' cam angles (the loft's pitch path), measured at ``samples`` points between the interpolated ones."""
     cq = cadquery()
     from OCP.BRep import BRep_Tool
     from OCP.GeomAPI import GeomAPI_ProjectPointOnCurve
@@ -187,31 +198,32 @@ def path_deviation(geometry: CylindricalGeometry, n: int = SWEEP_POINTS, samples
 
 
 def cylinder_solid(geometry: CylindricalGeometry, *, tol: float, bore_mm: float = 0.0):
-    """The grooved cylinder (:func:`grooved_cylinder` with :func:`sweep_points` sections) and the measured
+    """The grooved cylinder (:func:`grooved_cylinder` with :func:`loft_sections` sections) and the measured
     deviation of its pitch path (mm): what the STEP, STL and IGES files and the assembly are made of."""
-    n, dev = sweep_points(geometry, tol)
+    n, dev = loft_sections(geometry, tol)
     return grooved_cylinder(geometry, n=n, bore_mm=bore_mm), dev
 
 
 def cylinder_step(geometry: CylindricalGeometry, *, tol: float, name: str = "cam",
                   bore_mm: float = 0.0) -> tuple[str, float]:
-    """STEP text of the grooved cylinder and the measured deviation of its sweep path (mm); more points when
-    the default ones leave the path farther than ``tol`` from the exact curve."""
+    """STEP text of the grooved cylinder and the measured deviation of its loft's pitch path (mm); more sections
+    when the default ones leave the path farther than ``tol`` from the exact curve."""
     solid, dev = cylinder_solid(geometry, tol=tol, bore_mm=bore_mm)
     return solid_dumps(solid, name=name), dev
 
 
-def sweep_points(geometry: CylindricalGeometry, tol: float) -> tuple[int, float]:
-    """The points of the sweep path (:data:`SWEEP_POINTS`, doubled while the path lies farther than ``tol`` from
-    the exact pitch curve) and the path's measured deviation (mm)."""
-    n = SWEEP_POINTS
+def loft_sections(geometry: CylindricalGeometry, tol: float) -> tuple[int, float]:
+    """The number of the loft's sections (:data:`LOFT_SECTIONS`, doubled while the pitch path through their cam
+    angles lies farther than ``tol`` from the exact pitch curve, :func:`path_deviation`) and the path's measured
+    deviation (mm)."""
+    n = LOFT_SECTIONS
     dev = path_deviation(geometry, n)
-    while dev > tol and n < 16 * SWEEP_POINTS:
+    while dev > tol and n < 16 * LOFT_SECTIONS:
         n *= 2
         dev = path_deviation(geometry, n)
     if dev > tol:
-        raise ExportError(f"the STEP sweep path stays {dev:.3g} mm from the exact pitch curve with {n} points, more "
-                          f"than the {tol:g} mm tolerance. Give a larger [manufacturing] tolerance_mm")
+        raise ExportError(f"the STEP loft's pitch path stays {dev:.3g} mm from the exact pitch curve with {n} "
+                          f"sections, more than the {tol:g} mm tolerance. Give a larger [manufacturing] tolerance_mm")
     return n, dev
 
 
@@ -233,8 +245,8 @@ def solid_mesh(solid, tol: float):
 
 def cylinder_stl(geometry: CylindricalGeometry, *, tol: float, name: str = "cam",
                  bore_mm: float = 0.0) -> tuple[bytes, float]:
-    """Binary STL of the grooved cylinder (the STEP's solid, :func:`solid_mesh` within ``tol``) and the sweep
-    path's measured deviation (mm; the mesh adds at most ``tol``, OCC's linear deflection)."""
+    """Binary STL of the grooved cylinder (the STEP's solid, :func:`solid_mesh` within ``tol``) and the loft's
+    pitch path's measured deviation (mm; the mesh adds at most ``tol``, OCC's linear deflection)."""
     solid, dev = cylinder_solid(geometry, tol=tol, bore_mm=bore_mm)
     return solid_stl(solid, tol=tol, name=name), dev
 
