@@ -15,7 +15,7 @@ import numpy as np
 
 from ..design.cylindrical import CylindricalGeometry
 from ..errors import ExportError
-from .cylinder import CLEARANCE_MM, SECTION_RADII, loft_sections, solid_stl, track_loft
+from .cylinder import CLEARANCE_MM, SECTION_RADII, exact_edges, loft_sections, solid_stl, track_loft
 from .step import cadquery, solid_dumps
 
 __all__ = ["ribbed_cylinder", "rib_solid", "rib_step", "rib_stl"]
@@ -33,6 +33,7 @@ def ribbed_cylinder(geometry: CylindricalGeometry, *, n: int, bore_mm: float = 0
     solid = body.fuse(loft.intersect(top))
     if bore_mm > 0:
         solid = solid.cut(cq.Solid.makeCylinder(bore_mm / 2, cyl.length_mm, cq.Vector(0, 0, 0), cq.Vector(0, 0, 1)))
+    solid = exact_edges(solid)
     if not (loft.isValid() and solid.isValid()) or len(solid.Solids()) != 1:
         raise ExportError(f"the ribbed cylinder is not one valid solid (OCC's checker): rib {cyl.rib_width_mm:g} mm "
                           f"wide, {cyl.groove_depth_mm:g} mm high. Check the design for an undercut")

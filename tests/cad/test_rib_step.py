@@ -43,9 +43,12 @@ def made(tmp_path_factory):
 
 def test_rib_solid_passes_the_boolean_argument_analyser(made):
     """The ribbed cylinder as built (the rib a loft through its exact sections, as the groove's tool, cut to the
-    top cylinder and fused to the body) passes BOPAlgo_ArgumentAnalyzer with every check on; the sweep it replaces
-    had curve-on-surface faults of up to 4.9e-5 mm."""
-    assert bop_faults(made[4].wrapped) == []
+    top cylinder and fused to the body, its top and root edges rebuilt exactly) and read back from its STEP passes
+    BOPAlgo_ArgumentAnalyzer with every check on; the sweep it replaces had curve-on-surface faults of up to
+    4.9e-5 mm, and the boolean's top and root edges, read back, of up to 8e-7 mm."""
+    _, shape, _, _, solid = made
+    assert bop_faults(solid.wrapped) == []
+    assert bop_faults(shape) == []
 
 
 def _ray(hits, p, d, lo, hi) -> np.ndarray:
