@@ -17,7 +17,9 @@ roller by up to w·(1 − (rR + S′²)/(|C_r′||C_R′|)) off it (5 µm in the
 straight segment across the two flank points on the bottom radius (flat across, as an end mill's end).  The
 loft's edges along the track are iso-curves of its faces (exact pcurves: OCC's boolean argument analyser finds
 nothing; the sweep it replaces had curve-on-surface faults), its faces split in two so none crosses its own seam
-(docs/decisions.md, "Cylindrical cams: the loft, one build, IGES, assembly").
+(docs/decisions.md, "Cylindrical cams: the loft, one build, IGES, assembly").  The groove's opening edges (the
+loft ∩ the outer cylinder) are rebuilt from exact intersection points (:func:`exact_edges`), so the STEP read
+back passes the analyser too.
 """
 from __future__ import annotations
 
@@ -188,7 +190,8 @@ def exact_edges(solid):
     """``solid`` (changed in place and returned) with each edge where a loft face meets a cylinder face (the
     groove's opening, the rib's top and root) rebuilt from exact intersection points: the boolean approximates the
     intersection curve within 2.5e-6 mm, which OCC's STEP reader, setting each edge's tolerance from a few samples,
-    read as a curve-on-surface fault (docs/decisions.md, "Cylindrical cams: exact opening edges")."""
+    read as a curve-on-surface fault (docs/decisions.md, "Cylindrical cams: the rib's loft and exact edges on the
+    cylinders")."""
     from OCP.BRep import BRep_Builder
     from OCP.BRepAdaptor import BRepAdaptor_Surface
     from OCP.GeomAbs import GeomAbs_BSplineSurface, GeomAbs_Cylinder
