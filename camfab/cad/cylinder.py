@@ -226,8 +226,10 @@ def _exact_edge(builder, edge, cyl_face, loft_face) -> None:
     from OCP.TColStd import TColStd_HArray1OfReal
 
     cylinder = BRepAdaptor_Surface(cyl_face).Cylinder()
-    if abs(cylinder.Axis().Direction().Z() - 1.0) > 1e-12 or cylinder.Axis().Location().Distance(gp_Pnt()) > 1e-12:
-        return  # not a cylinder about +Z: leave the edge as the boolean made it
+    placed = not all(s.Location().IsIdentity() for s in (edge, cyl_face, loft_face))
+    if placed or abs(cylinder.Axis().Direction().Z() - 1.0) > 1e-12 or not cylinder.Direct() \
+            or cylinder.Axis().Location().Distance(gp_Pnt()) > 1e-12:
+        return  # not the booleans' edge on a cylinder about +Z: leave it as the boolean made it
     radius, surf = cylinder.Radius(), BRep_Tool.Surface_s(loft_face)
     curve = BRepAdaptor_Curve(edge)
     t0, t1 = curve.FirstParameter(), curve.LastParameter()
@@ -238,6 +240,8 @@ def _exact_edge(builder, edge, cyl_face, loft_face) -> None:
         u, v = GeomAPI_ProjectPointOnSurf(curve.Value(t), surf).LowerDistanceParameters()
         ends.append((u, v + period * round((old_uv.Value(t).Y() - v) / period)))  # the branch of a closed face
     (ua, va), (ub, vb) = ends
+    if abs(vb - va) < 1e-9:
+        return  # not along the track
     knots = np.array([surf.VKnot(k) for k in range(1, surf.NbVKnots() + 1)])
     lo, hi = sorted((va, vb))
     cuts = np.concatenate([[lo], knots[(knots > lo + 1e-9) & (knots < hi - 1e-9)], [hi]])
