@@ -23,7 +23,9 @@ the root) and on each side of the rib (+z, then −z), passes run outwards from 
 A shift along the axis keeps each pass clear of the rib (the rib is, at each developed x, an interval of z, and
 the shifted cutter lies beyond it), and at every x two neighbouring passes are s apart along z: with s less than
 the tool diameter (less twice the chord tolerance) their cutter sections overlap, so the root is covered to the
-end.  The chords of the roughing passes may be coarser than the finishing ones (half the allowance).
+end.  The chords of the roughing passes may be coarser than the finishing ones (half the allowance), but no coarser
+than the finishing tolerance plus the allowance less the twist error, scaled by ρ/r_top: a chord's sag on a level's
+radius ρ grows by r/ρ on the cylinders above it, which the cutter also cuts.
 
 **Finishing**: one pass per rib flank at full depth, on the exact cutter path of the flank on the root radius
 (the groove's machinery of :mod:`camfab.gcode.rotary_finish`, the cutter on the roller's side of the flank):
@@ -248,18 +250,23 @@ class _Cut:
         return phi
 
 
-def _roughing(cut: _Cut, geometry: Any, levels: list[float], s: float, tol_r: float) -> None:
+def _roughing(cut: _Cut, geometry: Any, levels: list[float], s: float, tol_r: float, bound: float) -> None:
+    """Roughing passes; ``bound`` (mm) is what a pass shifted by the allowance may cut past a flank: a chord's sag
+    on a level's radius grows by r/ρ on the cylinders above it, up to the rib's top, so each level's chords are
+    sampled within ``min(tol_r, bound)·ρ/r_top``."""
     job, w = cut.w.job, cut.w
     r_c, a, period = job.tool_radius_mm, job.roughing_allowance_mm, float(geometry.period)
     climb = job.direction == "climb"
+    r_top = geometry.cylinder.outer_radius_mm
     for i, rho in enumerate(levels):
+        tol_level = min(tol_r, bound) * rho / r_top
         for side, name in ((1, "+z"), (-1, "-z")):
             way = roughing_direction(side, int(cut.sigma), climb)
 
             def curve(t: np.ndarray, side: int = side, way: int = way, rho: float = rho) -> np.ndarray:
                 return flank_path(geometry, rho, side, r_c, way * t)
 
-            P = curve(cut.sampled(geometry, rho, tol_r, curve, False))
+            P = curve(cut.sampled(geometry, rho, tol_level, curve, False))
             paths = rib_roughing_paths(P, side, r_c, a, s, geometry.cylinder.length_mm, rho * period, way,
                                        2.0 * tol_r)
             for k, (kind, off, Q) in enumerate(paths):
@@ -301,7 +308,10 @@ def rib_gcode(geometry: Any, job: Job, tol: float, post: str | Post = "linuxcnc"
     _header(w, geometry, levels, safe, tol, over, s)
     lenoff = ["G43", f"H{job.tool_number}"] if p.tool_change and p.length_offset else []
     cut = _Cut(w, float(geometry.mechanism.sense), safe, cyl.outer_radius_mm + job.clearance_mm, lenoff)
-    _roughing(cut, geometry, levels, s, tol_rough)
+    # the first following pass is the finishing path shifted by the allowance a: its sag plus the twist error (over)
+    # stays within the finishing tolerance beyond the flank (at least a quarter of it)
+    _roughing(cut, geometry, levels, s, tol_rough,
+              max(tol_fit + job.roughing_allowance_mm - max(over, 0.0), 0.25 * tol_fit))
     # a chord's sag on the root grows by r/r_b on the cylinders above it, up to the rib's top
     scale = cyl.inner_radius_mm / cyl.outer_radius_mm
     _finishing(cut, geometry, s, max(tol_fit * scale - max(over, 0.0), 0.25 * tol_fit * scale))

@@ -165,6 +165,19 @@ def test_a_too_large_cutter_leaves_material_verify_sees_it(setup, monkeypatch):
     assert all("above the root" in p.message for p in rep.problems) and rep.max_deviation_mm > 0.03
 
 
+@pytest.mark.slow
+def test_a_thin_allowance_roughs_within_the_tolerance(setup):
+    """With a roughing allowance of 1 µm the first following pass runs along the finishing path: its chords, sampled
+    on the level's radius, sag more on the cylinders above it (by r/ρ, up to the rib's top), so each level's chord
+    tolerance is scaled by ρ/r_top and the roughing cuts past no flank by more than the tolerance (verify's exact
+    cutter sections on six radii; 9.1 µm of 10 before the scaling, 7.6 µm with it)."""
+    geometry, job, tol, _ = setup
+    thin = dataclasses.replace(job, roughing_allowance_mm=0.001)
+    rep = _verify(setup, rotary_gcode(geometry, thin, tol, "linuxcnc")[0].decode(), thin)
+    assert rep.ok and not rep.gouge
+    assert rep.rotary["max_penetration_mm"] <= 0.8 * tol
+
+
 def test_a_cutter_too_large_is_refused_naming_the_field(design, tmp_path, capsys):
     """A 14 mm end mill, radial and tangent to a flank on the root, cuts past the flank higher up (the rib's
     twist): exit 2 naming manufacturing.tool_diameter_mm and the diameters that fit; both ends of that range
