@@ -22,7 +22,7 @@ from .certify import certified_deviation
 from .chain import Chain, merge_cocircular
 from .curve import ParametricCurve, points_at
 from .entities import LINE_SWEEP_RAD, MAX_TURNING_RAD, arc_from, biarc, entity_point
-from .spanbatch import two_arc_fits
+from .spanbatch import MIN_BATCH, two_arc_fits
 from .spanmodel import SpanModel, cumtrapz, equioscillate
 from .spans import Span, cut_spans, span_density, span_ends, span_shape
 from .surrogate import HermiteSurrogate
@@ -301,7 +301,51 @@ def _fit_span_chains(curve: ParametricCurve, sur: HermiteSurrogate, spans: list,
     two = [f for f in searches if f is not None and f.n_fixed == 0 and len(f.span.segs) == 1 and f.first_count() == 2]
     for i, res in two_arc_fits(sur, two, target, _place_knots).items():
         two[i].pre[2] = res
-    return [_fit_span_chain(curve, sur, sp, target, f) for sp, f in zip(spans, searches, strict=True)]
+    if len(two) < MIN_BATCH:
+        return [_fit_span_chain(curve, sur, sp, target, f) for sp, f in zip(spans, searches, strict=True)]
+    fits = [None if f is None else _fit_span(sur, sp, target, f) for sp, f in zip(spans, searches, strict=True)]
+    return _span_chains(sur, spans, fits)
+
+
+def _span_chains(sur: HermiteSurrogate, spans: list, fits: list) -> list:
+    """The exact arcs and model error of every span (``fits``: each span's :func:`_fit_span`, None for an exact
+    span or a failed fit), the two-arc spans' biarcs laid in one call (:func:`_two_arc_chains`)."""
+    out = [(sp.exact, 0.0) if sp.exact is not None else None for sp in spans]
+    two_arc = [i for i, f in enumerate(fits) if f is not None and f[0].size == 3 and f[3] == (None, None)]
+    ends = [span_ends(sur, spans[i]) for i in two_arc]
+    for i, chain in zip(two_arc, _two_arc_chains(ends, [fits[i][1] for i in two_arc],
+                                                  [fits[i][0] for i in two_arc]), strict=True):
+        out[i] = None if chain is None else (chain, fits[i][2])
+    done = set(two_arc)
+    for i, f in enumerate(fits):
+        if f is not None and out[i] is None and i not in done:
+            knots, k, err, fixed = f
+            p0, t0, p1, t1 = span_ends(sur, spans[i])
+            chain = _span_chain(p0, t0, p1, t1, knots, k, fixed)
+            out[i] = None if chain is None else (chain, err)
+    return out
+
+
+def _two_arc_chains(ends: list, ks: list, knots: list) -> list:
+    """:func:`_span_chain` of two-arc spans with free end curvatures (the closing biarc alone), their biarcs
+    laid in one call; a span whose biarc needs the fallback ratio (or cutting) takes the per-span path."""
+    ratio = np.empty(len(ends))
+    tgt = np.empty((len(ends), 2))
+    for i, ((_, _, _, t1), k, x) in enumerate(zip(ends, ks, knots, strict=True)):
+        ell = np.diff(x)
+        d1, d2 = _tanlen(k[0], ell[0]), _tanlen(k[1], ell[1])
+        ratio[i] = d1 / d2 if d1 > 0 and d2 > 0 else 1.0
+        end_ang = math.atan2(t1[1], t1[0])
+        tgt[i] = math.cos(end_ang), math.sin(end_ang)
+    p0, t0, p1 = (np.array([e[j] for e in ends]) for j in range(3))
+    bi = biarc(p0, t0, p1, tgt, ratio)
+    s_next = np.stack([bi["s"][:, 1], p1], axis=1)
+    tt2, k2, l2, ok = arc_from(bi["s"], bi["T"], s_next)
+    # (no arc to cut: the test of _cut_long_arcs)
+    simple = bi["valid"] & ok.all(axis=1) & (np.ceil(np.abs(bi["k"] * bi["ell"]) / (0.5 * math.pi)) <= 1).all(axis=1)
+    return [(bi["s"][i], tt2[i], k2[i], l2[i], s_next[i]) if simple[i]
+            else _span_chain(ends[i][0], ends[i][1], ends[i][2], ends[i][3], knots[i], ks[i])
+            for i in range(len(ends))]
 
 
 def _merge_wrap(chain: Chain, labels: np.ndarray) -> tuple[Chain, np.ndarray]:
