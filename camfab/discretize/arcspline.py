@@ -22,6 +22,7 @@ from .certify import certified_deviation
 from .chain import Chain, merge_cocircular
 from .curve import ParametricCurve, points_at
 from .entities import LINE_SWEEP_RAD, MAX_TURNING_RAD, arc_from, biarc, entity_point
+from .spanbatch import MIN_BATCH, two_arc_fits
 from .spanmodel import SpanModel, cumtrapz, equioscillate
 from .spans import Span, cut_spans, span_density, span_ends, span_shape
 from .surrogate import HermiteSurrogate
@@ -93,10 +94,17 @@ class _SpanFit:
         self.m_min = 2 + self.n_fixed
         self.tried: dict = {}
         self.models: dict = {}
+        self.pre: dict = {}  # attempts at the placed knots computed in a batch (spanbatch), by arc count
+
+    def first_count(self) -> int:
+        """The arc count :meth:`search` tries first."""
+        return max(self.m_min, math.ceil(_EST_FACTOR * self.est))
 
     def attempt(self, m: int, ends=_END_ARCS, knots=None, fixed_ends=_FIXED_END_ARCS):
         """``(error, fits, (knots, k, error))`` of ``m`` arcs optimised from ``knots`` (default: placed)."""
         span = self.span
+        if knots is None and ends is _END_ARCS and fixed_ends is _FIXED_END_ARCS and m in self.pre:
+            return self.pre.pop(m)
         if m not in self.models:
             self.models[m] = SpanModel(self.sur, span.segs, max(_SPLINE_MIN_GRID, _SPLINE_SAMPLES * m + 1),
                                        span.fixed)
@@ -114,7 +122,7 @@ class _SpanFit:
 
     def search(self):
         """The fewest arcs that fit from the count search, or None (no fit, or more than the span allows)."""
-        m = max(self.m_min, math.ceil(_EST_FACTOR * self.est))
+        m = self.first_count()
         best = None
         for _ in range(12):
             if m in self.tried:
@@ -168,7 +176,7 @@ class _SpanFit:
         return best
 
 
-def _fit_span(sur: HermiteSurrogate, span: Span, target: float):
+def _fit_span(sur: HermiteSurrogate, span: Span, target: float, fit: _SpanFit | None = None):
     """Fewest arcs (model) for a clamped span: ``(knots, k, error, fixed)`` or None.
 
     The arc count starts from the asymptotic estimate ``∫ (|κ'| / (124.7·target))^(1/3) ds``;
@@ -178,9 +186,10 @@ def _fit_span(sur: HermiteSurrogate, span: Span, target: float):
     The optimum is not monotone in the count: at the smallest failing count a warm start
     and other end-arc ratios (:data:`_END_ARCS_ALT`) are tried when it failed narrowly.
     A span with a fixed end curvature that misses by far at its first count (:data:`_FIXED_HOPELESS`) is fitted
-    again with free end curvatures (``fixed`` returned: the curvatures the fit imposes).
+    again with free end curvatures (``fixed`` returned: the curvatures the fit imposes).  ``fit``: the span's
+    search when already made (:func:`_fit_span_chains`).
     """
-    fit = _SpanFit(sur, span, target)
+    fit = _SpanFit(sur, span, target) if fit is None else fit
     best = fit.search()
     if best is None and fit.n_fixed and len(fit.tried) == 1:
         log.info("arcs: span %s cannot keep its neighbour's end curvature (misses by more than %gx at its first "
@@ -271,17 +280,72 @@ def _span_chain(p0, t0, p1, t1, knots, k, fixed=(None, None)):
     return S, TT2, K2, L2, S_next
 
 
-def _fit_span_chain(curve: ParametricCurve, sur: HermiteSurrogate, span: Span, target: float):
+def _fit_span_chain(curve: ParametricCurve, sur: HermiteSurrogate, span: Span, target: float,
+                    search: _SpanFit | None = None):
     """The exact G1 arcs of one span fitted to ``target`` and the model error, or None."""
     if span.exact is not None:
         return span.exact, 0.0
-    fit = _fit_span(sur, span, target)
+    fit = _fit_span(sur, span, target, search)
     if fit is None:
         return None
     knots, k, err, fixed = fit
     p0, t0, p1, t1 = span_ends(sur, span)
     chain = _span_chain(p0, t0, p1, t1, knots, k, fixed)
     return None if chain is None else (chain, err)
+
+
+def _fit_span_chains(curve: ParametricCurve, sur: HermiteSurrogate, spans: list, target: float) -> list:
+    """:func:`_fit_span_chain` of every span, the first attempt of the free single-piece spans whose search starts
+    at two arcs made in one batch (:func:`~camfab.discretize.spanbatch.two_arc_fits`): the same arcs."""
+    searches = [None if sp.exact is not None else _SpanFit(sur, sp, target) for sp in spans]
+    two = [f for f in searches if f is not None and f.n_fixed == 0 and len(f.span.segs) == 1 and f.first_count() == 2]
+    for i, res in two_arc_fits(sur, two, target, _place_knots).items():
+        two[i].pre[2] = res
+    if len(two) < MIN_BATCH:
+        return [_fit_span_chain(curve, sur, sp, target, f) for sp, f in zip(spans, searches, strict=True)]
+    fits = [None if f is None else _fit_span(sur, sp, target, f) for sp, f in zip(spans, searches, strict=True)]
+    return _span_chains(sur, spans, fits)
+
+
+def _span_chains(sur: HermiteSurrogate, spans: list, fits: list) -> list:
+    """The exact arcs and model error of every span (``fits``: each span's :func:`_fit_span`, None for an exact
+    span or a failed fit), the two-arc spans' biarcs laid in one call (:func:`_two_arc_chains`)."""
+    out = [(sp.exact, 0.0) if sp.exact is not None else None for sp in spans]
+    two_arc = [i for i, f in enumerate(fits) if f is not None and f[0].size == 3 and f[3] == (None, None)]
+    ends = [span_ends(sur, spans[i]) for i in two_arc]
+    for i, chain in zip(two_arc, _two_arc_chains(ends, [fits[i][1] for i in two_arc],
+                                                  [fits[i][0] for i in two_arc]), strict=True):
+        out[i] = None if chain is None else (chain, fits[i][2])
+    done = set(two_arc)
+    for i, f in enumerate(fits):
+        if f is not None and out[i] is None and i not in done:
+            knots, k, err, fixed = f
+            p0, t0, p1, t1 = span_ends(sur, spans[i])
+            chain = _span_chain(p0, t0, p1, t1, knots, k, fixed)
+            out[i] = None if chain is None else (chain, err)
+    return out
+
+
+def _two_arc_chains(ends: list, ks: list, knots: list) -> list:
+    """:func:`_span_chain` of two-arc spans with free end curvatures (the closing biarc alone), their biarcs
+    laid in one call; a span whose biarc needs the fallback ratio (or cutting) takes the per-span path."""
+    ratio = np.empty(len(ends))
+    tgt = np.empty((len(ends), 2))
+    for i, ((_, _, _, t1), k, x) in enumerate(zip(ends, ks, knots, strict=True)):
+        ell = np.diff(x)
+        d1, d2 = _tanlen(k[0], ell[0]), _tanlen(k[1], ell[1])
+        ratio[i] = d1 / d2 if d1 > 0 and d2 > 0 else 1.0
+        end_ang = math.atan2(t1[1], t1[0])
+        tgt[i] = math.cos(end_ang), math.sin(end_ang)
+    p0, t0, p1 = (np.array([e[j] for e in ends]) for j in range(3))
+    bi = biarc(p0, t0, p1, tgt, ratio)
+    s_next = np.stack([bi["s"][:, 1], p1], axis=1)
+    tt2, k2, l2, ok = arc_from(bi["s"], bi["T"], s_next)
+    # (no arc to cut: the test of _cut_long_arcs)
+    simple = bi["valid"] & ok.all(axis=1) & (np.ceil(np.abs(bi["k"] * bi["ell"]) / (0.5 * math.pi)) <= 1).all(axis=1)
+    return [(bi["s"][i], tt2[i], k2[i], l2[i], s_next[i]) if simple[i]
+            else _span_chain(ends[i][0], ends[i][1], ends[i][2], ends[i][3], knots[i], ks[i])
+            for i in range(len(ends))]
 
 
 def _merge_wrap(chain: Chain, labels: np.ndarray) -> tuple[Chain, np.ndarray]:
@@ -328,7 +392,7 @@ def fit_spline(curve: ParametricCurve, surrogate: tuple[HermiteSurrogate, float]
     spans = cut_spans(curve, sur, target, tol, anchored)
     targets = [target] * len(spans)
     with np.errstate(invalid="ignore", divide="ignore"):
-        fits = [_fit_span_chain(curve, sur, sp, target) for sp in spans]
+        fits = _fit_span_chains(curve, sur, spans, target)
     if any(f is None for f in fits):
         return None
     parts, errs = [f[0] for f in fits], [f[1] for f in fits]

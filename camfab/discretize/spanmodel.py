@@ -12,7 +12,7 @@ import numpy as np
 from ..geom2d import TWO_PI, cross, dot
 from .surrogate import HermiteSurrogate
 
-__all__ = ["span_model", "cumtrapz", "SpanModel", "equioscillate"]
+__all__ = ["span_model", "cumtrapz", "SpanModel", "equioscillate", "peak"]
 
 
 #: Lawson (minimax) reweighting iterations of the curvatures of given knots
@@ -229,7 +229,7 @@ def equioscillate(model: SpanModel, knots: np.ndarray, iters: int = _EQUI_ITERS)
     best = (float(np.abs(e).max()), knots, k, e)
     m = k.size
     if m < 3:
-        return _peak(e), knots, k
+        return peak(e), knots, k
     lam = 1e-2
     hmean = model.L / m
     lin = None  # the linearisation at ``best`` (kept while steps fail: only the damping changes)
@@ -273,10 +273,10 @@ def equioscillate(model: SpanModel, knots: np.ndarray, iters: int = _EQUI_ITERS)
                 break
         elif emax - best[0] < 1e-3 * emax:
             break
-    return _peak(best[3]), best[1], best[2]
+    return peak(best[3]), best[1], best[2]
 
 
-def _peak(e: np.ndarray) -> float:
+def peak(e: np.ndarray) -> float:
     """Largest ``|e|`` with every interior local extremum refined by a parabola through its neighbours."""
     ae = np.abs(e)
     j = np.clip(_local_extrema(e), 1, e.size - 2)

@@ -126,9 +126,9 @@ def test_overshooting_span_is_refitted_alone(monkeypatch):
     calls = []
     fit_span = d._fit_span
 
-    def spy(sur, span, target):
+    def spy(sur, span, target, search=None):
         calls.append(id(span))
-        return fit_span(sur, span, target)
+        return fit_span(sur, span, target, search)
 
     monkeypatch.setattr(d, "_SPLINE_FILL", 1.3)
     monkeypatch.setattr(d, "_fit_span", spy)

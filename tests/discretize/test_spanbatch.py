@@ -1,0 +1,59 @@
+"""The batched two-arc fit of many short spans (spanbatch) against the per-span fit it stands in for.
+
+A profile of 240 short cycloidal segments is cut into hundreds of spans whose fit starts at two arcs; the batch
+must give every span the same knots and curvatures bit for bit (so the arcs and the files do not change), the
+same verdict and the same error up to rounding, their biarcs laid in one call must be the per-span arcs bit for
+bit, and the whole fit must stay within tol by the independent checker.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from camfab.discretize import arcs
+from camfab.discretize.arcspline import _fit_span, _place_knots, _span_chain, _SpanFit, _two_arc_chains
+from camfab.discretize.spanbatch import MIN_BATCH, two_arc_fits
+from camfab.discretize.spans import cut_spans, span_ends
+from camfab.discretize.surrogate import fit_surrogate
+
+from .test_discretize import Dense, cam, check_arcs
+
+TOL = 1e-3
+ROWS = [("cycloidal", 0.001 * (-1) ** i, 1.5) for i in range(240)]
+
+
+def test_two_arc_batch_equals_per_span_fit():
+    curve = cam(ROWS, base=40.0)
+    sur, sur_err = fit_surrogate(curve, TOL)
+    target = 0.97 * TOL - sur_err
+    searches = [_SpanFit(sur, sp, target) for sp in cut_spans(curve, sur, target, TOL) if sp.exact is None]
+    two = [f for f in searches if f.n_fixed == 0 and len(f.span.segs) == 1 and f.first_count() == 2]
+    assert len(two) >= 100 > MIN_BATCH
+    batch = two_arc_fits(sur, two, target, _place_knots)
+    assert len(batch) == len(two)
+    for i, f in enumerate(two):
+        err, ok, (knots, k, _) = f.attempt(2)  # the per-span model, system and Lawson fit
+        b_err, b_ok, (b_knots, b_k, _) = batch[i]
+        assert np.array_equal(knots, b_knots) and np.array_equal(k, b_k)
+        assert b_ok == ok and abs(b_err - err) <= 1e-9 * err
+
+
+def test_two_arc_chains_equal_per_span_chains():
+    curve = cam(ROWS, base=40.0)
+    sur, sur_err = fit_surrogate(curve, TOL)
+    target = 0.97 * TOL - sur_err
+    fits = [_fit_span(sur, sp, target) for sp in cut_spans(curve, sur, target, TOL) if sp.exact is None]
+    spans = [sp for sp in cut_spans(curve, sur, target, TOL) if sp.exact is None]
+    two = [(sp, f) for sp, f in zip(spans, fits, strict=True) if f[0].size == 3 and f[3] == (None, None)]
+    assert len(two) >= 100
+    ends = [span_ends(sur, sp) for sp, _ in two]
+    batch = _two_arc_chains(ends, [f[1] for _, f in two], [f[0] for _, f in two])
+    for e, (_, f), got in zip(ends, two, batch, strict=True):
+        want = _span_chain(*e, f[0], f[1], f[3])
+        assert all(np.array_equal(a, b) for a, b in zip(want, got, strict=True))
+
+
+def test_many_segment_profile_within_tol():
+    curve = cam(ROWS, base=40.0)
+    res = arcs(curve, tol=TOL)
+    assert res.max_deviation <= TOL
+    assert check_arcs(res, Dense(curve)) <= TOL
