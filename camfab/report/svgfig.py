@@ -23,6 +23,8 @@ from xml.sax.saxutils import escape
 
 import numpy as np
 
+from ..errors import InternalError
+
 __all__ = ["figure_svg"]
 
 _FONT = "DejaVu Sans, Bitstream Vera Sans, Arial, Helvetica, sans-serif"
@@ -33,8 +35,8 @@ _ANCHOR = {"left": "start", "center": "middle", "right": "end"}
 _MARKERS = frozenset({"o", "v", "^", "+", "x", "s", "D", "None", "none", "", " "})
 
 
-class _Unsupported(Exception):
-    """The figure has an artist this writer does not draw."""
+class _Unsupported(InternalError):
+    """The figure has an artist this writer does not draw (caught here: the figure goes to matplotlib's save)."""
 
 
 def figure_svg(fig) -> bytes | None:
