@@ -196,33 +196,14 @@ def rib_roughing_paths(P: np.ndarray, side: int, r_c: float, a: float, s: float,
 
 def _header(w: RotaryWriter, geometry: Any, levels: list[float], safe: float, tol: float, over: float,
             s: float) -> None:
-    p, job, cyl, mech = w.p, w.job, geometry.cylinder, geometry.mechanism
-    inch = job.units == "inch"
-    u = "in" if inch else "mm"
-    if p.percent:
-        w.lines.append("%")
-    if p.program_number:
-        w.lines.append(f"O1000 ({p.sanitize_comment(job.design_name)[:16]})")
-    for text in ("camfab 4-axis program: cylindrical cam rib, roughing both sides to the root and a finishing pass "
-                 "per rib flank", f"design: {job.design_name}", f"post: {p.name}",
-                 f"units: {'inch' if inch else 'mm'}, A in degrees",
-                 "work offset G54: X0 at the cylinder z = 0 end, Z0 on the rotary axis (Z = tool tip radius), "
-                 "A0 = cam angle 0 under the tool",
-                 f"rotary axis: A about X, A = {'-' if mech.sense > 0 else '+'}cam angle ({mech.rotation})",
-                 f"tool: T{job.tool_number} flat end mill D{w.L(job.tool_diameter_mm)} {u}, axis radial (along Z)",
-                 f"stock: cylinder Z{w.L(cyl.outer_radius_mm)} (the rib top) x {w.L(cyl.length_mm)} {u} long, "
-                 f"rib root Z{w.L(cyl.inner_radius_mm)}, rib width {w.L(cyl.rib_width_mm)} {u} where it runs round",
-                 f"roughing: stepover {w.L(s)} {u}, allowance {w.L(job.roughing_allowance_mm)} {u} on the flanks",
-                 f"tolerance: {tol:.6f} mm, output resolution {10.0 ** -w.d:.{w.d}f} {u} and "
-                 f"{10.0 ** -w.d:.{w.d}f} deg",
-                 f"flanks: one finishing pass each at full depth, tangent on the root radius, twist above it "
-                 f"either way at most {max(over, 0.0) * w.k:.4f} {u}",
-                 f"depth levels: {len(levels)}, safe Z{w.L(safe)}",
-                 f"spindle: {round(job.spindle_rpm)} rpm cw",
-                 f"feed: {job.feed_mm_min * w.k:.{w.fd}f} {u}/min at the tool tip as inverse time G93, "
-                 f"plunge {job.plunge_feed_mm_min * w.k:.{w.fd}f} {u}/min", *job.notes):
-        w.comment(text)
-    w.start()
+    cyl, mech, u = geometry.cylinder, geometry.mechanism, "in" if w.job.units == "inch" else "mm"
+    w.header("camfab 4-axis program: cylindrical cam rib, roughing both sides to the root and a finishing pass "
+             "per rib flank",
+             [f"stock: cylinder Z{w.L(cyl.outer_radius_mm)} (the rib top) x {w.L(cyl.length_mm)} {u} long, "
+              f"rib root Z{w.L(cyl.inner_radius_mm)}, rib width {w.L(cyl.rib_width_mm)} {u} where it runs round",
+              f"roughing: stepover {w.L(s)} {u}, allowance {w.L(w.job.roughing_allowance_mm)} {u} on the flanks"],
+             f"flanks: one finishing pass each at full depth, tangent on the root radius, twist above it "
+             f"either way at most {max(over, 0.0) * w.k:.4f} {u}", levels, safe, tol, mech.sense, mech.rotation)
 
 
 class _Cut:

@@ -38,10 +38,12 @@ from .rotary_verify import (
     RotaryVerifyReport,
     Samples,
     feed_findings,
+    floor_findings,
     from_cutter_path,
     is_lateral,
     rapid_findings,
     read_or_refused,
+    step_down_findings,
     worst_per_pass,
 )
 
@@ -254,23 +256,7 @@ def _coverage(ctx: RotaryContext) -> tuple[float, dict, list[Finding]]:
 
 def _depth(ctx: RotaryContext) -> list[Finding]:
     """Nothing below the root, the finishing passes on it, step-downs kept."""
-    out, tol, mv = [], ctx.tol, ctx.moves
-    if len(ctx.cut.Z) and float(ctx.cut.Z.min()) < ctx.r_b - tol:
-        j = int(np.argmin(ctx.cut.Z))
-        out.append(Finding.at_line(IssueCode.TOO_DEEP, f"cuts to radius Z{ctx.cut.Z[j]:g}, below the rib's root "
-                                   f"({ctx.r_b:g} mm)", mv[ctx.cut.move[j]].line))
-    off = np.abs(ctx.finish.Z - ctx.r_b) > tol
-    if off.any():
-        out.append(Finding.at_line(IssueCode.FINISH_DEPTH, f"a finishing pass runs at Z{ctx.finish.Z[off][0]:g}, not "
-                                   f"on the rib's root ({ctx.r_b:g} mm)", mv[ctx.finish.move[off][0]].line))
-    deepest = ctx.r_o
-    for m in mv:
-        if m.kind == "feed" and m.end[2] < deepest:
-            if m.end[2] < deepest - ctx.job.step_down_mm - tol:
-                out.append(Finding.at_line(IssueCode.STEP_DOWN, f"plunges {deepest - m.end[2]:.4g} mm below what was "
-                                           f"cut before (step-down {ctx.job.step_down_mm:g} mm)", m.line))
-            deepest = m.end[2]
-    return out
+    return floor_findings(ctx, "the rib's root") + step_down_findings(ctx)
 
 
 def _directions(ctx: RotaryContext) -> list[Finding]:

@@ -175,6 +175,32 @@ class _Writer:
         self.block(["G0", f"Z{self.L(clear)}"])
         self.block(["G1", f"Z{self.L(z)}", self.feed(self.job.plunge_feed_mm_min)])
 
+    def header(self, title: str, mid: list[str], flanks: str, levels: list[float], safe: float, tol: float,
+               sense: int, rotation: str) -> None:
+        """The program's head (``%``, the O number) and its comment block: ``title``, the set-up, the tool, the
+        feature's own lines ``mid``, the tolerance, the ``flanks`` line, the levels, spindle, feeds and the job's
+        notes; then :meth:`start`."""
+        p, job = self.p, self.job
+        inch = job.units == "inch"
+        u = "in" if inch else "mm"
+        if p.percent:
+            self.lines.append("%")
+        if p.program_number:
+            self.lines.append(f"O1000 ({p.sanitize_comment(job.design_name)[:16]})")
+        for text in (title, f"design: {job.design_name}", f"post: {p.name}", f"units: {'inch' if inch else 'mm'}, "
+                     "A in degrees", "work offset G54: X0 at the cylinder z = 0 end, Z0 on the rotary axis (Z = tool "
+                     "tip radius), A0 = cam angle 0 under the tool",
+                     f"rotary axis: A about X, A = {'-' if sense > 0 else '+'}cam angle ({rotation})",
+                     f"tool: T{job.tool_number} flat end mill D{self.L(job.tool_diameter_mm)} {u}, axis radial "
+                     "(along Z)", *mid,
+                     f"tolerance: {tol:.6f} mm, output resolution {10.0 ** -self.d:.{self.d}f} {u} and "
+                     f"{10.0 ** -self.d:.{self.d}f} deg", flanks,
+                     f"depth levels: {len(levels)}, safe Z{self.L(safe)}", f"spindle: {round(job.spindle_rpm)} rpm cw",
+                     f"feed: {job.feed_mm_min * self.k:.{self.fd}f} {u}/min at the tool tip as inverse time G93, "
+                     f"plunge {job.plunge_feed_mm_min * self.k:.{self.fd}f} {u}/min", *job.notes):
+            self.comment(text)
+        self.start()
+
     def start(self) -> None:
         """The post's preamble, the tool, the spindle (M3) and the coolant, after the header's comments."""
         p, job = self.p, self.job
@@ -198,31 +224,13 @@ def _to_machine(P: np.ndarray, r: float, sigma: float) -> tuple[np.ndarray, np.n
 
 
 def _header(w: _Writer, geometry: Any, levels: list[float], safe: float, tol: float, over: float) -> None:
-    p, job, cyl, mech = w.p, w.job, geometry.cylinder, geometry.mechanism
-    inch = job.units == "inch"
-    u = "in" if inch else "mm"
-    if p.percent:
-        w.lines.append("%")
-    if p.program_number:
-        w.lines.append(f"O1000 ({p.sanitize_comment(job.design_name)[:16]})")
-    for text in ("camfab 4-axis program: cylindrical cam groove, centre pass and a finishing pass per flank",
-                 f"design: {job.design_name}", f"post: {p.name}", f"units: {'inch' if inch else 'mm'}, A in degrees",
-                 "work offset G54: X0 at the cylinder z = 0 end, Z0 on the rotary axis (Z = tool tip radius), "
-                 "A0 = cam angle 0 under the tool",
-                 f"rotary axis: A about X, A = {'-' if mech.sense > 0 else '+'}cam angle ({mech.rotation})",
-                 f"tool: T{job.tool_number} flat end mill D{w.L(job.tool_diameter_mm)} {u}, axis radial (along Z)",
-                 f"groove: bottom Z{w.L(cyl.inner_radius_mm)}, outer Z{w.L(cyl.outer_radius_mm)}, "
-                 f"width {w.L(2 * mech.half_width(cyl.inner_radius_mm))} {u} at the bottom",
-                 f"tolerance: {tol:.6f} mm, output resolution {10.0 ** -w.d:.{w.d}f} {u} and "
-                 f"{10.0 ** -w.d:.{w.d}f} deg",
-                 f"flanks: one finishing pass each at full depth, tangent on the bottom radius, "
-                 f"twist overcut above it at most {max(over, 0.0) * w.k:.4f} {u}",
-                 f"depth levels: {len(levels)}, safe Z{w.L(safe)}",
-                 f"spindle: {round(job.spindle_rpm)} rpm cw",
-                 f"feed: {job.feed_mm_min * w.k:.{w.fd}f} {u}/min at the tool tip as inverse time G93, "
-                 f"plunge {job.plunge_feed_mm_min * w.k:.{w.fd}f} {u}/min", *job.notes):
-        w.comment(text)
-    w.start()
+    cyl, mech, u = geometry.cylinder, geometry.mechanism, "in" if w.job.units == "inch" else "mm"
+    w.header("camfab 4-axis program: cylindrical cam groove, centre pass and a finishing pass per flank",
+             [f"groove: bottom Z{w.L(cyl.inner_radius_mm)}, outer Z{w.L(cyl.outer_radius_mm)}, "
+              f"width {w.L(2 * mech.half_width(cyl.inner_radius_mm))} {u} at the bottom"],
+             f"flanks: one finishing pass each at full depth, tangent on the bottom radius, "
+             f"twist overcut above it at most {max(over, 0.0) * w.k:.4f} {u}", levels, safe, tol, mech.sense,
+             mech.rotation)
 
 
 def _finishing(w: _Writer, geometry: Any, tol_fin: float, safe: float, clear: float) -> tuple[int, float]:

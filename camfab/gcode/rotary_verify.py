@@ -42,7 +42,8 @@ from .rotary_finish import cutter_penetration, finishing_direction, flank_path, 
 from .rotary_read import RotaryMove, RotaryReadError, read_rotary
 from .verify import VerifyReport
 
-__all__ = ["RotaryVerifyReport", "verify_rotary_program", "RotaryContext", "Samples", "sample_moves", "worst_per_pass",
+__all__ = ["RotaryVerifyReport", "verify_rotary_program", "RotaryContext", "floor_findings",
+           "step_down_findings", "Samples", "sample_moves", "worst_per_pass",
            "feed_findings", "rapid_findings", "is_lateral", "from_cutter_path", "read_or_refused"]
 
 #: sampling step of a move on its developed cylinder (mm), the coverage probes per target, and the radii (fractions
@@ -265,28 +266,40 @@ def _coverage(ctx: _Context) -> tuple[float, list[Finding]]:
     return worst, out
 
 
-def _depth(ctx: _Context) -> list[Finding]:
-    """Nothing below the groove bottom, the finishing passes and a centre pass on it, step-downs kept."""
+def floor_findings(ctx: _Context, floor: str) -> list[Finding]:
+    """Nothing cut below the ``floor`` radius ``ctx.r_b`` (named: the groove bottom, the rib's root), every
+    finishing pass on it."""
     out, tol, mv = [], ctx.tol, ctx.moves
     if len(ctx.cut.Z) and float(ctx.cut.Z.min()) < ctx.r_b - tol:
         j = int(np.argmin(ctx.cut.Z))
-        out.append(Finding.at_line(IssueCode.TOO_DEEP, f"cuts to radius Z{ctx.cut.Z[j]:g}, below the groove bottom "
+        out.append(Finding.at_line(IssueCode.TOO_DEEP, f"cuts to radius Z{ctx.cut.Z[j]:g}, below {floor} "
                                    f"({ctx.r_b:g} mm)", mv[ctx.cut.move[j]].line))
     off = np.abs(ctx.finish.Z - ctx.r_b) > tol
     if off.any():
         out.append(Finding.at_line(IssueCode.FINISH_DEPTH, f"a finishing pass runs at Z{ctx.finish.Z[off][0]:g}, not "
-                                   f"on the groove bottom ({ctx.r_b:g} mm)", mv[ctx.finish.move[off][0]].line))
-    if not (np.abs(ctx.centre.Z - ctx.r_b) <= tol).any():
-        out.append(Finding.at_line(IssueCode.FINISH_DEPTH, f"no centre pass on the groove bottom ({ctx.r_b:g} mm)",
-                                   None))
-    deepest = ctx.r_o
-    for m in mv:
+                                   f"on {floor} ({ctx.r_b:g} mm)", mv[ctx.finish.move[off][0]].line))
+    return out
+
+
+def step_down_findings(ctx: _Context) -> list[Finding]:
+    """No feed plunging deeper than the job's step-down below what was cut before."""
+    out, tol, deepest = [], ctx.tol, ctx.r_o
+    for m in ctx.moves:
         if m.kind == "feed" and m.end[2] < deepest:
             if m.end[2] < deepest - ctx.job.step_down_mm - tol:
                 out.append(Finding.at_line(IssueCode.STEP_DOWN, f"plunges {deepest - m.end[2]:.4g} mm below what was "
                                            f"cut before (step-down {ctx.job.step_down_mm:g} mm)", m.line))
             deepest = m.end[2]
     return out
+
+
+def _depth(ctx: _Context) -> list[Finding]:
+    """Nothing below the groove bottom, the finishing passes and a centre pass on it, step-downs kept."""
+    out = floor_findings(ctx, "the groove bottom")
+    if not (np.abs(ctx.centre.Z - ctx.r_b) <= ctx.tol).any():
+        out.append(Finding.at_line(IssueCode.FINISH_DEPTH, f"no centre pass on the groove bottom ({ctx.r_b:g} mm)",
+                                   None))
+    return out + step_down_findings(ctx)
 
 
 def _feeds(ctx: _Context) -> list[Finding]:
