@@ -75,6 +75,7 @@ import io
 import math
 import re
 import zipfile
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -84,6 +85,7 @@ from ..design.tables import LiftTable, intervals, lift_table, sample_params
 from ..errors import InputError
 from ..results import JUMP_CODES, IssueCode, Severity, Verdict, pair_names
 from ..textsafe import xlsx_no_formulas, xlsx_put, xlsx_text
+from .xlsx_blocks import NumberBlocks
 
 __all__ = ["CAMDAS_COLUMNS", "FIXED_DATE", "LiftTable", "camdas_workbook", "camdas_columns", "conclusions",
            "dynamics_columns", "dynamics_summary_rows", "strength_summary_rows",
@@ -367,10 +369,11 @@ def camdas_workbook(spec, geometry, report, *, step_deg: float = 1.0, lift_step_
     intervals(lift_step_deg, "lift_step_deg")
     wb = Workbook()
     wb.remove(wb.active)
+    blocks = NumberBlocks()
     cylindrical = spec.cam.kind == "cylindrical"  # developed coordinates, no plate: camfab.formats.cylinder_sheet
     for k in range(0 if cylindrical else len(geometry.profiles)):
         _camdas_sheet(wb.create_sheet("CAM-DAS" if k == 0 else f"CAM-DAS {k + 1}"), spec, geometry, report,
-                      step_deg, k)
+                      step_deg, k, blocks)
     if cylindrical:
         from .cylinder_sheet import write_cylinder_sheet
 
@@ -380,28 +383,30 @@ def camdas_workbook(spec, geometry, report, *, step_deg: float = 1.0, lift_step_
         xlsx_put(ws["A2"], spec.name)
     _checks_sheet(wb.create_sheet("Checks"), spec, report)
     if not cylindrical:
-        _lift_sheet(wb.create_sheet("Lift table"), lift_table(geometry, lift_step_deg), geometry)
+        _lift_sheet(wb.create_sheet("Lift table"), lift_table(geometry, lift_step_deg), geometry, blocks)
     if spec.dynamics is not None and not cylindrical:
-        _dynamics_sheet(wb.create_sheet("Dynamics"), *dynamics_columns(spec, geometry, step_deg=step_deg))
+        _dynamics_sheet(wb.create_sheet("Dynamics"), *dynamics_columns(spec, geometry, step_deg=step_deg),
+                        blocks=blocks)
     wb.properties.creator = "camfab"
     wb.properties.title = xlsx_text(spec.name)
     wb.properties.created = FIXED_DATE
     wb.properties.modified = FIXED_DATE
-    return _save(wb)
+    return _save(wb, blocks)
 
 
-def _save(wb) -> bytes:
+def _save(wb, blocks: NumberBlocks | None = None) -> bytes:
     xlsx_no_formulas(wb)  # camfab writes no formula: text openpyxl took for one stays text
     buf = io.BytesIO()
     wb.save(buf)
-    return fixed_zip(buf.getvalue())
+    return fixed_zip(buf.getvalue(), blocks.patches() if blocks is not None else None)
 
 
 _MODIFIED = re.compile(rb"(<dcterms:modified[^>]*>)[^<]*(</dcterms:modified>)")
 
 
-def fixed_zip(raw: bytes) -> bytes:
-    """Re-pack an xlsx with fixed entry timestamps and a fixed ``modified`` property (equal content, equal bytes)."""
+def fixed_zip(raw: bytes, patches: dict[str, Callable[[bytes], bytes]] | None = None) -> bytes:
+    """Re-pack an xlsx with fixed entry timestamps and a fixed ``modified`` property (equal content, equal bytes);
+    ``patches`` rewrites the named entries (:meth:`camfab.formats.xlsx_blocks.NumberBlocks.patches`)."""
     out = io.BytesIO()
     with zipfile.ZipFile(io.BytesIO(raw)) as src, zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as dst:
         for info in src.infolist():
@@ -411,16 +416,15 @@ def fixed_zip(raw: bytes) -> bytes:
             data = src.read(info.filename)
             if info.filename == "docProps/core.xml":  # openpyxl stamps the save time into <modified>
                 data = _MODIFIED.sub(rb"\g<1>" + FIXED_DATE.strftime("%Y-%m-%dT%H:%M:%SZ").encode() + rb"\2", data)
+            if patches and info.filename in patches:
+                data = patches[info.filename](data)
             dst.writestr(zi, data)
     return out.getvalue()
 
 
-def _finite_or_none(v: float) -> float | None:
-    return None if not math.isfinite(v) else float(v)
-
-
-def _camdas_sheet(ws, spec, geometry, report, step_deg: float, profile: int) -> None:
+def _camdas_sheet(ws, spec, geometry, report, step_deg: float, profile: int, blocks: NumberBlocks) -> None:
     from openpyxl.styles import Font
+    from openpyxl.utils.cell import column_index_from_string
 
     ws["A1"] = type_text(spec) + (f" — profile {profile + 1}" if profile else "")
     xlsx_put(ws["A2"], spec.name)  # the design's text: never a formula, no control characters
@@ -436,11 +440,7 @@ def _camdas_sheet(ws, spec, geometry, report, step_deg: float, profile: int) -> 
     for letter, text in head.items():
         ws[f"{letter}9"] = text
         ws[f"{letter}9"].font = bold
-    n = len(cols["A"])
-    for letter, values in cols.items():
-        col = ws[letter + "1"].column
-        for i in range(n):
-            ws.cell(FIRST_DATA_ROW + i, col, _finite_or_none(values[i]))
+    blocks.add(ws, FIRST_DATA_ROW, [(column_index_from_string(letter), values) for letter, values in cols.items()])
     ws.freeze_panes = "B10"
 
 
@@ -536,7 +536,7 @@ def _checks_sheet(ws, spec, report) -> None:
             xlsx_put(ws.cell(row, col), _fmt(float(v)) if isinstance(v, (float, np.floating)) else v)
 
 
-def _lift_sheet(ws, table: LiftTable, geometry) -> None:
+def _lift_sheet(ws, table: LiftTable, geometry, blocks: NumberBlocks) -> None:
     from openpyxl.styles import Font
 
     bold = Font(bold=True)
@@ -544,18 +544,15 @@ def _lift_sheet(ws, table: LiftTable, geometry) -> None:
              table.radius_label)
     for col, text in enumerate(heads, 1):
         ws.cell(1, col, text).font = bold
-    for i, (a, s, r) in enumerate(zip(table.angle, table.lift, table.radius, strict=True)):
-        ws.cell(2 + i, 1, float(a)), ws.cell(2 + i, 2, float(s)), ws.cell(2 + i, 3, float(r))
+    blocks.add(ws, 2, [(1, table.angle.tolist()), (2, table.lift.tolist()), (3, table.radius.tolist())])
     ws.freeze_panes = "A2"
 
 
-def _dynamics_sheet(ws, head: list[str], cols: list[np.ndarray]) -> None:
+def _dynamics_sheet(ws, head: list[str], cols: list[np.ndarray], *, blocks: NumberBlocks) -> None:
     from openpyxl.styles import Font
 
     bold = Font(bold=True)
     for col, text in enumerate(head, 1):
         ws.cell(1, col, text).font = bold
-    data = np.column_stack(cols)
-    for values in data.tolist():  # openpyxl writes cell by cell; NaN → empty cell
-        ws.append([v if math.isfinite(v) else None for v in values])
+    blocks.add(ws, 2, [(k, np.asarray(c, dtype=float).tolist()) for k, c in enumerate(cols, 1)])  # NaN → empty
     ws.freeze_panes = "A2"
