@@ -176,6 +176,26 @@ def _overlap(a: np.ndarray, b: np.ndarray, eps: float = 0.05) -> bool:
     return True
 
 
+def _any_overlap(a: np.ndarray, others: np.ndarray, eps: float = 0.05) -> bool:
+    """Whether the box ``a`` (corners (4, 2)) overlaps any of the boxes ``others`` (m, 4, 2): the test of
+    :func:`_overlap`, all boxes at once (a new dimension's text against every text on the sheet)."""
+    if not len(others):
+        return False
+    ea = np.array([a[1] - a[0], a[3] - a[0]])  # a's two edge normals, each tested against every box
+    na = np.stack([-ea[:, 1], ea[:, 0]], axis=-1)
+    na = na / np.hypot(na[:, 0], na[:, 1])[:, None]  # (2, 2)
+    pa = a @ na.T  # (4, 2)
+    pb = others @ na.T  # (m, 4, 2)
+    sep = (pa.max(axis=0) - eps <= pb.min(axis=1)) | (pb.max(axis=1) - eps <= pa.min(axis=0))  # (m, 2)
+    eb = np.stack([others[:, 1] - others[:, 0], others[:, 3] - others[:, 0]], axis=1)  # (m, 2, 2)
+    nb = np.stack([-eb[..., 1], eb[..., 0]], axis=-1)
+    nb = nb / np.hypot(nb[..., 0], nb[..., 1])[..., None]  # (m, 2 normals, 2)
+    qa = np.einsum("pc,mkc->mkp", a, nb)  # (m, 2, 4): a's corners on each box's normals
+    qb = np.einsum("mpc,mkc->mkp", others, nb)
+    sep_b = (qa.max(axis=2) - eps <= qb.min(axis=2)) | (qb.max(axis=2) - eps <= qa.min(axis=2))  # (m, 2)
+    return bool((~(sep.any(axis=1) | sep_b.any(axis=1))).any())
+
+
 def _quad(b) -> np.ndarray:
     return np.array([(b[0], b[1]), (b[2], b[1]), (b[2], b[3]), (b[0], b[3])], dtype=float)
 
@@ -294,9 +314,16 @@ class Occupancy:
                 return False
             if len(self.segments) and _crosses(q, self.segments).any():
                 return False
-            if any(_overlap(q, other) for other in self.quads):
+            if _any_overlap(q, self._stacked()):
                 return False
-        return not (len(segments) and self.quads and _any_crosses(np.array(self.quads), segments))
+        return not (len(segments) and self.quads and _any_crosses(self._stacked(), segments))
+
+    def _stacked(self) -> np.ndarray:
+        """:attr:`quads` as one (m, 4, 2) array (made again when a box was added)."""
+        st = getattr(self, "_stack", None)
+        if st is None or len(st) != len(self.quads):
+            st = self._stack = np.array(self.quads, dtype=float).reshape(-1, 4, 2)
+        return st
 
     def add(self, quads: list[np.ndarray], segments: np.ndarray) -> None:
         self.quads += quads
