@@ -85,7 +85,7 @@ from ..design.tables import LiftTable, intervals, lift_table, sample_params
 from ..errors import InputError
 from ..results import JUMP_CODES, IssueCode, Severity, Verdict, pair_names
 from ..textsafe import xlsx_no_formulas, xlsx_put, xlsx_text
-from .xlsx_blocks import NumberBlocks
+from .xlsx_blocks import NumberBlocks, workbook_bytes
 
 __all__ = ["CAMDAS_COLUMNS", "FIXED_DATE", "LiftTable", "camdas_workbook", "camdas_columns", "conclusions",
            "dynamics_columns", "dynamics_summary_rows", "strength_summary_rows",
@@ -396,9 +396,8 @@ def camdas_workbook(spec, geometry, report, *, step_deg: float = 1.0, lift_step_
 
 def _save(wb, blocks: NumberBlocks | None = None) -> bytes:
     xlsx_no_formulas(wb)  # camfab writes no formula: text openpyxl took for one stays text
-    buf = io.BytesIO()
-    wb.save(buf)
-    return fixed_zip(buf.getvalue(), blocks.patches() if blocks is not None else None)
+    raw = workbook_bytes(wb)  # wb.save, in memory and uncompressed (fixed_zip compresses once)
+    return fixed_zip(raw, blocks.patches() if blocks is not None else None)
 
 
 _MODIFIED = re.compile(rb"(<dcterms:modified[^>]*>)[^<]*(</dcterms:modified>)")
@@ -544,7 +543,7 @@ def _lift_sheet(ws, table: LiftTable, geometry, blocks: NumberBlocks) -> None:
              table.radius_label)
     for col, text in enumerate(heads, 1):
         ws.cell(1, col, text).font = bold
-    blocks.add(ws, 2, [(1, table.angle.tolist()), (2, table.lift.tolist()), (3, table.radius.tolist())])
+    blocks.add(ws, 2, [(1, table.angle), (2, table.lift), (3, table.radius)])
     ws.freeze_panes = "A2"
 
 
@@ -554,5 +553,5 @@ def _dynamics_sheet(ws, head: list[str], cols: list[np.ndarray], *, blocks: Numb
     bold = Font(bold=True)
     for col, text in enumerate(head, 1):
         ws.cell(1, col, text).font = bold
-    blocks.add(ws, 2, [(k, np.asarray(c, dtype=float).tolist()) for k, c in enumerate(cols, 1)])  # NaN → empty
+    blocks.add(ws, 2, [(k, np.asarray(c, dtype=float)) for k, c in enumerate(cols, 1)])  # NaN → empty
     ws.freeze_panes = "A2"

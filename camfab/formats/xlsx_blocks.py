@@ -12,12 +12,15 @@ bytes are those openpyxl writes when the same numbers go through ``ws.cell``.  N
 """
 from __future__ import annotations
 
+import io
 import math
 import re
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from typing import Any
 
-__all__ = ["NumberBlocks"]
+import numpy as np
+
+__all__ = ["NumberBlocks", "workbook_bytes"]
 
 _DIMENSION = re.compile(rb'<dimension ref="([A-Z]+[0-9]+(?::[A-Z]+[0-9]+)?)" />')
 
@@ -26,7 +29,7 @@ class NumberBlocks:
     """Numeric blocks to add to worksheets when the workbook is saved (:meth:`patches`)."""
 
     def __init__(self) -> None:
-        self._blocks: list[tuple[Any, int, list[tuple[int, list[float | None]]]]] = []
+        self._blocks: list[tuple[Any, int, list[tuple[int, list[str | None]]]]] = []
 
     def add(self, ws: Any, first_row: int, columns: Iterable[tuple[int, Any]]) -> None:
         """Rows ``first_row`` … of ``ws``: ``columns`` is (1-based column, values) pairs, all the same length;
@@ -34,49 +37,53 @@ class NumberBlocks:
         may be written to ``ws`` through openpyxl; one block per sheet."""
         if any(ws is w for w, _, _ in self._blocks):
             raise ValueError(f"a second number block for sheet {ws.title!r}")
-        cols = sorted(((int(c), [_number(v) for v in (vals.tolist() if hasattr(vals, "tolist") else vals)])
-                       for c, vals in columns), key=lambda cv: cv[0])
+        cols = sorted(((int(c), _texts(vals)) for c, vals in columns), key=lambda cv: cv[0])
         if len({len(v) for _, v in cols}) > 1:
             raise ValueError("number block columns of different lengths")
-        if ws.max_row >= first_row and any(c.row >= first_row for c in ws._cells.values()):
+        if any(c.row >= first_row for c in ws._cells.values()):
             raise ValueError(f"sheet {ws.title!r} has openpyxl cells inside its number block")
         self._blocks.append((ws, first_row, cols))
 
-    def patches(self) -> dict[str, Any]:
-        """Zip entry name -> function rewriting that sheet's XML; call after ``wb.save`` (which names the
+    def patches(self) -> dict[str, Callable[[bytes], bytes]]:
+        """Zip entry name -> function rewriting that sheet's XML; call after the save (which names the
         sheet parts)."""
         return {ws.path.lstrip("/"): _patch(ws, first, cols) for ws, first, cols in self._blocks}
 
 
-def _number(v: Any) -> float | None:
-    if v is None:
-        return None
-    if isinstance(v, (bool, str)):
-        raise TypeError(f"not a number for a number block: {v!r}")
-    f = float(v)
-    return f if math.isfinite(f) else None
+def _texts(vals: Any) -> list[str | None]:
+    """Each value as openpyxl writes a number (``"%.16g"``), ``None`` for an empty cell."""
+    if isinstance(vals, np.ndarray) and vals.dtype.kind in "fiu":
+        a = vals.astype(float, copy=False)
+        return [f"{v:.16g}" if ok else None for v, ok in zip(a.tolist(), np.isfinite(a).tolist(), strict=True)]
+    out: list[str | None] = []
+    for v in vals:
+        if v is None:
+            out.append(None)
+            continue
+        if isinstance(v, (bool, str)):
+            raise TypeError(f"not a number for a number block: {v!r}")
+        f = float(v)
+        out.append(f"{f:.16g}" if math.isfinite(f) else None)
+    return out
 
 
-def _patch(ws: Any, first: int, cols: list[tuple[int, list[float | None]]]):
+def _patch(ws: Any, first: int, cols: list[tuple[int, list[str | None]]]) -> Callable[[bytes], bytes]:
     from openpyxl.utils.cell import get_column_letter, range_boundaries
 
     def run(xml: bytes) -> bytes:
         if not cols or not cols[0][1]:
             return xml
-        letters = [(get_column_letter(c), vals) for c, vals in cols]
-        rows = []
-        for i in range(len(cols[0][1])):
-            r = first + i
-            cells = "".join(f'<c r="{col}{r}" t="n"><v>{v:.16g}</v></c>'
-                            for col, vals in letters if (v := vals[i]) is not None)
-            rows.append(f'<row r="{r}">{cells}</row>')
-        block = "".join(rows).encode()
+        n = len(cols[0][1])
+        cells = [[f'<c r="{letter}{first + i}" t="n"><v>{t}</v></c>' if t is not None else ""
+                  for i, t in enumerate(texts)] for letter, texts in ((get_column_letter(c), t) for c, t in cols)]
+        block = "".join(f'<row r="{first + i}">{"".join(row)}</row>'
+                        for i, row in zip(range(n), zip(*cells, strict=True), strict=True)).encode()
         if b"</sheetData>" in xml:
             xml = xml.replace(b"</sheetData>", block + b"</sheetData>", 1)
         else:
             xml = xml.replace(b"<sheetData />", b"<sheetData>" + block + b"</sheetData>", 1)
         # the dimension openpyxl computes over every cell, the block's included
-        min_col, min_row, max_col, max_row = cols[0][0], first, cols[-1][0], first + len(cols[0][1]) - 1
+        min_col, min_row, max_col, max_row = cols[0][0], first, cols[-1][0], first + n - 1
         if ws._cells:
             c0, r0, c1, r1 = range_boundaries(ws.calculate_dimension())
             min_col, min_row, max_col, max_row = min(min_col, c0), min(min_row, r0), max(max_col, c1), max(max_row, r1)
@@ -84,3 +91,33 @@ def _patch(ws: Any, first: int, cols: list[tuple[int, list[float | None]]]):
         return _DIMENSION.sub(f'<dimension ref="{ref}" />'.encode(), xml, count=1)
 
     return run
+
+
+def workbook_bytes(wb: Any) -> bytes:
+    """``wb.save`` into memory, its entries stored, not compressed (:func:`~camfab.formats.camdas_workbook.fixed_zip`
+    re-packs and compresses them once) and each sheet written in memory (openpyxl's save writes each to a
+    temporary file, reads it back and deletes it).  The entries are those of ``wb.save``, in its order."""
+    import zipfile
+
+    from openpyxl.drawing.spreadsheet_drawing import SpreadsheetDrawing
+    from openpyxl.worksheet._writer import WorksheetWriter
+    from openpyxl.writer.excel import ExcelWriter
+
+    class _InMemory(ExcelWriter):
+        def write_worksheet(self, ws):  # ExcelWriter.write_worksheet, the sheet's XML kept in memory
+            if self.workbook.write_only:
+                return super().write_worksheet(ws)
+            ws._drawing = SpreadsheetDrawing()
+            ws._drawing.charts = ws._charts
+            ws._drawing.images = ws._images
+            out = io.BytesIO()
+            writer = WorksheetWriter(ws, out)
+            writer.write()
+            ws._rels = writer._rels
+            self._archive.writestr(ws.path[1:], out.getvalue())
+            self.manifest.append(ws)
+
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", zipfile.ZIP_STORED, allowZip64=True) as archive:
+        _InMemory(wb, archive).write_data()
+    return buf.getvalue()
