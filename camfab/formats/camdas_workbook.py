@@ -379,7 +379,7 @@ def camdas_workbook(spec, geometry, report, *, step_deg: float = 1.0, lift_step_
 
         ws = wb.create_sheet("Cylinder")
         write_cylinder_sheet(ws, spec, geometry, title=type_text(spec), verdict=verdict_sentence(report),
-                             step_deg=step_deg)
+                             step_deg=step_deg, blocks=blocks)
         xlsx_put(ws["A2"], spec.name)
     _checks_sheet(wb.create_sheet("Checks"), spec, report)
     if not cylindrical:

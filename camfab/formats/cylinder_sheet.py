@@ -66,8 +66,11 @@ def cylinder_columns(spec: Any, geometry: Any, *, step_deg: float = 1.0) -> tupl
     return head, cols
 
 
-def write_cylinder_sheet(ws: Any, spec: Any, geometry: Any, *, title: str, verdict: str, step_deg: float) -> None:
-    """Fill the openpyxl sheet ``ws``, A2 (the design name) left to the caller (:mod:`camfab.textsafe`)."""
+def write_cylinder_sheet(ws: Any, spec: Any, geometry: Any, *, title: str, verdict: str, step_deg: float,
+                         blocks: Any = None) -> None:
+    """Fill the openpyxl sheet ``ws``, A2 (the design name) left to the caller (:mod:`camfab.textsafe`); the
+    numbers go into ``blocks`` (a :class:`~camfab.formats.xlsx_blocks.NumberBlocks`, written at the save) when
+    one is given, else cell by cell."""
     from openpyxl.styles import Font
 
     ws["A1"] = title
@@ -80,7 +83,10 @@ def write_cylinder_sheet(ws: Any, spec: Any, geometry: Any, *, title: str, verdi
     bold = Font(bold=True)
     for j, text in enumerate(head, 1):
         ws.cell(CYLINDER_FIRST_ROW - 1, j, text).font = bold
-    for i, values in enumerate(np.column_stack(cols).tolist()):
-        for j, v in enumerate(values, 1):
-            ws.cell(CYLINDER_FIRST_ROW + i, j, v if math.isfinite(v) else None)
+    if blocks is not None:
+        blocks.add(ws, CYLINDER_FIRST_ROW, [(j, np.asarray(c, dtype=float)) for j, c in enumerate(cols, 1)])
+    else:
+        for i, values in enumerate(np.column_stack(cols).tolist()):
+            for j, v in enumerate(values, 1):
+                ws.cell(CYLINDER_FIRST_ROW + i, j, v if math.isfinite(v) else None)
     ws.freeze_panes = f"B{CYLINDER_FIRST_ROW}"
