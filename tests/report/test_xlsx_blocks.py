@@ -1,5 +1,5 @@
-"""Number blocks written straight into the sheet XML (camfab.formats.xlsx_blocks): the same bytes openpyxl
-writes cell by cell, and openpyxl reads the numbers back."""
+"""Number blocks written straight into the sheet XML and the in-memory save (camfab.formats.xlsx_blocks): the
+same bytes openpyxl's own save writes cell by cell, and openpyxl reads the numbers back."""
 from __future__ import annotations
 
 import io
@@ -10,20 +10,21 @@ import numpy as np
 import pytest
 
 from camfab.formats.camdas_workbook import fixed_zip
-from camfab.formats.xlsx_blocks import NumberBlocks
+from camfab.formats.xlsx_blocks import NumberBlocks, workbook_bytes
 
 openpyxl = pytest.importorskip("openpyxl")
 
 VALUES = [0.0, -0.0, 1 / 3, -2.5e-13, 1e16, 123456.789, math.nan, None, math.inf, 7.0]
 
 
-def _book(through_blocks: bool) -> bytes:
+def _book(through_blocks: bool, in_memory: bool = False) -> bytes:
     wb = openpyxl.Workbook()
     ws = wb.active
     ws.title = "Data"
     ws["A1"] = "head"
     ws["B2"] = 5
-    cols = [(1, np.array(VALUES, dtype=float)), (3, VALUES[::-1]), (6, [None] * len(VALUES))]
+    n = len(VALUES)  # and a last row empty in every column
+    cols = [(1, np.array(VALUES + [None], dtype=float)), (3, VALUES[::-1] + [math.nan]), (6, [None] * (n + 1))]
     blocks = NumberBlocks()
     if through_blocks:
         blocks.add(ws, 3, cols)
@@ -32,6 +33,8 @@ def _book(through_blocks: bool) -> bytes:
             for i, v in enumerate(vals):
                 ok = v is not None and math.isfinite(v)
                 ws.cell(3 + i, c, float(v) if ok else None)
+    if in_memory:  # what camdas_workbook does: stored entries, no temporary files
+        return fixed_zip(workbook_bytes(wb), blocks.patches())
     buf = io.BytesIO()
     wb.save(buf)
     return fixed_zip(buf.getvalue(), blocks.patches())
@@ -39,14 +42,15 @@ def _book(through_blocks: bool) -> bytes:
 
 def test_blocks_equal_openpyxl_bytes_and_read_back():
     fast, slow = _book(True), _book(False)
-    assert fast == slow
+    assert fast == slow == _book(True, in_memory=True)
     with zipfile.ZipFile(io.BytesIO(fast)) as z:
-        assert b'<dimension ref="A1:F12" />' in z.read("xl/worksheets/sheet1.xml")
+        xml = z.read("xl/worksheets/sheet1.xml")
+    assert b'<dimension ref="A1:F13" />' in xml and b'<row r="13"></row>' in xml
     ws = openpyxl.load_workbook(io.BytesIO(fast))["Data"]
     got = [ws.cell(3 + i, 1).value for i in range(len(VALUES))]
     want = [None if v is None or not math.isfinite(v) else v for v in VALUES]
     assert got[:6] == pytest.approx(want[:6], rel=1e-15) and got[6:9] == [None] * 3 and got[9] == 7
-    assert ws["A1"].value == "head" and ws["B2"].value == 5 and ws.max_row == 12
+    assert ws["A1"].value == "head" and ws["B2"].value == 5
 
 
 def test_blocks_refuse_text_and_overlap():
