@@ -54,23 +54,25 @@ def _tick_labels(axis) -> list[str]:
     return [s for s in axis.get_major_formatter().format_ticks(list(locs)) if s]
 
 
-def _tick_room(renderer, axis, vertical: bool) -> float:
-    """Points taken beside the axes by an axis's tick marks and labels (0 when its labels are hidden)."""
+def _tick_room(renderer, axis, vertical: bool, labels: list[str] | None = None) -> float:
+    """Points taken beside the axes by an axis's tick marks and labels (0 when its labels are hidden);
+    ``labels``: its :func:`_tick_labels` when the caller has them."""
     tick = axis.get_major_ticks(numticks=1)[0]
     if not tick.label1.get_visible():
         return 0.0
-    sizes = [_size(renderer, s, tick.label1.get_fontproperties()) for s in _tick_labels(axis)]
+    labels = _tick_labels(axis) if labels is None else labels
+    sizes = [_size(renderer, s, tick.label1.get_fontproperties()) for s in labels]
     text = max((w if vertical else h for w, h in sizes), default=0.0)
     return text + tick.get_tick_padding() + tick.get_pad()
 
 
-def _overhang(renderer, axis) -> float:
-    """Points an x axis's end tick labels reach past the axes' sides (half the widest label)."""
+def _overhang(renderer, axis, labels: list[str]) -> float:
+    """Points an x axis's end tick labels (``labels``) reach past the axes' sides (half the widest label)."""
     tick = axis.get_major_ticks(numticks=1)[0]
     if not tick.label1.get_visible():
         return 0.0
     prop = tick.label1.get_fontproperties()
-    return max((_size(renderer, s, prop)[0] for s in _tick_labels(axis)), default=0.0) / 2
+    return max((_size(renderer, s, prop)[0] for s in labels), default=0.0) / 2
 
 
 def _label_room(renderer, label) -> float:
@@ -80,8 +82,8 @@ def _label_room(renderer, label) -> float:
 
 
 def _offset_room(renderer, axis) -> float:
-    """Points above the axes taken by a y axis's offset text ("1e6"; the titles go above it)."""
-    _tick_labels(axis)  # the formatter's offset follows its last ticks
+    """Points above the axes taken by a y axis's offset text ("1e6"; the titles go above it), after
+    :func:`_tick_labels` of the axis (the formatter's offset follows its last ticks)."""
     text = axis.get_major_formatter().get_offset()
     return _size(renderer, text, axis.get_offset_text().get_fontproperties())[1] + 2.0 if text else 0.0
 
@@ -115,14 +117,15 @@ def fixed_layout(fig) -> None:
     w_in, h_in = fig.get_size_inches()
     left = right = 0.0
     tops, bottoms = [], []
-    for ax in axes:
-        left = max(left, _tick_room(renderer, ax.yaxis, True) + _label_room(renderer, ax.yaxis.label))
+    for ax in axes:  # each axis's ticks located and formatted once (its formatter's offset set by that call)
+        ylabels, xlabels = _tick_labels(ax.yaxis), _tick_labels(ax.xaxis)
+        left = max(left, _tick_room(renderer, ax.yaxis, True, ylabels) + _label_room(renderer, ax.yaxis.label))
         legend = ax.get_legend()
         if legend is not None and legend.get_visible():
             right = max(right, legend.get_window_extent(renderer).width * 72.0 / fig.dpi + 0.01 * 72.0 * w_in)
-        right = max(right, _overhang(renderer, ax.xaxis))
+        right = max(right, _overhang(renderer, ax.xaxis, xlabels))
         tops.append(_title_room(renderer, ax) + _offset_room(renderer, ax.yaxis))
-        bottoms.append(_tick_room(renderer, ax.xaxis, False) + _label_room(renderer, ax.xaxis.label))
+        bottoms.append(_tick_room(renderer, ax.xaxis, False, xlabels) + _label_room(renderer, ax.xaxis.label))
     suptitle = fig.get_suptitle()
     artist = getattr(fig, "_suptitle", None)  # matplotlib keeps the suptitle's Text there (no public getter)
     sup = _size(renderer, suptitle, artist.get_fontproperties())[1] + 4.0 if suptitle and artist else 0.0
