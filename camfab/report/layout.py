@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["fixed_layout", "text_size"]
+__all__ = ["fixed_layout", "legend_extent", "text_size"]
 
 #: breathing room at each figure edge and between stacked axes (points)
 _EDGE_PT = 5.0
@@ -122,7 +122,7 @@ def fixed_layout(fig) -> None:
         left = max(left, _tick_room(renderer, ax.yaxis, True, ylabels) + _label_room(renderer, ax.yaxis.label))
         legend = ax.get_legend()
         if legend is not None and legend.get_visible():
-            right = max(right, legend.get_window_extent(renderer).width * 72.0 / fig.dpi + 0.01 * 72.0 * w_in)
+            right = max(right, legend_extent(legend, renderer).width * 72.0 / fig.dpi + 0.01 * 72.0 * w_in)
         right = max(right, _overhang(renderer, ax.xaxis, xlabels))
         tops.append(_title_room(renderer, ax) + _offset_room(renderer, ax.yaxis))
         bottoms.append(_tick_room(renderer, ax.xaxis, False, xlabels) + _label_room(renderer, ax.xaxis.label))
@@ -142,6 +142,22 @@ def fixed_layout(fig) -> None:
     for ax in axes:
         ax.set_position(ax.get_subplotspec().get_position(fig))
         _fix_titles(ax)
+
+
+def legend_extent(legend, renderer):
+    """``legend.get_window_extent(renderer)``, the legend's packed box (its texts and handles, which do not change
+    once it is made, nor with where its axes are) measured once per legend and renderer resolution: the layout
+    and the SVG writer each need the extent, the SVG writer after the axes moved (the offset is computed again).
+    A legend spread over its anchor's width (``mode="expand"``) is measured every time."""
+    packer = legend._legend_box  # matplotlib's packer of the legend's entries (Legend.get_window_extent uses it)
+    if getattr(legend, "_mode", None) is not None:
+        return legend.get_window_extent(renderer)
+    kept = getattr(legend, "_camfab_packed", None)
+    if kept is None or kept[0] != renderer.dpi:
+        kept = (renderer.dpi, packer.get_bbox(renderer))
+        legend._camfab_packed = kept
+    bbox = kept[1]
+    return bbox.translated(*packer.get_offset(bbox, renderer))
 
 
 def _no_engine(fig) -> None:

@@ -503,7 +503,9 @@ class _Writer:
         from matplotlib.lines import Line2D
         from matplotlib.patches import Patch
 
-        box = leg.get_window_extent(self.renderer)
+        from .layout import legend_extent
+
+        box = legend_extent(leg, self.renderer)  # the packed size measured by the layout, the offset anew
         k = self.dpi / self.renderer.dpi
         x0, y0, x1, y1 = box.x0 * k, box.y0 * k, box.x1 * k, box.y1 * k
         frame = leg.get_frame()

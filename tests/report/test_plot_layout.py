@@ -58,3 +58,20 @@ def test_every_text_inside_the_figure(example):
             for t in (c for c in ax.get_children() if isinstance(c, Text) and c.get_text() in names):
                 hit = [o for o in boxes if o is not own and t.get_window_extent(renderer).overlaps(o)]
                 assert not hit, f"{example} {name}: title {t.get_text()!r} overlaps other axes"
+
+
+def test_legend_extent_is_matplotlibs_after_the_axes_move():
+    """The legend's packed box measured once (layout.legend_extent) gives matplotlib's own window extent, before
+    the layout and after it moved the axes (the SVG writer's call)."""
+    from camfab.report.layout import fixed_layout, legend_extent
+    from camfab.report.plots import new_figure
+
+    fig = new_figure(6.0, 4.0)  # the report's figures: an Agg canvas, constrained layout until fixed_layout
+    ax = fig.subplots()
+    ax.plot([0, 1], [0, 2], label="a line")
+    ax.axhline(1.0, color="r", label="a limit, longer")
+    leg = ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    r = fig.canvas.get_renderer()
+    assert tuple(legend_extent(leg, r).bounds) == pytest.approx(tuple(leg.get_window_extent(r).bounds), abs=1e-9)
+    fixed_layout(fig)  # the axes move; the legend with them
+    assert tuple(legend_extent(leg, r).bounds) == pytest.approx(tuple(leg.get_window_extent(r).bounds), abs=1e-9)
