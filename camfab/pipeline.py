@@ -161,6 +161,7 @@ class Cam:
     def __init__(self, spec: DesignSpec):
         self.spec = spec
         self._shapes: dict[float, CamShapes] = {}
+        self._tool_paths: dict[Any, Any] = {}  # the tool-centre paths (camfab.gcode.cam.contour_paths' cache)
         self._report: CheckReport | None = None
         self._geometry: CamGeometry | None = None
 
@@ -356,9 +357,12 @@ def _tool_paths(cam: Cam, req: Request) -> bool:
 
 
 def _dxf(cam: Cam, req: Request) -> list[Artifact]:
-    tol = cam.tolerance(req.tol)
+    from .gcode.cam import contour_paths  # the G-code's tool paths (docs/decisions.md, "The DXF tool path is …")
+
+    tol, draw = cam.tolerance(req.tol), _tool_paths(cam, req) and cam.spec.cam.kind != "groove"
+    paths = draw and contour_paths(cam.spec, cam.geometry, req.machining, tol=tol, post=req.post, cache=cam._tool_paths)
     return build_artifacts(cam.spec, cam.geometry, ["dxf"], tol=tol, dxf_flavour=req.dxf_flavour,
-                           tool_paths=_tool_paths(cam, req), shapes=cam.shapes(tol))
+                           tool_paths=_tool_paths(cam, req), shapes=cam.shapes(tol), tool_centre=paths or None)
 
 
 def _stl(cam: Cam, req: Request) -> list[Artifact]:
@@ -428,7 +432,7 @@ def _assembly(cam: Cam, req: Request) -> list[Artifact]:
 
 def _gcode(cam: Cam, req: Request) -> list[Artifact]:
     from .gcode import dumps
-    from .gcode.cam import cam_program
+    from .gcode.cam import cam_program, contour_paths
     from .gcode.groove import groove_gcode
 
     tol = cam.tolerance(req.tol)
@@ -443,10 +447,10 @@ def _gcode(cam: Cam, req: Request) -> list[Artifact]:
         return [Artifact(f"{safe_stem(cam.name)}.nc", data, "gcode", moves, dev, req.post)]
     if cam.spec.cam.kind == "groove":  # one program mills the slot of both flanks
         return [Artifact(f"{safe_stem(cam.name)}.nc", *groove_gcode(cam.geometry, job, tol, m, req.post), req.post)]
-    out = []
+    out, paths = [], contour_paths(cam.spec, cam.geometry, req.machining, tol=tol, post=req.post, cache=cam._tool_paths)
     for i, contact in enumerate(cam.geometry.profiles):
         cp = cam_program(contact, job, tol=tol, compensation=m.compensation, arcs_allowed=not m.lines_only,
-                         post=req.post)
+                         post=req.post, path=paths[i] if paths else None)
         out.append(Artifact(f"{safe_stem(cam.name)}{_suffix(i, n)}.nc", dumps(cp.program, req.post).encode(), "gcode",
                             cp.entities, cp.deviation_mm, req.post))
     return out

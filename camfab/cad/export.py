@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -22,7 +22,7 @@ from ..discretize.tolerance import within
 from ..errors import GeometryError
 from ..geom2d import ArcChain
 from ..io import atomic_write, inside, safe_stem
-from ..offset.cutter import pitch_curve, profile_curve, tool_centre_path
+from ..offset.cutter import ToolCentrePath, pitch_curve, profile_curve, tool_centre_path
 from ..tolerances import arc_radius_limit
 from . import dxf as dxf_mod
 from . import step, stl
@@ -102,7 +102,8 @@ def _suffix(i: int, n: int) -> str:
 
 def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_flavour: str = "lwpolyline",
                     tool_paths: bool = False, progress: Callable[[str], None] | None = None,
-                    shapes: CamShapes | None = None) -> list[Artifact]:
+                    shapes: CamShapes | None = None, tool_centre: Sequence[ToolCentrePath] | None = None
+                    ) -> list[Artifact]:
     """Build the requested artifacts in memory.
 
     Parameters
@@ -116,6 +117,10 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
         Add the tool-centre paths (``[manufacturing] tool_diameter_mm``) on the DXF's TOOL_PATH layer.
     shapes : CamShapes, optional
         The arc fits within ``tol`` when the caller has them already (with the pitch curves for a DXF).
+    tool_centre : sequence of ToolCentrePath, optional
+        The tool-centre paths to draw with ``tool_paths`` (one per profile, each fitted within ``tol`` of its
+        exact curve) when the caller has them: the pipeline gives the G-code program's own (docs/decisions.md, "The
+        DXF tool path is the program's"); else each is fitted here within ``tol``.
     """
     say = progress or (lambda msg: None)
     formats = [f for f in FORMATS if f in set(formats)]
@@ -139,7 +144,7 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
     n = len(shapes.profiles)
     if "dxf" in formats:
         say("DXF")
-        out.append(_dxf(spec, geometry, shapes, plate, tol, dxf_flavour, tool_paths))
+        out.append(_dxf(spec, geometry, shapes, plate, tol, dxf_flavour, tool_paths, tool_centre))
     if "stl" in formats:
         out += _stl_artifacts(spec, shapes.curves, plate, tol, say)
     if "step" in formats:
@@ -197,11 +202,13 @@ def _size(loop) -> float:
 
 
 def _dxf(spec, geometry, shapes: CamShapes, plate: PlateSpec, tol: float, flavour: str,
-         tool_paths: bool) -> Artifact:
+         tool_paths: bool, tool_centre: Sequence[ToolCentrePath] | None = None) -> Artifact:
     f = spec.follower
     tools: tuple[ArcChain, ...] = ()
     tool_d = spec.manufacturing.tool_diameter_mm
-    if tool_paths and tool_d:
+    if tool_paths and tool_centre is not None:
+        tools = tuple(p.arcs for p in tool_centre)
+    elif tool_paths and tool_d:
         tools = tuple(tool_centre_path(c, tool_d / 2, tol=tol).arcs for c in geometry.profiles)
     c = geometry.profiles[0]  # a roller's prime circle; a curved face's centre of curvature starts on R_b + R
     rr = c.roller_radius if c.kind is ContactKind.ROLLER else 0.0

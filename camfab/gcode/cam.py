@@ -9,21 +9,25 @@ reaches the toolpath builder as an :class:`~camfab.geom2d.ArcChain`.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
 from ..discretize import ParametricCurve, arcs, arcs_within_radius, polyline
 from ..discretize.fit import REFIT_SHARE
+from ..errors import ApiError
 from ..geom2d import ArcChain
-from ..offset.cutter import offset_curve, profile_curve, tool_centre_path
+from ..offset.cutter import ToolCentrePath, offset_curve, profile_curve, tool_centre_path
 from ..tolerances import arc_radius_limit
 from .distance import CurveDistance
-from .model import Job, Program
+from .model import Job, Program, machining_of
 from .toolpath import contour_toolpath
 from .verify import VerifyReport, verify_program
 
-__all__ = ["FIT_SHARE", "CamProgram", "cam_program", "contour_tolerance", "signed_distance", "verify_cam_program"]
+__all__ = ["FIT_SHARE", "CamProgram", "cam_program", "contour_tolerance", "contour_fit_tolerance", "signed_distance",
+           "verify_cam_program"]
 
 
 @dataclass(frozen=True)
@@ -52,14 +56,49 @@ def contour_tolerance(tol: float, post=None, units: str = "mm") -> float:
     return max(min(tol * FIT_SHARE, room), 1e-6)
 
 
+def contour_fit_tolerance(tol: float, post=None, units: str = "mm") -> float:
+    """The tolerance (mm) the finishing contour's tool-centre path is arc-fitted within: the
+    :func:`contour_tolerance` less the :data:`~camfab.discretize.fit.REFIT_SHARE` the chords of arcs above the
+    post's largest radius may need.  The DXF's TOOL_PATH layer draws the same fit (docs/decisions.md, "The DXF
+    tool path is the program's")."""
+    return max(contour_tolerance(tol, post, units) * (1.0 - REFIT_SHARE), 1e-6)
+
+
+def contour_paths(spec, geometry, overrides: Mapping[str, Any] | None = None, *, tol: float, post=None,
+                  cache: dict | None = None) -> tuple[ToolCentrePath, ...] | None:
+    """The tool-centre path of every profile of ``geometry`` that :func:`cam_program` makes the finishing contour
+    of: the design's tool (``overrides["tool_diameter_mm"]`` when given), fitted within
+    :func:`contour_fit_tolerance` of ``tol`` for ``post`` and the ``[machining]`` units; None without a tool.
+
+    ``cache`` (a dict the caller keeps, e.g. :class:`camfab.pipeline.Cam`'s) holds each path once per (profile,
+    radius, tolerance): the DXF's TOOL_PATH layer and the program share one offset, one shapely guard and one fit
+    (docs/decisions.md, "The DXF tool path is the program's").
+    """
+    over = {k: v for k, v in (overrides or {}).items() if v is not None}
+    tool = over.get("tool_diameter_mm", spec.manufacturing.tool_diameter_mm)
+    if not tool:
+        return None
+    r = 0.5 * tool
+    fit_tol = contour_fit_tolerance(tol, post, machining_of(spec, over).units)
+    cache = {} if cache is None else cache
+    for i, contact in enumerate(geometry.profiles):
+        if (i, r, fit_tol) not in cache:
+            cache[i, r, fit_tol] = tool_centre_path(contact, r, tol=fit_tol)
+    return tuple(cache[i, r, fit_tol] for i in range(len(geometry.profiles)))
+
+
 def cam_program(contact, job: Job, *, tol: float, compensation: str | None = None,
-                arcs_allowed: bool = True, post=None) -> CamProgram:
+                arcs_allowed: bool = True, post=None, path: ToolCentrePath | None = None) -> CamProgram:
     """The contour-milling program of one profile (periphery, outside), for ``post`` (name or
     :class:`~camfab.gcode.posts.base.Post`; default linuxcnc), which sets the rounding budget and the
     largest arc radius written (larger arcs become chords within the tolerance).
 
     ``arcs_allowed=False`` writes the finishing contour as G1 lines only (a polyline within the
     same tolerance), for controllers or shops that do not want G2/G3.
+
+    ``path`` is the tool-centre path of ``contact`` for ``job.tool_radius_mm`` when the caller has it already
+    (:func:`~camfab.offset.cutter.tool_centre_path` at :func:`contour_fit_tolerance`, its shapely guard run):
+    the finishing contour is then made from its arcs, and nothing is offset, guarded or fitted twice.
     """
     from .post import get_post
 
@@ -67,12 +106,15 @@ def cam_program(contact, job: Job, *, tol: float, compensation: str | None = Non
     r = job.tool_radius_mm
     share = contour_tolerance(tol, post, job.units)
     # the arcs get (1 - REFIT_SHARE) of the share, the chords of arcs above max_r the room the fit leaves
-    tol_fit = max(share * (1.0 - REFIT_SHARE), 1e-6)
+    tol_fit = contour_fit_tolerance(tol, post, job.units)
     # the finishing contour's arcs are the tool path's own fit at tol_fit (one fit, not one at the usual share and
     # a finer one after it: the shapely cross-check does not depend on the tolerance); the compensated and
     # lines-only programs use the tool path only for its size and cross-check, at the usual share
     usual = max(tol_fit, tol * FIT_SHARE * (1.0 - REFIT_SHARE))
-    path = tool_centre_path(contact, r, tol=tol_fit if arcs_allowed and not compensation else usual)
+    if path is None:
+        path = tool_centre_path(contact, r, tol=tol_fit if arcs_allowed and not compensation else usual)
+    elif not math.isclose(path.tool_radius, r, rel_tol=0.0, abs_tol=1e-12):
+        raise ApiError(f"the tool path given is for a cutter of radius {path.tool_radius:g} mm, the job's is {r:g}")
     max_r = arc_radius_limit(float(np.hypot(*np.asarray(path.arcs.starts, dtype=float).T).max()), cap)
     if compensation:
         # the program carries the part contour (the controller offsets it exactly): its deviation is the claim
