@@ -151,6 +151,8 @@ class SpanModel:
         self._nm = _hermite_rows(np.hstack([self.N, self.M]), np.hstack([nrm, self.m_fp[0]]),
                                  np.hstack([dn, self.m_fp[1]]))
         self._last_key: bytes | None = None
+        self._grid_rows = np.arange(s.size)
+        self._cols = np.arange(s.size)[None, :]  # (arc indices: never more arcs than grid points)
         self._rows: dict = {}  # the rows of the fixed curvatures, per arc count
         self._last_nm: tuple[np.ndarray, np.ndarray] = (np.empty((0, 2)), np.empty((0, 2)))
 
@@ -179,12 +181,10 @@ class SpanModel:
         m = ell.size
         jj = np.minimum(np.maximum(np.searchsorted(knots, self.s, side="right") - 1, 0), m - 1)
         Dk_end = (Mx[1:] - Mx[:-1]) - knots[:-1, None] * (Nx[1:] - Nx[:-1]) + ell[:, None] * (self.N[-1] - Nx[1:])
-        scale = self.L / ell.size
-        C = np.vstack([ell * scale, Dk_end.T])
-        d = np.concatenate([[(self.theta[-1] - self.theta[0]) * scale], -self.Dt[-1]])
-        rows, vals = self._fixed_rows(m)
+        rows, d = self._fixed_rows(m)
+        C = np.vstack([ell * (self.L / m), Dk_end.T])  # (vstack, not filled in place: see the decisions)
         if rows.shape[0]:
-            C, d = np.vstack([C, rows]), np.concatenate([d, vals])
+            C = np.vstack([C, rows])
         return C, d, (ell, G, jj)
 
     def matrix(self, knots: np.ndarray, parts) -> np.ndarray:
@@ -192,13 +192,16 @@ class SpanModel:
         ell, G, jj = parts
         nrm = self.nrm
         full = nrm @ (G[1:] - G[:-1]).T + self.nN[:, None] * ell[None, :]
-        A = np.where(np.arange(ell.size)[None, :] < jj[:, None], full, 0.0)
-        A[np.arange(self.s.size), jj] = self.nM - knots[jj] * self.nN - dot(nrm, G[jj])
+        A = np.where(self._cols[:, :ell.size] < jj[:, None], full, 0.0)
+        A[self._grid_rows, jj] = self.nM - knots[jj] * self.nN - dot(nrm, G[jj])
         return A
 
     def _fixed_rows(self, m: int):
+        """The rows of the fixed curvatures of ``m`` arcs and the whole right-hand side ``d`` of the closure."""
         if m not in self._rows:
-            self._rows[m] = self._make_fixed_rows(m)
+            rows, vals = self._make_fixed_rows(m)
+            scale = self.L / m
+            self._rows[m] = rows, np.concatenate([[(self.theta[-1] - self.theta[0]) * scale], -self.Dt[-1], vals])
         return self._rows[m]
 
     def _make_fixed_rows(self, m: int):
@@ -294,10 +297,11 @@ def equioscillate(model: SpanModel, knots: np.ndarray, iters: int = _EQUI_ITERS)
         y = _damped_step(lin, m, lam * emax / hmean)
         dk, dx = y[:m], y[m:2 * m - 1]
         improved = False
+        shortest = 0.3 * (knots[1:] - knots[:-1])
         for alpha in (1.0, 0.5, 0.25):
             xn = knots.copy()
             xn[1:-1] += alpha * dx
-            if not np.all(np.diff(xn) >= 0.3 * np.diff(knots)):
+            if not np.all(xn[1:] - xn[:-1] >= shortest):
                 continue
             C2, d2, parts = model.closure(xn)
             k2 = k + alpha * dk
