@@ -14,7 +14,11 @@ samples (``measure_deviation(..., samples=200 000)``).
 process per tree, the trees alternating ``--rounds`` times, and the best CPU time of each tree is printed with
 both fits' arc counts and deviations (and whether the arcs are the same bit for bit).
 
-Run:  PYTHONPATH=. python3 benchmarks/bench_fit.py [--repeat 20] [--root /work/main --rounds 3]
+``--examples`` fits every profile of every example design (``camfab/examples/*.toml``) at 1e-3 and 1e-4 mm and
+lists per fit the arcs, the measured deviation and the CPU time; with ``--root`` both trees' fits side by side
+(arcs before/after, whether they are the same bit for bit) and the totals.
+
+Run:  PYTHONPATH=. python3 benchmarks/bench_fit.py [--repeat 20] [--root /work/main --rounds 3] [--examples]
 """
 from __future__ import annotations
 
@@ -139,6 +143,55 @@ def compare(root: Path, repeat: int, rounds: int, which: list[int]) -> None:
               f"(indep. {new['indep']:.4e}) {1e3 * new['cpu']:8.1f} ms CPU  ({same})", flush=True)
 
 
+def example_fits() -> list[dict]:
+    """Every profile of every example design fitted at 1e-3 and 1e-4 mm in this process: arcs, deviation, CPU."""
+    import camfab
+
+    examples = Path(camfab.__file__).resolve().parent / "examples"
+    out = []
+    for path in sorted(examples.glob("*.toml")):
+        try:
+            curves = design_curves(path.read_text(), examples)
+        except (AttributeError, TypeError, ValueError):  # no plane profile (the cylindrical cam)
+            continue
+        for i, c in enumerate(curves):
+            for tol in (1e-3, 1e-4):
+                t0 = time.process_time()
+                f = arcs(c, tol=tol)
+                cpu = time.process_time() - t0
+                ch = f.chain()
+                digest = hashlib.sha256(ch.start.tobytes() + ch.curvature.tobytes() + ch.length.tobytes())
+                out.append({"label": f"{path.stem}[{i}] {tol:g}", "arcs": f.n_entities, "dev": f.max_deviation,
+                            "tol": tol, "cpu": cpu, "hash": digest.hexdigest()[:12]})
+    return out
+
+
+def _examples_tree(root: Path) -> list[dict]:
+    env = dict(os.environ, PYTHONPATH=str(root))
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    out = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--examples-json"], env=env, check=True,
+                         capture_output=True, text=True).stdout
+    return json.loads(out.strip().splitlines()[-1])
+
+
+def compare_examples(root: Path | None) -> None:
+    """The example fits of this tree (and of ``root``): per fit arcs, deviation, CPU; the totals."""
+    new = _examples_tree(HERE.parent)
+    old = _examples_tree(root) if root is not None else new
+    grow = []
+    for o, n in zip(old, new, strict=True):
+        same = "same" if o["hash"] == n["hash"] else "differ"
+        grow.append(n["arcs"] - o["arcs"])
+        flag = "" if n["dev"] <= n["tol"] else "  DEVIATION ABOVE TOL"
+        print(f"{n['label']:<40} arcs {o['arcs']:5d} -> {n['arcs']:5d}  dev {o['dev']:.3e} -> {n['dev']:.3e}  "
+              f"{1e3 * o['cpu']:8.1f} -> {1e3 * n['cpu']:8.1f} ms  ({same}){flag}", flush=True)
+    to, tn = sum(r["arcs"] for r in old), sum(r["arcs"] for r in new)
+    print(f"{len(new)} fits: arcs {to} -> {tn} ({100.0 * (tn - to) / to:+.2f} %), largest growth {max(grow)}, "
+          f"identical {sum(o['hash'] == n['hash'] for o, n in zip(old, new, strict=True))}, CPU "
+          f"{sum(r['cpu'] for r in old):.2f} -> {sum(r['cpu'] for r in new):.2f} s, all within tol: "
+          f"{all(r['dev'] <= r['tol'] for r in new)}")
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=20, help="fits timed, the best kept (constant width: a quarter, "
@@ -147,8 +200,17 @@ def main(argv=None) -> None:
     ap.add_argument("--rounds", type=int, default=3, help="alternations with --root")
     ap.add_argument("--cases", default="0,1,2", help="with --root: the cases compared (0 issue cam, 1 constant "
                     "width, 2 1000 segments)")
+    ap.add_argument("--examples", action="store_true", help="every example profile at 1e-3 and 1e-4 mm: arcs, "
+                    "deviation, CPU per fit (with --root: both trees)")
     ap.add_argument("--case", type=int, help=argparse.SUPPRESS)
+    ap.add_argument("--examples-json", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
+    if args.examples_json:
+        print(json.dumps(example_fits()))
+        return
+    if args.examples:
+        compare_examples(args.root.resolve() if args.root is not None else None)
+        return
     if args.case is not None:
         print(json.dumps(measure_case(args.case, args.repeat)))
         return

@@ -20,9 +20,10 @@ import numpy as np
 from ..geom2d import cross, dot, rotate
 from .certify import certified_deviation
 from .chain import Chain, merge_cocircular
+from .congruent import CongruentSpans
 from .curve import ParametricCurve, points_at
 from .entities import LINE_SWEEP_RAD, MAX_TURNING_RAD, arc_from, biarc, entity_point
-from .spanbatch import MIN_BATCH, two_arc_fits
+from .spanbatch import two_arc_fits
 from .spanmodel import SpanModel, cumtrapz, equioscillate
 from .spans import Span, cut_spans, span_density, span_ends, span_shape
 from .surrogate import HermiteSurrogate
@@ -63,6 +64,8 @@ _FIXED_END_ARCS_ALT: tuple = ()
 #: dozen counts per span before the whole spline fell back to spans clamped at every breakpoint.  Fits that do
 #: converge start at most 16× over (the examples at 1e-2…1e-4 mm), the hopeless ones at 80–1700×.
 _FIXED_HOPELESS = 40.0
+#: spans whose search starts at this many arcs or more take the arcs of a congruent span already fitted
+_CONGRUENT_MIN = 4
 
 
 def _place_knots(s, density, m, ends=_END_ARCS, ends_hi=None):
@@ -294,17 +297,37 @@ def _fit_span_chain(curve: ParametricCurve, sur: HermiteSurrogate, span: Span, t
     return None if chain is None else (chain, err)
 
 
-def _fit_span_chains(curve: ParametricCurve, sur: HermiteSurrogate, spans: list, target: float) -> list:
-    """:func:`_fit_span_chain` of every span, the first attempt of the free single-piece spans whose search starts
-    at two arcs made in one batch (:func:`~camfab.discretize.spanbatch.two_arc_fits`): the same arcs."""
+def _fit_span_chains(curve: ParametricCurve, sur: HermiteSurrogate, spans: list, target: float) -> tuple[list, list]:
+    """:func:`_fit_span_chain` of every span, and which spans took a congruent span's arcs (:func:`_fit_spans`).
+
+    The first attempt of the free single-piece spans whose search starts at two arcs is made in one batch
+    (:func:`~camfab.discretize.spanbatch.two_arc_fits`): the same arcs."""
     searches = [None if sp.exact is not None else _SpanFit(sur, sp, target) for sp in spans]
     two = [f for f in searches if f is not None and f.n_fixed == 0 and len(f.span.segs) == 1 and f.first_count() == 2]
     for i, res in two_arc_fits(sur, two, target, _place_knots).items():
         two[i].pre[2] = res
-    if len(two) < MIN_BATCH:
-        return [_fit_span_chain(curve, sur, sp, target, f) for sp, f in zip(spans, searches, strict=True)]
-    fits = [None if f is None else _fit_span(sur, sp, target, f) for sp, f in zip(spans, searches, strict=True)]
-    return _span_chains(sur, spans, fits)
+    fits, carried = _fit_spans(sur, spans, target, searches)
+    return _span_chains(sur, spans, fits), carried
+
+
+def _fit_spans(sur: HermiteSurrogate, spans: list, target: float, searches: list) -> tuple[list, list]:
+    """:func:`_fit_span` of every span (None: exact or failed) and whether it was carried over from a congruent
+    span (:class:`~camfab.discretize.congruent.CongruentSpans`, spans of :data:`_CONGRUENT_MIN` arcs or more:
+    the search of the smaller ones costs less than the comparison)."""
+    same = CongruentSpans(sur)
+    fits, carried = [], []
+    for sp, f in zip(spans, searches, strict=True):
+        fit = sig = None
+        if f is not None:
+            sig = same.signature(sp) if f.first_count() >= _CONGRUENT_MIN else None
+            fit = None if sig is None else same.find(sig, sp)
+        carried.append(fit is not None)
+        if f is not None and fit is None:
+            fit = _fit_span(sur, sp, target, f)
+            if sig is not None and fit is not None:
+                same.add(sig, sp, fit)
+        fits.append(fit)
+    return fits, carried
 
 
 def _span_chains(sur: HermiteSurrogate, spans: list, fits: list) -> list:
@@ -312,13 +335,19 @@ def _span_chains(sur: HermiteSurrogate, spans: list, fits: list) -> list:
     span or a failed fit), the two-arc spans' biarcs laid in one call (:func:`_two_arc_chains`)."""
     out = [(sp.exact, 0.0) if sp.exact is not None else None for sp in spans]
     two_arc = [i for i, f in enumerate(fits) if f is not None and f[0].size == 3 and f[3] == (None, None)]
+    if not two_arc:
+        return _other_chains(sur, spans, fits, out)
     ends = [span_ends(sur, spans[i]) for i in two_arc]
     for i, chain in zip(two_arc, _two_arc_chains(ends, [fits[i][1] for i in two_arc],
                                                   [fits[i][0] for i in two_arc]), strict=True):
         out[i] = None if chain is None else (chain, fits[i][2])
-    done = set(two_arc)
+    return _other_chains(sur, spans, fits, out, set(two_arc))
+
+
+def _other_chains(sur: HermiteSurrogate, spans: list, fits: list, out: list, done: set | None = None) -> list:
+    """``out`` with the exact arcs of every fitted span not in ``done`` laid one by one (:func:`_span_chain`)."""
     for i, f in enumerate(fits):
-        if f is not None and out[i] is None and i not in done:
+        if f is not None and out[i] is None and i not in (done or ()):
             knots, k, err, fixed = f
             p0, t0, p1, t1 = span_ends(sur, spans[i])
             chain = _span_chain(p0, t0, p1, t1, knots, k, fixed)
@@ -392,7 +421,7 @@ def fit_spline(curve: ParametricCurve, surrogate: tuple[HermiteSurrogate, float]
     spans = cut_spans(curve, sur, target, tol, anchored)
     targets = [target] * len(spans)
     with np.errstate(invalid="ignore", divide="ignore"):
-        fits = _fit_span_chains(curve, sur, spans, target)
+        fits, carried = _fit_span_chains(curve, sur, spans, target)
     if any(f is None for f in fits):
         return None
     parts, errs = [f[0] for f in fits], [f[1] for f in fits]
@@ -411,8 +440,10 @@ def fit_spline(curve: ParametricCurve, surrogate: tuple[HermiteSurrogate, float]
         for j in np.flatnonzero(worst > 0.99 * tol):
             if spans[j].exact is not None:
                 return None
-            # the measured / model ratio of this span scales its next target
-            targets[j] = min(0.98 * targets[j], 0.97 * tol * errs[j] / worst[j])
+            if carried[j]:  # a congruent span's arcs: fitted on its own first
+                carried[j] = False
+            else:  # the measured / model ratio of this span scales its next target
+                targets[j] = min(0.98 * targets[j], 0.97 * tol * errs[j] / worst[j])
             with np.errstate(invalid="ignore", divide="ignore"):
                 fit = _fit_span_chain(curve, sur, spans[j], targets[j])
             if fit is None:

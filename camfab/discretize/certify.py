@@ -58,13 +58,16 @@ def _curve_bounds(sur: HermiteSurrogate) -> tuple[float, float]:
     a, b = sur.x[:-1], sur.x[1:]
     # each interval's own cubic at offsets 0, (a + b)/2 - a and b - a (at b the next interval's start agrees to
     # rounding: the stand-in is C¹ inside a piece), evaluated from the coefficients without locating the cubics
-    u = np.concatenate([np.zeros_like(a), 0.5 * (a + b) - a, b - a])[:, None]
-    c = np.tile(sur.coef, (1, 3, 1))
-    d, dd = c[1] + u * (2 * c[2] + 3 * u * c[3]), 2 * c[2] + 6 * u * c[3]
-    v = np.hypot(d[:, 0], d[:, 1])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        k = np.abs(cross(d, dd)) / v ** 3
-    return _SAFETY * float(np.max(k)), _SAFETY * float(np.max(v))
+    c = sur.coef
+    k_max = v_max = -np.inf
+    for u in (np.zeros_like(a), 0.5 * (a + b) - a, b - a):  # (one offset at a time: no tiled copy of the cubics)
+        u = u[:, None]
+        d, dd = c[1] + u * (2 * c[2] + 3 * u * c[3]), 2 * c[2] + 6 * u * c[3]
+        v = np.hypot(d[:, 0], d[:, 1])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            k = np.abs(cross(d, dd)) / v ** 3
+        k_max, v_max = np.maximum(k_max, np.max(k)), np.maximum(v_max, np.max(v))  # (a NaN stays NaN)
+    return _SAFETY * float(k_max), _SAFETY * float(v_max)
 
 
 def semiconcavity(sur: HermiteSurrogate, chain: Chain, tol: float) -> tuple[float, float]:

@@ -66,16 +66,25 @@ def _cumhermite(f: np.ndarray, fp: np.ndarray, s: np.ndarray) -> np.ndarray:
     return np.concatenate([np.zeros((1,) + f.shape[1:]), np.cumsum(inc, axis=0)])
 
 
-def _hermite_at(x: np.ndarray, s: np.ndarray, F: np.ndarray, f: np.ndarray, fp: np.ndarray) -> np.ndarray:
-    """``F(x) = ∫₀ˣ f`` between grid points: integral of the cubic Hermite interpolant of ``f``."""
+def _hermite_rows(F: np.ndarray, f: np.ndarray, fp: np.ndarray) -> np.ndarray:
+    """The table :func:`_hermite_at` reads, one row per grid interval: ``F``, ``f``, ``fp`` at its start, ``f``,
+    ``fp`` at its end."""
+    return np.hstack([F[:-1], f[:-1], fp[:-1], f[1:], fp[1:]])
+
+
+def _hermite_at(x: np.ndarray, s: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """``F(x) = ∫₀ˣ f`` between grid points: integral of the cubic Hermite interpolant of ``f`` (``rows``: the
+    :func:`_hermite_rows` of ``F``, ``f``, ``fp``)."""
     i = np.minimum(np.maximum(np.searchsorted(s, x, side="right") - 1, 0), s.size - 2)  # (np.clip: 10× the call)
     h = s[i + 1] - s[i]
     tau = np.minimum(np.maximum((x - s[i]) / np.where(h > 0, h, 1.0), 0.0), 1.0)
     t2, t3, t4 = tau * tau, tau ** 3, tau ** 4
     w = (h * (tau - t3 + 0.5 * t4), h * h * (0.25 * t4 - 2.0 * t3 / 3.0 + 0.5 * t2),
          h * (t3 - 0.5 * t4), h * h * (0.25 * t4 - t3 / 3.0))
-    return (F[i] + w[0][:, None] * f[i] + w[1][:, None] * fp[i] + w[2][:, None] * f[i + 1]
-            + w[3][:, None] * fp[i + 1])
+    r = rows[i]
+    q = r.shape[1] // 5
+    return (r[:, :q] + w[0][:, None] * r[:, q:2 * q] + w[1][:, None] * r[:, 2 * q:3 * q]
+            + w[2][:, None] * r[:, 3 * q:4 * q] + w[3][:, None] * r[:, 4 * q:])
 
 
 def _lawson(A: np.ndarray, b: np.ndarray, C: np.ndarray, dvec: np.ndarray, iters: int = _LAWSON_ITERS):
@@ -139,8 +148,11 @@ class SpanModel:
         self.b = dot(self.Dt, nrm)
         self.M = _cumhermite(*self.m_fp, s)                              # ∫ s·n ds
         self.nN, self.nM = dot(nrm, self.N), dot(nrm, self.M)
-        self._nm = (np.hstack([self.N, self.M]), np.hstack([nrm, self.m_fp[0]]), np.hstack([dn, self.m_fp[1]]))
+        self._nm = _hermite_rows(np.hstack([self.N, self.M]), np.hstack([nrm, self.m_fp[0]]),
+                                 np.hstack([dn, self.m_fp[1]]))
         self._last_key: bytes | None = None
+        self._grid_rows = np.arange(s.size)
+        self._cols = np.arange(s.size)[None, :]  # (arc indices: never more arcs than grid points)
         self._rows: dict = {}  # the rows of the fixed curvatures, per arc count
         self._last_nm: tuple[np.ndarray, np.ndarray] = (np.empty((0, 2)), np.empty((0, 2)))
 
@@ -148,36 +160,48 @@ class SpanModel:
         """``(N(x), M(x))`` between grid points (the last query is cached)."""
         key = x.tobytes()
         if self._last_key != key:
-            v = _hermite_at(x, self.s, *self._nm)
+            v = _hermite_at(x, self.s, self._nm)
             self._last_key, self._last_nm = key, (v[:, :2], v[:, 2:])
         return self._last_nm
 
     def system(self, knots: np.ndarray):
         """``(A, C, d)`` of the knots: ``e = A k + b`` on the grid, ``C k = d`` closes the span."""
-        ell = np.diff(knots)
-        s, nrm = self.s, self.nrm
+        C, d, parts = self.closure(knots)
+        return self.matrix(knots, parts), C, d
+
+    def closure(self, knots: np.ndarray):
+        """``(C, d, parts)`` of the knots: ``C k = d`` closes the span; ``parts`` (what :meth:`matrix` and
+        :meth:`deviation` share): arc lengths, ``G = M - x·N`` at the knots, the arc of every grid point."""
+        ell = knots[1:] - knots[:-1]
         # V_j(s) = ∫ clip(s' - x_j, 0, ℓ_j)·n ds' from the prefix integrals N = ∫ n, M = ∫ s'·n:
         # after arc j (s > x_{j+1}) n·V_j = n·W_j + ℓ_j·n·N(s), W_j = [M - x·N] from x_j to x_{j+1};
         # inside it n·V_j = n·M(s) - x_j·n·N(s) - n·(M(x_j) - x_j·N(x_j)); before it 0
         Nx, Mx = self.NM_at(knots)
         G = Mx - knots[:, None] * Nx                                        # (m + 1, 2)
         m = ell.size
-        A = nrm @ (G[1:] - G[:-1]).T + self.nN[:, None] * ell[None, :]
-        jj = np.minimum(np.maximum(np.searchsorted(knots, s, side="right") - 1, 0), m - 1)
-        A[np.arange(m)[None, :] >= jj[:, None]] = 0.0
-        A[np.arange(s.size), jj] = self.nM - knots[jj] * self.nN - dot(nrm, G[jj])
+        jj = np.minimum(np.maximum(np.searchsorted(knots, self.s, side="right") - 1, 0), m - 1)
         Dk_end = (Mx[1:] - Mx[:-1]) - knots[:-1, None] * (Nx[1:] - Nx[:-1]) + ell[:, None] * (self.N[-1] - Nx[1:])
-        scale = self.L / ell.size
-        C = np.vstack([ell * scale, Dk_end.T])
-        d = np.concatenate([[(self.theta[-1] - self.theta[0]) * scale], -self.Dt[-1]])
-        rows, vals = self._fixed_rows(m)
+        rows, d = self._fixed_rows(m)
+        C = np.vstack([ell * (self.L / m), Dk_end.T])  # (vstack, not filled in place: see the decisions)
         if rows.shape[0]:
-            C, d = np.vstack([C, rows]), np.concatenate([d, vals])
-        return A, C, d
+            C = np.vstack([C, rows])
+        return C, d, (ell, G, jj)
+
+    def matrix(self, knots: np.ndarray, parts) -> np.ndarray:
+        """``A`` (``e = A k + b`` on the grid) of the knots (``parts`` from :meth:`closure`)."""
+        ell, G, jj = parts
+        nrm = self.nrm
+        full = nrm @ (G[1:] - G[:-1]).T + self.nN[:, None] * ell[None, :]
+        A = np.where(self._cols[:, :ell.size] < jj[:, None], full, 0.0)
+        A[self._grid_rows, jj] = self.nM - knots[jj] * self.nN - dot(nrm, G[jj])
+        return A
 
     def _fixed_rows(self, m: int):
+        """The rows of the fixed curvatures of ``m`` arcs and the whole right-hand side ``d`` of the closure."""
         if m not in self._rows:
-            self._rows[m] = self._make_fixed_rows(m)
+            rows, vals = self._make_fixed_rows(m)
+            scale = self.L / m
+            self._rows[m] = rows, np.concatenate([[(self.theta[-1] - self.theta[0]) * scale], -self.Dt[-1], vals])
         return self._rows[m]
 
     def _make_fixed_rows(self, m: int):
@@ -198,8 +222,7 @@ class SpanModel:
         xi = knots[1:-1]
         Nx = self.NM_at(knots)[0][1:-1]
         jump = k[:-1] - k[1:]
-        B = (self.nN[:, None] - self.nrm @ Nx.T) * jump
-        B[self.s[:, None] <= xi[None, :]] = 0.0
+        B = np.where(self.s[:, None] <= xi[None, :], 0.0, (self.nN[:, None] - self.nrm @ Nx.T) * jump)
         Bc = np.vstack([jump * (self.L / k.size), ((self.N[-1][None] - Nx) * jump[:, None]).T])
         n_fixed = self._fixed_rows(k.size)[0].shape[0]
         if n_fixed:
@@ -213,6 +236,33 @@ def _local_extrema(e: np.ndarray) -> np.ndarray:
     left = np.concatenate([[-np.inf], ae[:-1]])
     right = np.concatenate([ae[1:], [-np.inf]])
     return np.flatnonzero((ae >= left) & (ae >= right) & (ae > 0))
+
+
+def _normal_equations(J: np.ndarray, r: np.ndarray):
+    """``(J, r, JᵀJ, Jᵀr, scale)`` of the least-squares problem ``J y ≈ r``, its columns scaled to unit norm."""
+    scale = np.sqrt(np.einsum("ij,ij->j", J, J))
+    scale = 1.0 / np.where(scale > 0, scale, 1.0)
+    Js = J * scale
+    return J, r, Js.T @ Js, Js.T @ r, scale
+
+
+def _damped_step(lin, m: int, mu: float) -> np.ndarray:
+    """The Levenberg step ``y`` minimising ``|J y - r|² + mu²·|dx|²`` (the knot moves ``dx`` = ``y[m:2m-1]``):
+    the normal equations of the column-scaled system (a Cholesky-sized solve instead of an SVD least squares),
+    the SVD least squares only when they are singular."""
+    J, r, H, g, scale = lin
+    H = H.copy()
+    idx = np.arange(m, 2 * m - 1)
+    H[idx, idx] += (mu * scale[idx]) ** 2
+    try:
+        y = np.linalg.solve(H, g) * scale
+    except np.linalg.LinAlgError:
+        y = None
+    if y is None or not np.all(np.isfinite(y)):
+        damp = np.zeros((m - 1, 2 * m))
+        damp[:, m:2 * m - 1] = np.eye(m - 1) * mu
+        y, *_ = np.linalg.lstsq(np.vstack([J, damp]), np.concatenate([r, np.zeros(m - 1)]), rcond=None)
+    return y
 
 
 def equioscillate(model: SpanModel, knots: np.ndarray, iters: int = _EQUI_ITERS):
@@ -241,25 +291,25 @@ def equioscillate(model: SpanModel, knots: np.ndarray, iters: int = _EQUI_ITERS)
             J = np.hstack([A[p], B[p], -np.sign(e[p])[:, None]])
             Cj = np.hstack([C, Bc, np.zeros((C.shape[0], 1))])
             wc = 1e3 / max(float(np.abs(Cj).max()), 1e-300)
-            lin = (np.vstack([J, wc * Cj]), np.concatenate([-e[p], wc * (d - C @ k), np.zeros(m - 1)]))
+            lin = _normal_equations(np.vstack([J, wc * Cj]), np.concatenate([-e[p], wc * (d - C @ k)]))
             level = np.abs(e[p])
             level_spread = 1.0 - float(level.min()) / emax if level.size else 1.0
-        damp = np.zeros((m - 1, 2 * m))
-        damp[:, m:2 * m - 1] = np.eye(m - 1) * (lam * emax / hmean)
-        y, *_ = np.linalg.lstsq(np.vstack([lin[0], damp]), lin[1], rcond=None)
+        y = _damped_step(lin, m, lam * emax / hmean)
         dk, dx = y[:m], y[m:2 * m - 1]
         improved = False
+        shortest = 0.3 * (knots[1:] - knots[:-1])
         for alpha in (1.0, 0.5, 0.25):
             xn = knots.copy()
             xn[1:-1] += alpha * dx
-            if not np.all(np.diff(xn) >= 0.3 * np.diff(knots)):
+            if not np.all(xn[1:] - xn[:-1] >= shortest):
                 continue
-            A2, C2, d2 = model.system(xn)
+            C2, d2, parts = model.closure(xn)
             k2 = k + alpha * dk
             try:  # restore the closure exactly (least-norm change of the curvatures)
                 k2 = k2 + C2.T @ np.linalg.solve(C2 @ C2.T, d2 - C2 @ k2)
             except np.linalg.LinAlgError:
                 continue
+            A2 = model.matrix(xn, parts)
             e2 = A2 @ k2 + model.b
             emax2 = float(np.abs(e2).max())
             if emax2 < best[0]:
