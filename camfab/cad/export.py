@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ..design.kinds import ContactKind
-from ..discretize import arcs, arcs_within_radius, measure_deviation, validate_tol
+from ..discretize import arcs, arcs_within_radius, measure_within, validate_tol
 from ..discretize.curve import discontinuities
 from ..discretize.tolerance import within
 from ..errors import GeometryError
@@ -76,7 +76,7 @@ def _pitch_loop(profile: ArcChain, roller_radius: float, pitch, tol: float) -> A
     otherwise (or for a chain with corners) a fit of its own."""
     loop = profile.offset_g1(roller_radius)
     if loop is not None:
-        dev = float(measure_deviation(loop, pitch).max)
+        dev = float(measure_within(loop, pitch, tol).max)
         if within(dev, tol):
             return loop.with_deviation(dev)
         log.info("pitch curve: the profile's arcs offset by the roller radius %g mm deviate %.3g mm > tol = %g mm "
@@ -180,7 +180,7 @@ def _stl_artifacts(spec, curves, plate: PlateSpec, tol: float, say: Callable[[st
     for i, curve in enumerate(curves):
         say(f"STL{_suffix(i, n)}")
         fine = arcs(curve, tol=tol / 2)
-        dev = float(measure_deviation(fine.flatten(tol / 2), curve).max)
+        dev = float(measure_within(fine.flatten(tol / 2), curve, tol).max)
         data = stl.dumps(fine, plate, tol=tol / 2, name=spec.name)
         out.append(Artifact(f"{safe_stem(spec.name)}{_suffix(i, n)}.stl", data, "stl", None, dev))
     return out

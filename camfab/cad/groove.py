@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..design.kinds import CamKind
-from ..discretize import arcs, measure_deviation
+from ..discretize import arcs, measure_within
 from ..errors import GeometryError
 from ..geom2d import ArcChain
 from ..io import safe_stem
@@ -57,7 +57,8 @@ def groove_artifacts(spec, geometry, formats: list[str], *, shapes: CamShapes, t
         out.append(_dxf(spec, geometry, shapes, plate, outline, tol, dxf_flavour, tool_paths))
     if "stl" in formats:
         fine = [arcs(c, tol=tol / 2) for c in shapes.curves]
-        dev = max(float(measure_deviation(f.flatten(tol / 2), c).max) for f, c in zip(fine, shapes.curves, strict=True))
+        dev = max(float(measure_within(f.flatten(tol / 2), c, tol).max)
+                  for f, c in zip(fine, shapes.curves, strict=True))
         data = _stl_bytes(groove_mesh(outline, fine[0], fine[1], plate, depth, tol=tol / 2), spec.name, tol / 2)
         out.append(Artifact(f"{stem}.stl", data, "stl", None, dev))
     if "step" in formats:

@@ -8,7 +8,7 @@ two-way maximum distance from the exact curve is measured and at most the tolera
 the curve.  An arc discretisation is an :class:`~camfab.geom2d.ArcChain`, what every writer reads.
 
 Modules, in dependency order: ``tolerance``, ``curve``, ``surrogate``, ``entities``, ``chain``,
-``results``, ``measure``, ``interpolate``, ``spanmodel``, ``spans``, ``arcspline``, ``fit``.
+``results``, ``measure``, ``certify``, ``within``, ``interpolate``, ``spanmodel``, ``spans``, ``arcspline``, ``fit``.
 """
 from .chain import Chain
 from .curve import CurveError, ParametricCurve, curvature_at, points_at
@@ -16,6 +16,7 @@ from .fit import arcs, arcs_within_radius, polyline
 from .measure import max_deviation, measure_deviation
 from .results import ArcDiscretisation, Deviation, Discretisation
 from .tolerance import ToleranceError, validate_tol
+from .within import measure_within
 
 __all__ = [
     "ArcDiscretisation",
@@ -30,6 +31,7 @@ __all__ = [
     "curvature_at",
     "max_deviation",
     "measure_deviation",
+    "measure_within",
     "points_at",
     "polyline",
     "validate_tol",

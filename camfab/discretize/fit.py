@@ -51,6 +51,7 @@ from .measure import measure_deviation
 from .results import ArcDiscretisation, Discretisation
 from .surrogate import fit_surrogate
 from .tolerance import validate_tol, within
+from .within import measure_within
 
 __all__ = ["polyline", "arcs", "arcs_within_radius", "REFIT_SHARE"]
 
@@ -188,12 +189,12 @@ def arcs_within_radius(fit: ArcChain, curve: ParametricCurve, *, tol: float, max
         return fit
     dev = fit.max_deviation
     if dev is None:
-        dev = float(measure_deviation(fit, curve).max)
+        dev = float(measure_within(fit, curve, tol).max)
     if tol - dev < REFIT_SHARE * tol:
         fit = arcs(curve, tol=tol * (1.0 - REFIT_SHARE))
         dev = float(fit.max_deviation)
     chords, _ = chord_large_arcs(fit, max_radius_mm, tol - dev)
-    measured = float(measure_deviation(chords, curve).max)
+    measured = float(measure_within(chords, curve, tol).max)
     if not within(measured, tol):
         raise GeometryError(f"arcs above R{max_radius_mm:g} mm as chords deviate {measured:.3g} mm from the curve "
                             f"(> tol {tol:g} mm); give a larger tolerance")

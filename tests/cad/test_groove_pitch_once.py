@@ -10,7 +10,8 @@ import subprocess
 import sys
 
 from camfab.cad.artifact import cam_shapes
-from camfab.discretize import measure_deviation
+from camfab.discretize import measure_deviation, measure_within
+from camfab.discretize.certify import CERTIFY_SHARE
 from camfab.offset import pitch_curve
 from camfab.pipeline import load
 
@@ -28,8 +29,9 @@ def test_one_pitch_loop_with_its_measured_deviation():
     assert len(shapes.pitch) == 1 and inner.roller_radius == outer.roller_radius == w
     exact = pitch_curve(inner)
     loop = shapes.profiles[0].offset_g1(w)
-    dev = float(measure_deviation(loop, exact).max)
+    dev = float(measure_within(loop, exact, tol).max)  # certified (docs/decisions.md, "measure_within")
     assert shapes.pitch[0].max_deviation == dev <= tol
+    assert -1e-12 <= float(measure_deviation(loop, exact).max) - dev <= CERTIFY_SHARE * tol
     assert shapes.pitch[0].n_entities == shapes.profiles[0].n_entities  # the offset, not a fit of its own
     back = shapes.profiles[1].offset_g1(-w)
     assert back is not None and float(measure_deviation(back, exact).max) <= tol
