@@ -259,12 +259,9 @@ def _finishing(w: _Writer, geometry: Any, tol_fin: float, safe: float, clear: fl
 
 
 def rotary_gcode(geometry: Any, job: Job, tol: float, post: str | Post = "linuxcnc") -> tuple[bytes, int, float]:
-    """The 4-axis program (module notes) as bytes, its number of cutting ``G1 X.. A..`` moves and the largest
-    chord error (mm) of the written path on the developed cylinder of each level's radius (before rounding)."""
-    if geometry.cylinder.rib_width_mm is not None:  # a rib: camfab.gcode.rib_program
-        from .rib_program import rib_gcode
-
-        return rib_gcode(geometry, job, tol, post)
+    """The groove's 4-axis program (module notes) as bytes, its number of cutting ``G1 X.. A..`` moves and the
+    largest chord error (mm) of the written path on the developed cylinder of each level's radius (before
+    rounding).  A rib's program is :func:`~camfab.gcode.rib_program.rib_gcode`."""
     p = _rotary_post(post)
     check_rotary_tool(geometry, job.tool_diameter_mm)
     cyl = geometry.cylinder

@@ -378,12 +378,9 @@ def read_or_refused(program: str | bytes, tol: float) -> list[RotaryMove] | Rota
 
 
 def verify_rotary_program(program: str | bytes, geometry: Any, job: Job, *, tol: float) -> RotaryVerifyReport:
-    """``camfab verify`` of a cylindrical cam's 4-axis program (module notes); ``job`` cut to the groove's
-    depth (:func:`~camfab.gcode.rotary.cylinder_job`)."""
-    if geometry.cylinder.rib_width_mm is not None:  # a rib's program (camfab.gcode.rib_verify)
-        from .rib_verify import verify_rib_program
-
-        return verify_rib_program(program, geometry, job, tol=tol)
+    """``camfab verify`` of a grooved cylindrical cam's 4-axis program (module notes); ``job`` cut to the
+    groove's depth (:func:`~camfab.gcode.rotary.cylinder_job`).  A rib's program is verified by
+    :func:`~camfab.gcode.rib_verify.verify_rib_program`."""
     moves = read_or_refused(program, tol)
     if isinstance(moves, RotaryVerifyReport):
         return moves
