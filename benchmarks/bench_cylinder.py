@@ -2,9 +2,10 @@
 
 - ``--build``: the cylindrical example's grooved cylinder (``camfab/cad/kind_exports.py::cylinder_solid``): the
   solid alone, then STEP + STL + IGES + assembly written by one run (the solid built once and shared; cadquery's
-  import is done before and not counted);
-- ``--verify``: ``camfab verify`` of the cylindrical example's 4-axis program (``verify_rotary_program``; the
-  program written once, untimed), with the read-back's deviation;
+  import is done before and not counted), with the STEP files' sizes;
+- ``--verify``: ``camfab verify`` of the cylindrical example's 4-axis program (``verify_rotary_program``) and of
+  the rib of ``tests/gcode/test_rib_program.py`` (``verify_rib_program``); each program written once, untimed;
+  with the read-back's deviation;
 - ``--dxf``: ``export --dxf`` of the groove example: the DXF stage in this process (``build_artifacts``), and
   ``python -m camfab export groove_translating --dxf`` as a whole process (bytecode cached, as installed).
 
@@ -16,6 +17,7 @@ Run:  PYTHONPATH=. python3 benchmarks/bench_cylinder.py [--build] [--verify] [--
 from __future__ import annotations
 
 import argparse
+import functools
 import math
 import os
 import resource
@@ -60,26 +62,36 @@ def build(repeat: int) -> None:
             return run(load("cylindrical_translating"), folder, req)
 
         t, res = _best(files, repeat)
+        sizes = {k: Path(v).stat().st_size for k, v in res.files.items() if k.lower().endswith((".step", ".stp"))}
     names = sorted(k for k in res.files if k != "check.json")
     stages = ", ".join(f"{k} {v:.2f}" for k, v in res.timings.items())
     print(f"  STEP + STL + IGES + assembly from one build: {t:.2f} s CPU ({', '.join(names)}; stage wall s: {stages})")
+    print("  STEP sizes: " + ", ".join(f"{k} {n / 1000:.0f} kB" for k, n in sorted(sizes.items())))
 
 
 def verify(repeat: int) -> None:
+    from camfab.gcode.rib_program import rib_gcode
+    from camfab.gcode.rib_verify import verify_rib_program
     from camfab.gcode.rotary import cylinder_job, rotary_gcode
     from camfab.gcode.rotary_verify import verify_rotary_program
     from camfab.pipeline import gcode_job, load
+    from tests.gcode.test_rib_program import RIB_TOML  # the rib of the tests, with a 12.1 mm cutter
 
-    cam = load("cylindrical_translating")
-    tol = cam.tolerance(None)
-    job = cylinder_job(gcode_job(cam.spec, tol=tol), cam.geometry)
-    t0 = time.process_time()
-    data, moves, _ = rotary_gcode(cam.geometry, job, tol, "linuxcnc")
-    made = time.process_time() - t0
-    t, rep = _best(lambda: verify_rotary_program(data, cam.geometry, job, tol=tol), repeat)
-    print(f"cylindrical_translating: 4-axis program {len(data.splitlines())} lines, {moves} moves, written in "
-          f"{made:.2f} s CPU; verify {t:.2f} s CPU: {'OK' if rep.ok else 'FAILED'}, max deviation "
-          f"{rep.max_deviation_mm:.3g} mm (tol {tol:g})")
+    with tempfile.TemporaryDirectory() as folder:
+        rib = Path(folder) / "rib.toml"
+        rib.write_text(RIB_TOML, encoding="utf-8")
+        cases = (("cylindrical_translating", load("cylindrical_translating"), rotary_gcode, verify_rotary_program),
+                 ("rib (test_rib_program)", load(str(rib)), rib_gcode, verify_rib_program))
+        for name, cam, program, check in cases:
+            tol = cam.tolerance(None)
+            job = cylinder_job(gcode_job(cam.spec, tol=tol), cam.geometry)
+            t0 = time.process_time()
+            data, moves, _ = program(cam.geometry, job, tol, "linuxcnc")
+            made = time.process_time() - t0
+            t, rep = _best(functools.partial(check, data, cam.geometry, job, tol=tol), repeat)
+            print(f"{name}: 4-axis program {len(data.splitlines())} lines, {moves} moves, written in "
+                  f"{made:.2f} s CPU; verify {t:.2f} s CPU: {'OK' if rep.ok else 'FAILED'}, max deviation "
+                  f"{rep.max_deviation_mm:.3g} mm (tol {tol:g})")
 
 
 def dxf(repeat: int, root: str | None) -> None:

@@ -7,9 +7,13 @@ the fitter").  This runs before numpy is imported (``import camfab`` imports no 
 """
 from __future__ import annotations
 
+import contextlib
 import os
+import signal
 import sys
+import threading
 from collections.abc import MutableMapping
+from typing import Any
 
 #: variables any BLAS build reads for its thread count; a user's explicit setting of any of them wins
 BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "GOTO_NUM_THREADS")
@@ -24,7 +28,59 @@ def one_blas_thread_by_default(environ: MutableMapping[str, str] = os.environ) -
 
 one_blas_thread_by_default()
 
-from .cli import main  # noqa: E402  (after the thread count: it imports numpy)
+#: the exit code of an interrupted command (``camfab.cli.EXIT_INTERRUPTED``: 128 + SIGINT)
+EXIT_INTERRUPTED = 130
+
+
+def main(argv: list[str] | None = None) -> int:
+    """The console script: :func:`camfab.cli.main` with Ctrl-C covered from the import of the command line to
+    the process's exit (docs/decisions.md, "Ctrl-C from start to exit").
+
+    - A Ctrl-C while ``camfab.cli`` and numpy are imported (most of a short command's start) is ``camfab:
+      interrupted``, exit 130, as one during the command; numpy's import may turn it into an ``ImportError``
+      ("PyCapsule_Import could not import module datetime"), which counts as the interrupt when SIGINT came.
+    - Once the command has returned, SIGINT is ignored: the process ends with the command's code.
+    - An interrupted command ends the process with ``os._exit(130)`` once stdout and stderr are flushed (the
+      command has removed what it was writing): CPython 3.11 had sometimes set its "unhandled
+      KeyboardInterrupt" flag although camfab caught the interrupt, and then killed the process by SIGINT on its
+      way out. So this function returns only when the command was not interrupted."""
+    came: list[int] = []
+    own = threading.current_thread() is threading.main_thread() and \
+        signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+    def during_import(signum: int, frame: Any) -> None:
+        came.append(signum)
+        signal.default_int_handler(signum, frame)  # raises KeyboardInterrupt
+
+    try:
+        if own:
+            signal.signal(signal.SIGINT, during_import)
+        try:
+            from .cli import main as cli_main  # after the thread count: it imports numpy
+        finally:
+            if own:
+                signal.signal(signal.SIGINT, signal.default_int_handler)
+        code = cli_main(argv)
+    except KeyboardInterrupt:  # before the command's own handler, or after it
+        code = _interrupted()
+    except ImportError:
+        if not came:
+            raise
+        code = _interrupted()
+    if own:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if code == EXIT_INTERRUPTED:
+        for stream in (sys.stdout, sys.stderr):
+            with contextlib.suppress(Exception):
+                stream.flush()
+        os._exit(code)
+    return code
+
+
+def _interrupted() -> int:
+    print("camfab: interrupted", file=sys.stderr)
+    return EXIT_INTERRUPTED
+
 
 if __name__ == "__main__":
     sys.exit(main())

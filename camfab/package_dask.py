@@ -19,16 +19,20 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import time
 import uuid
 from collections.abc import Callable, Generator, Iterator, Mapping
 from typing import Any
 
 from .errors import InputError, MissingDependencyError, UnreachableError
 
-__all__ = ["dask_executor", "LOCAL_CONFIG", "NO_DASHBOARD", "CONNECT_TIMEOUT_S", "parse_config", "executor_options"]
+__all__ = ["dask_executor", "close_workers_first", "LOCAL_CONFIG", "NO_DASHBOARD", "CONNECT_TIMEOUT_S",
+           "parse_config", "executor_options"]
 
 #: seconds to reach the scheduler, and for it to have a worker, before giving up (exit 3, nothing written)
 CONNECT_TIMEOUT_S = 10.0
+#: seconds a local cluster's workers get to close before its scheduler closes (then the scheduler closes anyway)
+CLOSE_WORKERS_S = 10.0
 
 #: camfab's settings for a local cluster (docs/decisions.md, "Dask executor", for the measurement)
 LOCAL_CONFIG: dict[str, Any] = {
@@ -127,9 +131,24 @@ def dask_executor(scheduler: str | None, workers: int | None, config: Mapping[st
                 n_workers=workers, threads_per_worker=1, processes=True, silence_logs=logging.ERROR,
                 dashboard_address=None, scheduler_kwargs=NO_DASHBOARD))
             client = stack.enter_context(distributed.Client(cluster, set_as_default=False))
+            stack.callback(close_workers_first, cluster)  # runs first: the stack unwinds in reverse
         else:
             client = stack.enter_context(_connect(distributed, scheduler))
         yield lambda fn, items, lost: _map(distributed, client, fn, items, lost)
+
+
+def close_workers_first(cluster: Any, timeout: float = CLOSE_WORKERS_S) -> None:
+    """Close a local cluster's workers and wait for them (up to ``timeout`` s) before its scheduler is closed.
+
+    Closing the cluster closes the scheduler first; a worker whose heartbeat was then on its way logged, at
+    ERROR, "Failed to communicate with scheduler during heartbeat" with an ``OSError`` traceback, after camfab's
+    own ``interrupted`` (a shutdown race inside Dask, seen on Ctrl-C).  Workers that have closed send no
+    heartbeat."""
+    with contextlib.suppress(Exception):  # the scheduler's own close follows whatever happens here
+        cluster.scale(0)
+        deadline = time.monotonic() + timeout
+        while cluster.workers and time.monotonic() < deadline:
+            time.sleep(0.02)
 
 
 def _connect(distributed: Any, address: str) -> Any:

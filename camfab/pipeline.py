@@ -440,10 +440,13 @@ def _gcode(cam: Cam, req: Request) -> list[Artifact]:
     job = gcode_job(cam.spec, tol=tol, overrides=req.machining)
     m = machining_of(cam.spec, req.machining)
     n = len(cam.geometry.profiles)
-    if cam.spec.cam.kind == "cylindrical":  # the 4-axis program of the groove or rib (camfab.gcode.rotary)
+    if cam.spec.cam.kind == "cylindrical":  # the 4-axis program of the groove (gcode.rotary) or rib (gcode.rib_program)
+        from .design.cylinder_spec import Feature
+        from .gcode.rib_program import rib_gcode
         from .gcode.rotary import cylinder_job, rotary_gcode
 
-        data, moves, dev = rotary_gcode(cam.geometry, cylinder_job(job, cam.geometry), tol, req.post)
+        program = rib_gcode if getattr(cam.spec.cylinder, "feature", None) is Feature.RIB else rotary_gcode
+        data, moves, dev = program(cam.geometry, cylinder_job(job, cam.geometry), tol, req.post)
         return [Artifact(f"{safe_stem(cam.name)}.nc", data, "gcode", moves, dev, req.post)]
     if cam.spec.cam.kind == "groove":  # one program mills the slot of both flanks
         return [Artifact(f"{safe_stem(cam.name)}.nc", *groove_gcode(cam.geometry, job, tol, m, req.post), req.post)]

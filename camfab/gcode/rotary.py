@@ -63,7 +63,7 @@ def _developed(geometry: Any, r: float, phi: np.ndarray) -> np.ndarray:
     return geometry.at_radius(r).pitch(np.asarray(phi, dtype=float))[0]
 
 
-def _chord_error(curve: Callable[[np.ndarray], np.ndarray], phi: np.ndarray) -> np.ndarray:
+def chord_error(curve: Callable[[np.ndarray], np.ndarray], phi: np.ndarray) -> np.ndarray:
     """Largest distance of the exact ``curve(phi)`` from each chord between consecutive ``phi`` (at 1/4, 1/2,
     3/4)."""
     P = curve(phi)
@@ -86,7 +86,7 @@ def rotary_samples(geometry: Any, r: float, tol: float,
     period = float(geometry.period)
     phi = np.linspace(0.0, period, _START + 1)
     while True:
-        bad = _chord_error(f, phi) > tol
+        bad = chord_error(f, phi) > tol
         if not bad.any():
             return phi
         if len(phi) + int(bad.sum()) > _MAX_POINTS:
@@ -115,7 +115,7 @@ def check_rotary_tool(geometry: Any, tool_diameter_mm: float) -> None:
                                 f"use a tool smaller than {width:.6g} mm (e.g. {math.floor(width * 0.8):g} mm)"))
 
 
-def _rotary_post(post: str | Post) -> Post:
+def rotary_post(post: str | Post) -> Post:
     from .post import get_post
 
     p = get_post(post)
@@ -125,7 +125,7 @@ def _rotary_post(post: str | Post) -> Post:
     return p
 
 
-class _Writer:
+class RotaryWriter:
     """The program's lines in the post's dialect: number formats, comments, numbered blocks."""
 
     def __init__(self, p: Post, job: Job, tol: float):
@@ -218,12 +218,12 @@ class _Writer:
         self.block(["G0", "A0"])
 
 
-def _to_machine(P: np.ndarray, r: float, sigma: float) -> tuple[np.ndarray, np.ndarray]:
+def to_machine(P: np.ndarray, r: float, sigma: float) -> tuple[np.ndarray, np.ndarray]:
     """Developed (x, z) on radius r → machine X (mm along the axis) and A (degrees, A = −σ·x/r)."""
     return P[:, 1], np.degrees(-sigma * P[:, 0] / r)
 
 
-def _header(w: _Writer, geometry: Any, levels: list[float], safe: float, tol: float, over: float) -> None:
+def _header(w: RotaryWriter, geometry: Any, levels: list[float], safe: float, tol: float, over: float) -> None:
     cyl, mech, u = geometry.cylinder, geometry.mechanism, "in" if w.job.units == "inch" else "mm"
     w.header("camfab 4-axis program: cylindrical cam groove, centre pass and a finishing pass per flank",
              [f"groove: bottom Z{w.L(cyl.inner_radius_mm)}, outer Z{w.L(cyl.outer_radius_mm)}, "
@@ -233,7 +233,7 @@ def _header(w: _Writer, geometry: Any, levels: list[float], safe: float, tol: fl
              mech.rotation)
 
 
-def _finishing(w: _Writer, geometry: Any, tol_fin: float, safe: float, clear: float) -> tuple[int, float]:
+def _finishing(w: RotaryWriter, geometry: Any, tol_fin: float, safe: float, clear: float) -> tuple[int, float]:
     """One finishing pass per flank at full depth (:mod:`camfab.gcode.rotary_finish`): plunge on the pitch
     curve at cam angle 0, straight along its normal to the flank's cutter path, once round it in the job's
     milling direction, back to the pitch curve.  Returns the moves and the largest chord error."""
@@ -247,9 +247,9 @@ def _finishing(w: _Writer, geometry: Any, tol_fin: float, safe: float, clear: fl
             return flank_path(geometry, r_b, flank, r_c, way * t)
 
         phi = rotary_samples(geometry, r_b, tol_fin, curve)
-        worst = max(worst, float(np.max(_chord_error(curve, phi))))
+        worst = max(worst, float(np.max(chord_error(curve, phi))))
         ends = _developed(geometry, r_b, np.array([0.0, way * period]))
-        X, A = _to_machine(np.concatenate([ends[:1], curve(phi), ends[1:]]), r_b, sigma)
+        X, A = to_machine(np.concatenate([ends[:1], curve(phi), ends[1:]]), r_b, sigma)
         w.comment(f"finishing pass {name} flank Z{w.L(r_b)} ({'forwards' if way > 0 else 'backwards'}, "
                   f"{w.job.direction})")
         w.enter(X[0], A[0], r_b, safe, clear, [])
@@ -259,18 +259,15 @@ def _finishing(w: _Writer, geometry: Any, tol_fin: float, safe: float, clear: fl
 
 
 def rotary_gcode(geometry: Any, job: Job, tol: float, post: str | Post = "linuxcnc") -> tuple[bytes, int, float]:
-    """The 4-axis program (module notes) as bytes, its number of cutting ``G1 X.. A..`` moves and the largest
-    chord error (mm) of the written path on the developed cylinder of each level's radius (before rounding)."""
-    if geometry.cylinder.rib_width_mm is not None:  # a rib: camfab.gcode.rib_program
-        from .rib_program import rib_gcode
-
-        return rib_gcode(geometry, job, tol, post)
-    p = _rotary_post(post)
+    """The groove's 4-axis program (module notes) as bytes, its number of cutting ``G1 X.. A..`` moves and the
+    largest chord error (mm) of the written path on the developed cylinder of each level's radius (before
+    rounding).  A rib's program is :func:`~camfab.gcode.rib_program.rib_gcode`."""
+    p = rotary_post(post)
     check_rotary_tool(geometry, job.tool_diameter_mm)
     cyl = geometry.cylinder
     over = check_finishing_tool(geometry, job.tool_radius_mm, tol, np.linspace(0.0, geometry.period, 1441))
     sigma = float(geometry.mechanism.sense)
-    w = _Writer(p, job, tol)
+    w = RotaryWriter(p, job, tol)
     # rounding: X and Z by half an increment (mm), A by half an increment (degrees) on the outer radius
     h_lin = 0.5 * 10.0 ** -w.d / w.k
     h_ang = 0.5 * 10.0 ** -w.d * math.pi / 180.0 * cyl.outer_radius_mm
@@ -283,8 +280,8 @@ def rotary_gcode(geometry: Any, job: Job, tol: float, post: str | Post = "linuxc
     worst, moves = 0.0, 0
     for i, z in enumerate(levels):
         phi = rotary_samples(geometry, z, tol_fit)
-        worst = max(worst, float(np.max(_chord_error(functools.partial(_developed, geometry, z), phi))))
-        X, A = _to_machine(_developed(geometry, z, phi), z, sigma)
+        worst = max(worst, float(np.max(chord_error(functools.partial(_developed, geometry, z), phi))))
+        X, A = to_machine(_developed(geometry, z, phi), z, sigma)
         w.comment(f"centre pass level {i + 1} of {len(levels)} Z{w.L(z)}")
         w.enter(X[0], A[0], z, safe, clear, lenoff)
         lenoff = []
@@ -297,14 +294,6 @@ def rotary_gcode(geometry: Any, job: Job, tol: float, post: str | Post = "linuxc
     if p.percent:
         w.lines.append("%")
     return ("\n".join(w.lines) + "\n").encode("ascii"), moves + m, max(worst, e)
-
-
-#: the writer, the developed-to-machine map, the chord error and the post check, shared with the rib's program
-#: (:mod:`camfab.gcode.rib_program`)
-RotaryWriter = _Writer
-to_machine = _to_machine
-chord_error = _chord_error
-rotary_post = _rotary_post
 
 
 def cylinder_job(job: Job, geometry: Any) -> Job:

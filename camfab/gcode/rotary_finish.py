@@ -176,7 +176,7 @@ def twist_overcut(geometry: Any, flank: int, r_c: float, phi: np.ndarray) -> tup
     return worst, where
 
 
-def _largest_overcut(geometry: Any, r_c: float, phi: np.ndarray) -> tuple[float, float]:
+def largest_overcut(geometry: Any, r_c: float, phi: np.ndarray) -> tuple[float, float]:
     a, b = twist_overcut(geometry, 1, r_c, phi), twist_overcut(geometry, -1, r_c, phi)
     return a if a[0] >= b[0] else b
 
@@ -192,16 +192,16 @@ def check_finishing_tool(geometry: Any, tool_radius: float, tol: float, phi: np.
         raise SpecError(Problem("manufacturing.tool_diameter_mm", 2 * tool_radius,
                                 f"the finishing pass would gouge a flank: {flank_cutter_problem(contact, tool_radius)}",
                                 fix))
-    over, where = _largest_overcut(geometry, tool_radius, phi)
+    over, where = largest_overcut(geometry, tool_radius, phi)
     budget = TWIST_SHARE * tol
     if over <= budget:
         return over
     w = geometry.mechanism.half_width(geometry.cylinder.inner_radius_mm)
-    _refuse_off_radial_axis(geometry, w, budget, phi)
+    refuse_off_radial_axis(geometry, w, budget, phi)
     fit, cur = tool_radius, over  # the overcut is nearly proportional to w − r_c: secant steps to the budget
     for _ in range(4):
         fit = w - (w - fit) * 0.98 * budget / cur
-        cur = _largest_overcut(geometry, fit, phi)[0]
+        cur = largest_overcut(geometry, fit, phi)[0]
         if cur <= budget:
             break
     raise SpecError(Problem("manufacturing.tool_diameter_mm", 2 * tool_radius,
@@ -213,11 +213,11 @@ def check_finishing_tool(geometry: Any, tool_radius: float, tol: float, phi: np.
                             f"is {2 * w:.6g} mm wide), or a coarser tolerance"))
 
 
-def _refuse_off_radial_axis(geometry: Any, w: float, budget: float, phi: np.ndarray) -> None:
+def refuse_off_radial_axis(geometry: Any, w: float, budget: float, phi: np.ndarray) -> None:
     """An oscillating follower's roller axis is parallel to the radial line at 0°, swung aside by
     e = L·(1 − cos φ): not radial, so even a cutter of the groove's width on the pitch curve of the bottom cuts
     past the flanks higher up.  Refused (naming ``follower.arm_length_mm``) when that alone exceeds the budget."""
-    over, where = _largest_overcut(geometry, w, phi)
+    over, where = largest_overcut(geometry, w, phi)
     if over <= budget:
         return
     raise SpecError(Problem("follower.arm_length_mm", getattr(geometry.mechanism, "arm_length_mm", None),
@@ -236,8 +236,3 @@ def finishing_direction(flank: int, sense: int, climb: bool) -> int:
     milling keeps the material on the travel's right: the −z flank for σ = +1 going forwards."""
     forwards_is_climb = flank * sense < 0
     return 1 if forwards_is_climb == climb else -1
-
-
-#: shared with the rib's program (:mod:`camfab.gcode.rib_program`)
-largest_overcut = _largest_overcut
-refuse_off_radial_axis = _refuse_off_radial_axis

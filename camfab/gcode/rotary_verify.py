@@ -64,7 +64,7 @@ class RotaryVerifyReport(VerifyReport):
 
 
 @dataclasses.dataclass(frozen=True)
-class _Samples:
+class Samples:
     """Points of the cutting moves: X, A (deg), Z, the index of their move, on the tip's developed cylinder."""
 
     X: np.ndarray
@@ -77,11 +77,11 @@ class _Samples:
         r = self.Z if r is None else r
         return np.stack([-sigma * r * np.radians(self.A), self.X], axis=1)
 
-    def subset(self, keep: np.ndarray) -> _Samples:
-        return _Samples(self.X[keep], self.A[keep], self.Z[keep], self.move[keep])
+    def subset(self, keep: np.ndarray) -> Samples:
+        return Samples(self.X[keep], self.A[keep], self.Z[keep], self.move[keep])
 
 
-def _sample(moves: list[RotaryMove]) -> _Samples:
+def sample_moves(moves: list[RotaryMove]) -> Samples:
     """Every feed move sampled every ``_STEP`` mm of its length on the tip's cylinder (ends included)."""
     out: list[np.ndarray] = []
     for i, m in enumerate(moves):
@@ -95,10 +95,10 @@ def _sample(moves: list[RotaryMove]) -> _Samples:
              else np.ones(1))[:, None]
         out.append(np.hstack([a + t * (b - a), np.full((len(t), 1), i)]))
     arr = np.vstack(out) if out else np.zeros((0, 4))
-    return _Samples(arr[:, 0], arr[:, 1], arr[:, 2], arr[:, 3].astype(int))
+    return Samples(arr[:, 0], arr[:, 1], arr[:, 2], arr[:, 3].astype(int))
 
 
-def _by_radius(geometry: Any, smp: _Samples, sigma: float, r: np.ndarray | None = None) -> np.ndarray:
+def _by_radius(geometry: Any, smp: Samples, sigma: float, r: np.ndarray | None = None) -> np.ndarray:
     """Signed distance of each sample's axis from the exact pitch curve on radius r (default the tip's)."""
     r = smp.Z if r is None else r
     s = np.zeros(len(r))
@@ -109,7 +109,7 @@ def _by_radius(geometry: Any, smp: _Samples, sigma: float, r: np.ndarray | None 
     return s
 
 
-def _worst_per_pass(values: np.ndarray, smp: _Samples, moves: list[RotaryMove], limit: float, code: IssueCode,
+def worst_per_pass(values: np.ndarray, smp: Samples, moves: list[RotaryMove], limit: float, code: IssueCode,
                     what: str) -> list[Finding]:
     """One finding per pass (label) whose worst value exceeds ``limit``, at the worst move's line."""
     out = []
@@ -124,7 +124,7 @@ def _worst_per_pass(values: np.ndarray, smp: _Samples, moves: list[RotaryMove], 
     return out
 
 
-class _Context:
+class RotaryContext:
     """What every check needs: the design's geometry, the job, the tolerance and the read program."""
 
     def __init__(self, geometry: Any, job: Job, tol: float, moves: list[RotaryMove]):
@@ -132,7 +132,7 @@ class _Context:
         cyl = geometry.cylinder
         self.r_b, self.r_o, self.r_c = cyl.inner_radius_mm, cyl.outer_radius_mm, job.tool_radius_mm
         self.sigma = float(geometry.mechanism.sense)
-        cut = _sample(moves)
+        cut = sample_moves(moves)
         self.cut = cut.subset(np.less(cut.Z, self.r_o - 1e-9))
         labels = np.array([moves[i].label for i in self.cut.move], dtype=object)
         self.centre = self.cut.subset(np.array([lb.startswith("centre") for lb in labels], dtype=bool))
@@ -145,20 +145,20 @@ class _Context:
         return 1 if "+z" in label else -1 if "-z" in label else 0
 
 
-def _lateral(m: RotaryMove) -> bool:
+def is_lateral(m: RotaryMove) -> bool:
     return m.start[0] != m.end[0] or m.start[1] != m.end[1]
 
 
-def _deviation(ctx: _Context) -> tuple[float | None, float | None, list[Finding], int]:
+def _deviation(ctx: RotaryContext) -> tuple[float | None, float | None, list[Finding], int]:
     """The centre passes against the pitch curve and the finishing passes (leads left out) against their flank
     paths, on the tip's radius; (centre max, finishing max, findings, finishing moves measured)."""
     mv, out = ctx.moves, []
-    c = ctx.centre.subset(np.array([_lateral(mv[i]) for i in ctx.centre.move], dtype=bool))
+    c = ctx.centre.subset(np.array([is_lateral(mv[i]) for i in ctx.centre.move], dtype=bool))
     dev_c = np.abs(_by_radius(ctx.g, c, ctx.sigma)) if len(c.Z) else np.zeros(0)
-    out += _worst_per_pass(dev_c, c, mv, ctx.tol, IssueCode.DEVIATION, "off the exact pitch curve by")
+    out += worst_per_pass(dev_c, c, mv, ctx.tol, IssueCode.DEVIATION, "off the exact pitch curve by")
     keep = np.zeros(len(ctx.finish.Z), dtype=bool)
     for label in dict.fromkeys(mv[i].label for i in ctx.finish.move):
-        idx = sorted({int(i) for i in ctx.finish.move if mv[i].label == label and _lateral(mv[i])})
+        idx = sorted({int(i) for i in ctx.finish.move if mv[i].label == label and is_lateral(mv[i])})
         inner = set(idx[1:-1])  # the first and last lateral moves are the lead-in and the lead-out
         keep |= np.array([int(i) in inner for i in ctx.finish.move], dtype=bool)
     f = ctx.finish.subset(keep)
@@ -167,13 +167,13 @@ def _deviation(ctx: _Context) -> tuple[float | None, float | None, list[Finding]
     for fl in (1, -1):
         k = side == fl
         if np.any(k):
-            dev_f[k] = _from_cutter_path(ctx, f.subset(k), fl)
-    out += _worst_per_pass(dev_f, f, mv, ctx.tol, IssueCode.DEVIATION, "off its flank's exact cutter path by")
+            dev_f[k] = from_cutter_path(ctx, f.subset(k), fl)
+    out += worst_per_pass(dev_f, f, mv, ctx.tol, IssueCode.DEVIATION, "off its flank's exact cutter path by")
     best = lambda v: float(np.max(v)) if len(v) else None  # noqa: E731
     return best(dev_c), best(dev_f), out, len(set(f.move.tolist()))
 
 
-def _from_cutter_path(ctx: _Context, smp: _Samples, flank: int) -> np.ndarray:
+def from_cutter_path(ctx: RotaryContext, smp: Samples, flank: int) -> np.ndarray:
     """Distance (mm) of finishing samples from their flank's exact cutter path on each tip radius
     (:func:`~camfab.gcode.rotary_finish.flank_path`): on the path the cutter's exact section touches the flank, so
     the distance is, to first order, how far the section through the sample reaches past or falls short of it."""
@@ -185,7 +185,7 @@ def _from_cutter_path(ctx: _Context, smp: _Samples, flank: int) -> np.ndarray:
     return out
 
 
-def _penetration(ctx: _Context, smp: _Samples, r: np.ndarray) -> np.ndarray:
+def _penetration(ctx: RotaryContext, smp: Samples, r: np.ndarray) -> np.ndarray:
     """How far (mm) the exact section on radius r of the radial cutter through each sample reaches past either
     flank (:func:`~camfab.gcode.rotary_finish.cutter_penetration`)."""
     pen = np.full(len(r), -np.inf)
@@ -197,7 +197,7 @@ def _penetration(ctx: _Context, smp: _Samples, r: np.ndarray) -> np.ndarray:
     return pen
 
 
-def _gouge(ctx: _Context) -> tuple[float, dict | None, list[Finding]]:
+def _gouge(ctx: RotaryContext) -> tuple[float, dict | None, list[Finding]]:
     """The radial cutter's section on six radii from its tip to the outer surface inside the groove."""
     smp = ctx.cut
     worst, at = -math.inf, None
@@ -211,11 +211,11 @@ def _gouge(ctx: _Context) -> tuple[float, dict | None, list[Finding]]:
             worst = float(pen[j])
             at = {"x": float(smp.X[j]), "y": 0.0, "z": float(smp.Z[j]), "a_deg": float(smp.A[j]),
                   "radius_mm": float(rho[j]), "line": ctx.moves[smp.move[j]].line, "penetration_mm": worst}
-    found = _worst_per_pass(pen_all, smp, ctx.moves, ctx.tol, IssueCode.GOUGE, "the cutter cuts past a flank by")
+    found = worst_per_pass(pen_all, smp, ctx.moves, ctx.tol, IssueCode.GOUGE, "the cutter cuts past a flank by")
     return worst, (at if found else None), found
 
 
-def _gap(probes: np.ndarray, smp: _Samples, moves: list[RotaryMove], sigma: float, r: float, span: float) -> float:
+def _gap(probes: np.ndarray, smp: Samples, moves: list[RotaryMove], sigma: float, r: float, span: float) -> float:
     """Largest distance (mm) from the probes (developed on radius r, x in [0, span)) to the moves of ``smp``."""
     from scipy.spatial import cKDTree
 
@@ -242,7 +242,7 @@ def _gap(probes: np.ndarray, smp: _Samples, moves: list[RotaryMove], sigma: floa
     return float(dist.min(axis=1).max())
 
 
-def _coverage(ctx: _Context) -> tuple[float, list[Finding]]:
+def _coverage(ctx: RotaryContext) -> tuple[float, list[Finding]]:
     """The centre pass on the groove bottom and each flank's finishing pass over the whole track."""
     period = float(ctx.g.period)
     phi = np.linspace(0.0, period, _PROBES, endpoint=False)
@@ -266,7 +266,7 @@ def _coverage(ctx: _Context) -> tuple[float, list[Finding]]:
     return worst, out
 
 
-def floor_findings(ctx: _Context, floor: str) -> list[Finding]:
+def floor_findings(ctx: RotaryContext, floor: str) -> list[Finding]:
     """Nothing cut below the ``floor`` radius ``ctx.r_b`` (named: the groove bottom, the rib's root), every
     finishing pass on it."""
     out, tol, mv = [], ctx.tol, ctx.moves
@@ -281,7 +281,7 @@ def floor_findings(ctx: _Context, floor: str) -> list[Finding]:
     return out
 
 
-def step_down_findings(ctx: _Context) -> list[Finding]:
+def step_down_findings(ctx: RotaryContext) -> list[Finding]:
     """No feed plunging deeper than the job's step-down below what was cut before."""
     out, tol, deepest = [], ctx.tol, ctx.r_o
     for m in ctx.moves:
@@ -293,7 +293,7 @@ def step_down_findings(ctx: _Context) -> list[Finding]:
     return out
 
 
-def _depth(ctx: _Context) -> list[Finding]:
+def _depth(ctx: RotaryContext) -> list[Finding]:
     """Nothing below the groove bottom, the finishing passes and a centre pass on it, step-downs kept."""
     out = floor_findings(ctx, "the groove bottom")
     if not (np.abs(ctx.centre.Z - ctx.r_b) <= ctx.tol).any():
@@ -302,7 +302,7 @@ def _depth(ctx: _Context) -> list[Finding]:
     return out + step_down_findings(ctx)
 
 
-def _feeds(ctx: _Context) -> list[Finding]:
+def feed_findings(ctx: RotaryContext) -> list[Finding]:
     """Inverse-time moves at the cutting feed on the tip's cylinder, plunges at the plunge feed, spindle on M3."""
     out, job = [], ctx.job
     for m in ctx.moves:
@@ -318,25 +318,25 @@ def _feeds(ctx: _Context) -> list[Finding]:
             continue
         r = 0.5 * (m.start[2] + m.end[2])
         length = math.hypot(m.end[0] - m.start[0], r * math.radians(m.end[1] - m.start[1]), m.end[2] - m.start[2])
-        if _lateral(m) and not m.inverse_time:
+        if is_lateral(m) and not m.inverse_time:
             out.append(Finding.at_line(IssueCode.FEED_OUT_OF_RANGE, "a move turning A in G94: its feed mixes mm and "
                                        "degrees; camfab writes them in inverse time (G93)", m.line))
             continue
         speed = length * m.feed if m.inverse_time else m.feed
-        want = job.feed_mm_min if _lateral(m) else job.plunge_feed_mm_min
+        want = job.feed_mm_min if is_lateral(m) else job.plunge_feed_mm_min
         if length > 1e-6 and abs(speed - want) > 0.01 * want + 0.1:
             out.append(Finding.at_line(IssueCode.FEED_OUT_OF_RANGE, f"runs at {speed:.1f} mm/min on the tool tip's "
                                        f"cylinder, not the job's {want:.1f} mm/min", m.line))
     return out
 
 
-def _rapids_and_end(ctx: _Context) -> list[Finding]:
+def rapid_findings(ctx: RotaryContext) -> list[Finding]:
     out = []
     safe = ctx.r_o + ctx.job.safe_z_mm
     for m in ctx.moves:
         if m.kind != "rapid":
             continue
-        if _lateral(m) and min(m.start[2], m.end[2]) < safe - ctx.tol:
+        if is_lateral(m) and min(m.start[2], m.end[2]) < safe - ctx.tol:
             out.append(Finding.at_line(IssueCode.RAPID_BELOW_SAFE, f"a rapid turns or moves along the axis at "
                                        f"Z{min(m.start[2], m.end[2]):g}, below the safe radius {safe:g}", m.line))
         if m.end[2] < ctx.r_o:
@@ -348,7 +348,7 @@ def _rapids_and_end(ctx: _Context) -> list[Finding]:
     return out
 
 
-def _directions(ctx: _Context) -> list[Finding]:
+def _directions(ctx: RotaryContext) -> list[Finding]:
     """Each flank's pass in the job's milling direction (:func:`~camfab.gcode.rotary_finish.finishing_direction`)."""
     out, climb = [], ctx.job.direction == "climb"
     for label in dict.fromkeys(ctx.moves[i].label for i in ctx.finish.move):
@@ -378,16 +378,13 @@ def read_or_refused(program: str | bytes, tol: float) -> list[RotaryMove] | Rota
 
 
 def verify_rotary_program(program: str | bytes, geometry: Any, job: Job, *, tol: float) -> RotaryVerifyReport:
-    """``camfab verify`` of a cylindrical cam's 4-axis program (module notes); ``job`` cut to the groove's
-    depth (:func:`~camfab.gcode.rotary.cylinder_job`)."""
-    if geometry.cylinder.rib_width_mm is not None:  # a rib's program (camfab.gcode.rib_verify)
-        from .rib_verify import verify_rib_program
-
-        return verify_rib_program(program, geometry, job, tol=tol)
+    """``camfab verify`` of a grooved cylindrical cam's 4-axis program (module notes); ``job`` cut to the
+    groove's depth (:func:`~camfab.gcode.rotary.cylinder_job`).  A rib's program is verified by
+    :func:`~camfab.gcode.rib_verify.verify_rib_program`."""
     moves = read_or_refused(program, tol)
     if isinstance(moves, RotaryVerifyReport):
         return moves
-    ctx = _Context(geometry, job, tol, moves)
+    ctx = RotaryContext(geometry, job, tol, moves)
     problems: list[Finding] = []
     if not len(ctx.cut.Z):
         problems.append(Finding.at_line(IssueCode.NO_CUTTING_MOVES, "no cutting move below the outer radius", None))
@@ -397,7 +394,7 @@ def verify_rotary_program(program: str | bytes, geometry: Any, job: Job, *, tol:
     dev_c, dev_f, found, n_fin = _deviation(ctx)
     pen, gouge_at, gouges = _gouge(ctx)
     gap, uncovered = _coverage(ctx)
-    problems += found + gouges + uncovered + _depth(ctx) + _feeds(ctx) + _rapids_and_end(ctx) + _directions(ctx)
+    problems += found + gouges + uncovered + _depth(ctx) + feed_findings(ctx) + rapid_findings(ctx) + _directions(ctx)
     devs = [d for d in (dev_c, dev_f) if d is not None]
     summary = {"centre_max_deviation_mm": dev_c, "finishing_max_deviation_mm": dev_f,
                "max_penetration_mm": pen if math.isfinite(pen) else None,
@@ -410,14 +407,3 @@ def verify_rotary_program(program: str | bytes, geometry: Any, job: Job, *, tol:
              "speed and the modal state")
     return RotaryVerifyReport(max(devs) if devs else None, bool(gouges), gouge_at, tuple(problems), tol,
                               gap if math.isfinite(gap) else None, n_fin, notes, summary)
-
-
-#: shared with the rib's verify (:mod:`camfab.gcode.rib_verify`)
-RotaryContext = _Context
-Samples = _Samples
-sample_moves = _sample
-worst_per_pass = _worst_per_pass
-feed_findings = _feeds
-rapid_findings = _rapids_and_end
-is_lateral = _lateral
-from_cutter_path = _from_cutter_path

@@ -20,9 +20,9 @@ from camfab import pipeline
 from camfab.cli import main
 from camfab.errors import SpecError
 from camfab.gcode.model import design_job
-from camfab.gcode.rib_program import check_rib_tool
-from camfab.gcode.rotary import cylinder_job, rotary_gcode
-from camfab.gcode.rotary_verify import verify_rotary_program
+from camfab.gcode.rib_program import check_rib_tool, rib_gcode
+from camfab.gcode.rib_verify import verify_rib_program
+from camfab.gcode.rotary import cylinder_job
 from camfab.offset.cutter import concave_limit
 from tests.design.test_cylinder_rib import RIB_TOML as RIB_6MM
 
@@ -46,13 +46,13 @@ def setup(design):
     cam = pipeline.load(str(design))
     tol = cam.tolerance()
     job = cylinder_job(design_job(cam.spec, tol=tol), cam.geometry)
-    data, _, _ = rotary_gcode(cam.geometry, job, tol, "linuxcnc")
+    data, _, _ = rib_gcode(cam.geometry, job, tol, "linuxcnc")
     return cam.geometry, job, tol, data.decode()
 
 
 def _verify(setup, text, job=None):
     geometry, job0, tol, _ = setup
-    return verify_rotary_program(text, geometry, job or job0, tol=tol)
+    return verify_rib_program(text, geometry, job or job0, tol=tol)
 
 
 @pytest.mark.skipif(RS274 is None, reason="LinuxCNC's rs274 interpreter is not installed (linuxcnc-uspace)")
@@ -63,7 +63,7 @@ def test_rs274_runs_the_rib_program(setup, tmp_path, post):
     the root reach past both ends of the cylinder."""
     geometry, job, tol, text = setup
     if post != "linuxcnc":
-        text = rotary_gcode(geometry, job, tol, post)[0].decode()
+        text = rib_gcode(geometry, job, tol, post)[0].decode()
     (tmp_path / "p.ngc").write_text(text)
     proc = subprocess.run([str(RS274), "-g", str(tmp_path / "p.ngc")], capture_output=True, text=True, timeout=300,
                           stdin=subprocess.DEVNULL)
@@ -138,7 +138,7 @@ def test_coverage_catches_a_deleted_roughing_ring(setup):
     below that band's width times 2π·r_b."""
     geometry, job, tol, _ = setup
     job = dataclasses.replace(job, roughing_stepover_mm=0.75 * TOOL_D)
-    lines = rotary_gcode(geometry, job, tol, "linuxcnc")[0].decode().splitlines()
+    lines = rib_gcode(geometry, job, tol, "linuxcnc")[0].decode().splitlines()
     assert _verify(setup, "\n".join(lines), job).ok
     rings = [ln for ln in lines if ln.startswith("(roughing pass level 4") and "+z" in ln and "ring" in ln]
     assert len(rings) >= 2
@@ -160,7 +160,7 @@ def test_a_too_large_cutter_leaves_material_verify_sees_it(setup, monkeypatch):
     geometry, job, tol, _ = setup
     big = dataclasses.replace(job, tool_diameter_mm=14.0)
     monkeypatch.setattr(rib_program, "check_rib_tool", lambda *a, **k: 0.0)
-    rep = _verify(setup, rotary_gcode(geometry, big, tol, "linuxcnc")[0], big)
+    rep = _verify(setup, rib_gcode(geometry, big, tol, "linuxcnc")[0], big)
     assert rep.codes() == {"DEVIATION"} and not rep.gouge
     assert all("above the root" in p.message for p in rep.problems) and rep.max_deviation_mm > 0.03
 
@@ -173,7 +173,7 @@ def test_a_thin_allowance_roughs_within_the_tolerance(setup):
     cutter sections on six radii; 9.1 µm of 10 before the scaling, 7.6 µm with it)."""
     geometry, job, tol, _ = setup
     thin = dataclasses.replace(job, roughing_allowance_mm=0.001)
-    rep = _verify(setup, rotary_gcode(geometry, thin, tol, "linuxcnc")[0].decode(), thin)
+    rep = _verify(setup, rib_gcode(geometry, thin, tol, "linuxcnc")[0].decode(), thin)
     assert rep.ok and not rep.gouge
     assert rep.rotary["max_penetration_mm"] <= 0.8 * tol
 
