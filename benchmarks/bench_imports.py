@@ -40,8 +40,10 @@ CASES = (
 def _cpu(args: list[str], env: dict[str, str], cwd: str) -> float:
     """The CPU time (user + system, s) of one fresh interpreter running ``args``."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    subprocess.run([sys.executable, *args], env=env, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                   check=False)
+    rc = subprocess.run([sys.executable, *args], env=env, cwd=cwd, stdout=subprocess.DEVNULL,
+                        stderr=subprocess.DEVNULL, check=False).returncode
+    if rc not in (0, 1):  # 1: a check's verdict; anything else did not run what is timed
+        raise SystemExit(f"{' '.join(args)} exited {rc}: nothing to time")
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     return after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime
 

@@ -360,17 +360,16 @@ def _dxf(cam: Cam, req: Request) -> list[Artifact]:
     from .gcode.cam import contour_paths  # the G-code's tool paths (docs/decisions.md, "The DXF tool path is …")
 
     tol, draw = cam.tolerance(req.tol), _tool_paths(cam, req) and cam.spec.cam.kind != "groove"
-    paths = draw and contour_paths(cam.spec, cam.geometry, req.machining, tol=tol, post=req.post, cache=cam._tool_paths)
+    paths = draw and contour_paths(cam.spec, cam.geometry, req.machining, tol=tol, post=req.post, cache=cam._tool_paths,
+                                   profiles=cam.shapes(tol).profiles)
     return build_artifacts(cam.spec, cam.geometry, ["dxf"], tol=tol, dxf_flavour=req.dxf_flavour,
                            tool_paths=_tool_paths(cam, req), shapes=cam.shapes(tol), tool_centre=paths or None)
 
 
 def _stl(cam: Cam, req: Request) -> list[Artifact]:
     tol = cam.tolerance(req.tol)
-    if tol in cam._shapes:
-        return build_artifacts(cam.spec, cam.geometry, ["stl"], tol=tol, shapes=cam.shapes(tol))
-    require_followable(cam.check())  # as cam.shapes does; the mesh needs the curves, not the fit within tol
-    return build_artifacts(cam.spec, cam.geometry, ["stl"], tol=tol)
+    require_followable(cam.check())  # as cam.shapes does; without the plate's fit the mesh fits the same arcs itself
+    return build_artifacts(cam.spec, cam.geometry, ["stl"], tol=tol, shapes=cam._shapes.get(tol))
 
 
 def _step(cam: Cam, req: Request) -> list[Artifact]:
@@ -450,7 +449,8 @@ def _gcode(cam: Cam, req: Request) -> list[Artifact]:
         return [Artifact(f"{safe_stem(cam.name)}.nc", data, "gcode", moves, dev, req.post)]
     if cam.spec.cam.kind == "groove":  # one program mills the slot of both flanks
         return [Artifact(f"{safe_stem(cam.name)}.nc", *groove_gcode(cam.geometry, job, tol, m, req.post), req.post)]
-    out, paths = [], contour_paths(cam.spec, cam.geometry, req.machining, tol=tol, post=req.post, cache=cam._tool_paths)
+    out, paths = [], contour_paths(cam.spec, cam.geometry, req.machining, tol=tol, post=req.post,
+                                   cache=cam._tool_paths, profiles=cam.shapes(tol).profiles)
     for i, contact in enumerate(cam.geometry.profiles):
         cp = cam_program(contact, job, tol=tol, compensation=m.compensation, arcs_allowed=not m.lines_only,
                          post=req.post, path=paths[i] if paths else None)

@@ -10,6 +10,7 @@ __all__ = [
     "DEFAULT_EXPORT_TOL_MM",
     "MIN_EXPORT_TOL_MM",
     "MAX_EXPORT_TOL_MM",
+    "PROFILE_FIT_SHARE",
     "MAX_ARC_RADIUS_MM",
     "ARC_RADIUS_OVER_SIZE",
     "arc_radius_limit",
@@ -30,6 +31,10 @@ CAMDAS_STEP_DEG = 1.0
 DEFAULT_EXPORT_TOL_MM = 0.001
 MIN_EXPORT_TOL_MM = 1e-6
 MAX_EXPORT_TOL_MM = 0.1
+#: the share of the export tolerance a plate cam's one arc fit per profile may use (docs/decisions.md, "One arc fit
+#: per profile"): the DXF, drawing and solids draw it, the pitch curve and the program's tool paths are its exact
+#: offsets, and the STL flattens it within the rest of the tolerance
+PROFILE_FIT_SHARE = 0.5
 #: arcs of a larger radius (mm) are written as chords within the tolerance in STEP and, by default, in G-code
 #: (``Post.max_arc_radius_mm``): docs/decisions.md, "Arc radius limit"
 MAX_ARC_RADIUS_MM = 5000.0

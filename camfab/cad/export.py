@@ -18,12 +18,11 @@ import numpy as np
 from ..design.kinds import ContactKind
 from ..discretize import arcs, arcs_within_radius, measure_within, validate_tol
 from ..discretize.curve import discontinuities
-from ..discretize.tolerance import within
 from ..errors import GeometryError
 from ..geom2d import ArcChain
 from ..io import atomic_write, inside, safe_stem
-from ..offset.cutter import ToolCentrePath, pitch_curve, profile_curve, tool_centre_path
-from ..tolerances import arc_radius_limit
+from ..offset.cutter import ToolCentrePath, offset_loop, pitch_curve, profile_curve, tool_centre_path
+from ..tolerances import PROFILE_FIT_SHARE, arc_radius_limit
 from . import dxf as dxf_mod
 from . import step, stl
 from .artifact import Artifact, CamShapes
@@ -38,14 +37,17 @@ log = logging.getLogger(__name__)
 
 
 def cam_shapes(geometry, *, tol: float, with_pitch: bool = True) -> CamShapes:
-    """Arc-fit every profile of ``geometry`` within ``tol`` (measured)."""
+    """Arc-fit every profile of ``geometry`` within ``PROFILE_FIT_SHARE·tol`` (measured), once for every file of
+    the plate: the DXF, drawing and solids draw these arcs, the STL flattens them within the rest of ``tol``, and
+    the pitch curve and the program's tool paths are their exact offsets where those lie within their tolerance
+    (docs/decisions.md, "One arc fit per profile")."""
     tol = validate_tol(tol)
     profiles, pitch, curves = [], [], []
     groove = getattr(getattr(geometry, "mechanism", None), "cam_kind", None) == "groove"
     for i, c in enumerate(geometry.profiles):
         curve = profile_curve(c)
         _require_continuous(curve, tol)
-        profiles.append(arcs(curve, tol=tol))
+        profiles.append(arcs(curve, tol=tol * PROFILE_FIT_SHARE))
         curves.append(curve)
         # a groove's flanks share one pitch curve, the inner flank's offset (the outer flank's offset by +w lies
         # 2w off it: measured far from every sample, then fitted again, for nothing)
@@ -72,19 +74,10 @@ def _require_continuous(curve, tol: float) -> None:
 
 def _pitch_loop(profile: ArcChain, roller_radius: float, pitch, tol: float) -> ArcChain:
     """The pitch curve's arcs: the profile's arc chain offset by the roller radius (exact for a G1 chain:
-    concentric arcs), kept when its deviation from the exact pitch curve, measured, is within ``tol``;
-    otherwise (or for a chain with corners) a fit of its own."""
-    loop = profile.offset_g1(roller_radius)
-    if loop is not None:
-        dev = float(measure_within(loop, pitch, tol).max)
-        if within(dev, tol):
-            return loop.with_deviation(dev)
-        log.info("pitch curve: the profile's arcs offset by the roller radius %g mm deviate %.3g mm > tol = %g mm "
-                 "from it; falling back to a fit of its own", roller_radius, dev, tol)
-    else:
-        log.info("pitch curve: the profile's arc chain has a corner or an arc below the roller radius %g mm, so "
-                 "it has no exact offset; falling back to a fit of its own", roller_radius)
-    return arcs(pitch, tol=tol)
+    concentric arcs, :func:`~camfab.offset.cutter.offset_loop`), kept when its deviation from the exact pitch
+    curve, measured, is within ``tol``; otherwise (or for a chain with corners) a fit of its own."""
+    loop = offset_loop(profile, roller_radius, pitch, tol)
+    return loop if loop is not None else arcs(pitch, tol=tol)
 
 
 def plate_of(spec) -> PlateSpec:
@@ -146,7 +139,7 @@ def build_artifacts(spec, geometry, formats: Iterable[str], *, tol: float, dxf_f
         say("DXF")
         out.append(_dxf(spec, geometry, shapes, plate, tol, dxf_flavour, tool_paths, tool_centre))
     if "stl" in formats:
-        out += _stl_artifacts(spec, shapes.curves, plate, tol, say)
+        out += _stl_artifacts(spec, shapes.curves, plate, tol, say, shapes.profiles)
     if "step" in formats:
         loops, devs = solid_outlines(shapes, tol)
         for i, (loop, dev) in enumerate(zip(loops, devs, strict=True)):
@@ -172,16 +165,19 @@ def profile_curves(geometry, tol: float) -> list:
     return curves
 
 
-def _stl_artifacts(spec, curves, plate: PlateSpec, tol: float, say: Callable[[str], None]) -> list[Artifact]:
-    """One STL per profile curve: arcs within tol/2 of the curve, flattened within tol/2 of the arcs (within
-    tol overall), the deviation of the flattened polyline measured."""
+def _stl_artifacts(spec, curves, plate: PlateSpec, tol: float, say: Callable[[str], None],
+                   fits: Sequence[ArcChain] = ()) -> list[Artifact]:
+    """One STL per profile curve: its arcs within ``PROFILE_FIT_SHARE·tol`` (``fits``, the plate's own fit, when
+    the caller has them; fitted here otherwise: the same arcs), flattened within the rest of ``tol``, the
+    deviation of the flattened polyline measured."""
     out = []
     n = len(curves)
+    rest = tol * (1.0 - PROFILE_FIT_SHARE)
     for i, curve in enumerate(curves):
         say(f"STL{_suffix(i, n)}")
-        fine = arcs(curve, tol=tol / 2)
-        dev = float(measure_within(fine.flatten(tol / 2), curve, tol).max)
-        data = stl.dumps(fine, plate, tol=tol / 2, name=spec.name)
+        fine = fits[i] if fits else arcs(curve, tol=tol * PROFILE_FIT_SHARE)
+        dev = float(measure_within(fine.flatten(rest), curve, tol).max)
+        data = stl.dumps(fine, plate, tol=rest, name=spec.name)
         out.append(Artifact(f"{safe_stem(spec.name)}{_suffix(i, n)}.stl", data, "stl", None, dev))
     return out
 
@@ -209,7 +205,8 @@ def _dxf(spec, geometry, shapes: CamShapes, plate: PlateSpec, tol: float, flavou
     if tool_paths and tool_centre is not None:
         tools = tuple(p.arcs for p in tool_centre)
     elif tool_paths and tool_d:
-        tools = tuple(tool_centre_path(c, tool_d / 2, tol=tol).arcs for c in geometry.profiles)
+        tools = tuple(tool_centre_path(c, tool_d / 2, tol=tol, profile_arcs=p).arcs
+                      for c, p in zip(geometry.profiles, shapes.profiles, strict=True))
     c = geometry.profiles[0]  # a roller's prime circle; a curved face's centre of curvature starts on R_b + R
     rr = c.roller_radius if c.kind is ContactKind.ROLLER else 0.0
     content = dxf_mod.DxfContent(

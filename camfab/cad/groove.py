@@ -23,6 +23,7 @@ from ..geom2d import ArcChain
 from ..io import safe_stem
 from ..offset.groove import groove_tool_paths
 from ..textsafe import plain
+from ..tolerances import PROFILE_FIT_SHARE
 from . import dxf as dxf_mod
 from . import step
 from .export import Artifact, CamShapes, plate_of, solid_outlines
@@ -56,10 +57,12 @@ def groove_artifacts(spec, geometry, formats: list[str], *, shapes: CamShapes, t
     if "dxf" in formats:
         out.append(_dxf(spec, geometry, shapes, plate, outline, tol, dxf_flavour, tool_paths))
     if "stl" in formats:
-        fine = [arcs(c, tol=tol / 2) for c in shapes.curves]
-        dev = max(float(measure_within(f.flatten(tol / 2), c, tol).max)
-                  for f, c in zip(fine, shapes.curves, strict=True))
-        data = _stl_bytes(groove_mesh(outline, fine[0], fine[1], plate, depth, tol=tol / 2), spec.name, tol / 2)
+        # the flanks' plate fit (within PROFILE_FIT_SHARE·tol) when built, else the same fit here; flattened within
+        # the rest of tol
+        fine = list(shapes.profiles) or [arcs(c, tol=tol * PROFILE_FIT_SHARE) for c in shapes.curves]
+        rest = tol * (1.0 - PROFILE_FIT_SHARE)
+        dev = max(float(measure_within(f.flatten(rest), c, tol).max) for f, c in zip(fine, shapes.curves, strict=True))
+        data = _stl_bytes(groove_mesh(outline, fine[0], fine[1], plate, depth, tol=rest), spec.name, rest)
         out.append(Artifact(f"{stem}.stl", data, "stl", None, dev))
     if "step" in formats:
         (inner, outer), devs = solid_outlines(shapes, tol)

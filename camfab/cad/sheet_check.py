@@ -168,12 +168,7 @@ def _any_crosses(quads: np.ndarray, seg: np.ndarray, eps: float = 0.05) -> bool:
 
 def _overlap(a: np.ndarray, b: np.ndarray, eps: float = 0.05) -> bool:
     """Whether two boxes (corners (4, 2)) share more than a rim of ``eps``."""
-    for n in np.vstack([_axes(a), _axes(b)]):
-        n = n / np.hypot(*n)
-        pa, pb = a @ n, b @ n
-        if pa.max() - eps <= pb.min() or pb.max() - eps <= pa.min():
-            return False
-    return True
+    return _any_overlap(a, b[None], eps)
 
 
 def _any_overlap(a: np.ndarray, others: np.ndarray, eps: float = 0.05) -> bool:

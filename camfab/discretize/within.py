@@ -12,17 +12,31 @@ measured once more with the gap half the room left (:data:`MIN_GAP_SHARE` of ``t
 of samples).  When no certificate holds (a chain farther than ``tol``, an arc tighter than ``tol``) the full
 measurement runs, so the answer is never weaker than :func:`measure_deviation`'s; the value reported is then
 exactly that measurement's.
+
+The certificate is made only for tangent-continuous chains (a pitch loop, a tool path offset from a fit).  Where
+a chain has a corner and the curve passes on its inner side, the distance to the chain is the smaller of two
+entities' distances, whose slopes differ by up to the corner's turn ``θ``: a kink that may exceed the sampled
+maximum by ``θ·h/4``, a first-order term the ``K·h²/8`` bound does not cover.  A polyline (an STL outline) or
+chords of large arcs therefore get the full measurement, and so does a curve whose stand-in misses ``tol/200``
+(:data:`~camfab.discretize.surrogate.SURROGATE_MAX_NODES` reached): its curvature and speed bounds would be
+weaker evidence.
 """
 from __future__ import annotations
 
+import numpy as np
+
+from ..geom2d import cross, dot
 from .certify import CERTIFY_SHARE, DEFAULT_SAMPLES, sample_gap, samples_for, semiconcavity
 from .curve import ParametricCurve
 from .measure import as_chain, measure_deviation, measure_fit
 from .results import Deviation
-from .surrogate import fit_surrogate
+from .surrogate import SURROGATE_FRACTION, fit_surrogate
 from .tolerance import WRITE_ROOM_MM, validate_tol, within
 
-__all__ = ["MIN_GAP_SHARE", "measure_within"]
+__all__ = ["CORNER_RAD", "MIN_GAP_SHARE", "measure_within"]
+
+#: a joint whose tangents turn by more than this (rad) is a corner: no certificate (module notes)
+CORNER_RAD = 1e-9
 
 #: the smallest gap (share of ``tol``) a second certificate may ask for: at most ``sqrt(CERTIFY_SHARE /
 #: MIN_GAP_SHARE)`` = 5 times the first one's samples
@@ -51,7 +65,11 @@ def measure_within(entities, curve: ParametricCurve, tol: float) -> Deviation:
     """
     tol = validate_tol(tol)
     chain = as_chain(entities, curve.closed)
-    sur, _ = fit_surrogate(curve, tol)
+    if chain.n == 0 or _largest_turn(chain, curve.closed) > CORNER_RAD:
+        return measure_deviation(chain, curve)
+    sur, err = fit_surrogate(curve, tol)
+    if not err <= tol / SURROGATE_FRACTION:
+        return measure_deviation(chain, curve)
     K, vmax = semiconcavity(sur, chain, tol)
     gap = CERTIFY_SHARE * tol
     while gap >= MIN_GAP_SHARE * tol:
@@ -66,3 +84,10 @@ def measure_within(entities, curve: ParametricCurve, tol: float) -> Deviation:
             break
         gap = 0.5 * (tol - WRITE_ROOM_MM - dev.max)
     return measure_deviation(chain, curve)
+
+
+def _largest_turn(chain, closed: bool) -> float:
+    """The largest tangent turn (rad) at the chain's joints (the closing one too when ``closed``)."""
+    out, into = chain.end_tangent, np.roll(chain.tangent, -1, axis=0)
+    turn = np.arctan2(np.abs(cross(out, into)), dot(out, into))
+    return float(turn.max() if closed else turn[:-1].max(initial=0.0))

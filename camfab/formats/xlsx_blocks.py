@@ -20,9 +20,12 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import InternalError
+
 __all__ = ["NumberBlocks", "workbook_bytes"]
 
-_DIMENSION = re.compile(rb'<dimension ref="([A-Z]+[0-9]+(?::[A-Z]+[0-9]+)?)" />')
+_DIMENSION = re.compile(rb'<dimension ref="([A-Z]+[0-9]+(?::[A-Z]+[0-9]+)?)"\s*/>')
+_SHEET_DATA_END = re.compile(rb"</sheetData>|<sheetData\s*/>")
 
 
 class NumberBlocks:
@@ -78,17 +81,23 @@ def _patch(ws: Any, first: int, cols: list[tuple[int, list[str | None]]]) -> Cal
                   for i, t in enumerate(texts)] for letter, texts in ((get_column_letter(c), t) for c, t in cols)]
         block = "".join(f'<row r="{first + i}">{"".join(row)}</row>'
                         for i, row in zip(range(n), zip(*cells, strict=True), strict=True)).encode()
-        if b"</sheetData>" in xml:
-            xml = xml.replace(b"</sheetData>", block + b"</sheetData>", 1)
-        else:
-            xml = xml.replace(b"<sheetData />", b"<sheetData>" + block + b"</sheetData>", 1)
+        # cells or row settings added through openpyxl after add() would be rows of their own: a duplicate row
+        if any(c.row >= first for c in ws._cells.values()) or any(r >= first for r in ws.row_dimensions):
+            raise InternalError(f"sheet {ws.title!r} has openpyxl cells or rows inside its number block")
+        xml, k = _SHEET_DATA_END.subn(lambda m: b"<sheetData>" * m.group().startswith(b"<sheetData") + block
+                                      + b"</sheetData>", xml, count=1)
+        if k != 1:  # openpyxl's writer changed (lxml's?): never write a sheet without its numbers
+            raise InternalError(f"sheet {ws.title!r}: no <sheetData> in openpyxl's XML to add the numbers to")
         # the dimension openpyxl computes over every cell, the block's included
         min_col, min_row, max_col, max_row = cols[0][0], first, cols[-1][0], first + n - 1
         if ws._cells:
             c0, r0, c1, r1 = range_boundaries(ws.calculate_dimension())
             min_col, min_row, max_col, max_row = min(min_col, c0), min(min_row, r0), max(max_col, c1), max(max_row, r1)
         ref = f"{get_column_letter(min_col)}{min_row}:{get_column_letter(max_col)}{max_row}"
-        return _DIMENSION.sub(f'<dimension ref="{ref}" />'.encode(), xml, count=1)
+        xml, k = _DIMENSION.subn(f'<dimension ref="{ref}" />'.encode(), xml, count=1)
+        if k != 1:
+            raise InternalError(f"sheet {ws.title!r}: no <dimension> in openpyxl's XML to widen to the numbers")
+        return xml
 
     return run
 

@@ -9,7 +9,7 @@ reaches the toolpath builder as an :class:`~camfab.geom2d.ArcChain`.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -19,7 +19,7 @@ from ..discretize import ParametricCurve, arcs, arcs_within_radius, polyline
 from ..discretize.fit import REFIT_SHARE
 from ..errors import ApiError
 from ..geom2d import ArcChain
-from ..offset.cutter import ToolCentrePath, offset_curve, profile_curve, tool_centre_path
+from ..offset.cutter import ToolCentrePath, offset_curve, offset_loop, profile_curve, tool_centre_path
 from ..tolerances import arc_radius_limit
 from .distance import CurveDistance
 from .model import Job, Program, machining_of
@@ -65,14 +65,18 @@ def contour_fit_tolerance(tol: float, post=None, units: str = "mm") -> float:
 
 
 def contour_paths(spec, geometry, overrides: Mapping[str, Any] | None = None, *, tol: float, post=None,
-                  cache: dict | None = None) -> tuple[ToolCentrePath, ...] | None:
+                  cache: dict | None = None, profiles: Sequence[ArcChain] = ()
+                  ) -> tuple[ToolCentrePath, ...] | None:
     """The tool-centre path of every profile of ``geometry`` that :func:`cam_program` makes the finishing contour
     of: the design's tool (``overrides["tool_diameter_mm"]`` when given), fitted within
     :func:`contour_fit_tolerance` of ``tol`` for ``post`` and the ``[machining]`` units; None without a tool.
 
     ``cache`` (a dict the caller keeps, e.g. :class:`camfab.pipeline.Cam`'s) holds each path once per (profile,
     radius, tolerance): the DXF's TOOL_PATH layer and the program share one offset, one shapely guard and one fit
-    (docs/decisions.md, "The DXF tool path is the program's").
+    (docs/decisions.md, "The DXF tool path is the program's").  ``profiles`` (the plate's arc fit of every
+    profile, :func:`camfab.cad.export.cam_shapes` within ``tol``) make each path when their offset by the tool
+    radius lies within the fit tolerance of the exact offset, measured (docs/decisions.md, "One arc fit per
+    profile").
     """
     over = {k: v for k, v in (overrides or {}).items() if v is not None}
     tool = over.get("tool_diameter_mm", spec.manufacturing.tool_diameter_mm)
@@ -82,9 +86,10 @@ def contour_paths(spec, geometry, overrides: Mapping[str, Any] | None = None, *,
     fit_tol = contour_fit_tolerance(tol, post, machining_of(spec, over).units)
     cache = {} if cache is None else cache
     for i, contact in enumerate(geometry.profiles):
-        if (i, r, fit_tol) not in cache:
-            cache[i, r, fit_tol] = tool_centre_path(contact, r, tol=fit_tol)
-    return tuple(cache[i, r, fit_tol] for i in range(len(geometry.profiles)))
+        if (i, r, fit_tol, tol) not in cache:
+            cache[i, r, fit_tol, tol] = tool_centre_path(contact, r, tol=fit_tol,
+                                                         profile_arcs=profiles[i] if profiles else None)
+    return tuple(cache[i, r, fit_tol, tol] for i in range(len(geometry.profiles)))
 
 
 def cam_program(contact, job: Job, *, tol: float, compensation: str | None = None,
@@ -109,7 +114,8 @@ def cam_program(contact, job: Job, *, tol: float, compensation: str | None = Non
     tol_fit = contour_fit_tolerance(tol, post, job.units)
     # the finishing contour's arcs are the tool path's own fit at tol_fit (one fit, not one at the usual share and
     # a finer one after it: the shapely cross-check does not depend on the tolerance); the compensated and
-    # lines-only programs use the tool path only for its size and cross-check, at the usual share
+    # lines-only programs use the tool path only for its size and cross-check, at the usual share (when the caller
+    # gives no path: the pipeline gives the shared one, contour_paths)
     usual = max(tol_fit, tol * FIT_SHARE * (1.0 - REFIT_SHARE))
     if path is None:
         path = tool_centre_path(contact, r, tol=tol_fit if arcs_allowed and not compensation else usual)
@@ -132,18 +138,23 @@ def cam_program(contact, job: Job, *, tol: float, compensation: str | None = Non
         line = polyline(path.curve, tol=tol_fit)
         contour, dev = line.arc_chain(), line.max_deviation
     job = replace(job, achieved_deviation_mm=dev)
-    prog = contour_toolpath(contour, job, roughing_contours=_rough(contact, job, tol, max_r))
+    prog = contour_toolpath(contour, job, roughing_contours=_rough(contact, job, tol, max_r, path))
     return CamProgram(prog, dev, path.shapely_deviation, contour.n_entities)
 
 
-def _rough(contact, job: Job, tol: float, max_r: float) -> list[ArcChain]:
-    """Roughing contours, outermost first: exact offsets by tool radius + allowance + k·step-over."""
+def _rough(contact, job: Job, tol: float, max_r: float, path: ToolCentrePath) -> list[ArcChain]:
+    """Roughing contours, outermost first: exact offsets by tool radius + allowance + k·step-over, each the
+    finishing path's arcs offset outward when those lie within the roughing tolerance of it (measured,
+    :func:`~camfab.offset.cutter.offset_loop`), else a fit of its own."""
     out: list[ArcChain] = []
     rough_tol = max(tol, 1e-3)
     for k in range(job.roughing_passes, 0, -1):
         d = job.tool_radius_mm + job.roughing_allowance_mm + (k - 1) * job.stepover
         curve = offset_curve(contact, d)
-        out.append(arcs_within_radius(arcs(curve, tol=rough_tol), curve, tol=rough_tol, max_radius_mm=max_r))
+        fit = offset_loop(path.arcs, d - path.tool_radius, curve, rough_tol)
+        if fit is None:
+            fit = arcs(curve, tol=rough_tol)
+        out.append(arcs_within_radius(fit, curve, tol=rough_tol, max_radius_mm=max_r))
     return out
 
 

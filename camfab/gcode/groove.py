@@ -26,13 +26,12 @@ import dataclasses
 import numpy as np
 
 from ..discretize import arcs_within_radius, points_at, polyline
-from ..discretize.fit import REFIT_SHARE
 from ..geom2d import ArcChain
 from ..offset.cutter import offset_curve, profile_curve
 from ..offset.groove import groove_tool_paths
 from ..results import Finding, IssueCode
 from ..tolerances import arc_radius_limit
-from .cam import CamProgram, contour_tolerance
+from .cam import CamProgram, contour_fit_tolerance, contour_tolerance
 from .contour import orient_contour
 from .distance import CurveDistance
 from .model import Comment, Coolant, Feed, Job, Program, Rapid, Spindle, ToolChange
@@ -56,7 +55,7 @@ def groove_program(inner, outer, job: Job, *, tol: float, arcs_allowed: bool = T
     cap = get_post(post or "linuxcnc").max_arc_radius_mm
     r = job.tool_radius_mm
     share = contour_tolerance(tol, post, job.units)
-    tol_fit = max(share * (1.0 - REFIT_SHARE), 1e-6)
+    tol_fit = contour_fit_tolerance(tol, post, job.units)
     paths = groove_tool_paths(inner, outer, r, tol=tol_fit)
     size = float(np.hypot(*np.asarray(paths.outer.arcs.starts, dtype=float).T).max())
     max_r = arc_radius_limit(size, cap)

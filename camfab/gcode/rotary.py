@@ -46,7 +46,7 @@ import numpy as np
 from ..errors import ExportError, Problem, SpecError
 from .model import Job
 from .posts.base import MM_PER_INCH, Post
-from .rotary_finish import check_finishing_tool, finishing_direction, flank_path
+from .rotary_finish import check_finishing_tool, finishing_direction, flank_path, require_groove
 
 __all__ = ["ROTARY_POSTS", "rotary_samples", "rotary_levels", "rotary_gcode", "check_rotary_tool", "RotaryWriter",
            "to_machine", "chord_error", "rotary_post"]
@@ -261,7 +261,8 @@ def _finishing(w: RotaryWriter, geometry: Any, tol_fin: float, safe: float, clea
 def rotary_gcode(geometry: Any, job: Job, tol: float, post: str | Post = "linuxcnc") -> tuple[bytes, int, float]:
     """The groove's 4-axis program (module notes) as bytes, its number of cutting ``G1 X.. A..`` moves and the
     largest chord error (mm) of the written path on the developed cylinder of each level's radius (before
-    rounding).  A rib's program is :func:`~camfab.gcode.rib_program.rib_gcode`."""
+    rounding).  A rib's program is :func:`~camfab.gcode.rib_program.rib_gcode` (a rib here: ApiError)."""
+    require_groove(geometry, "rotary_gcode", "camfab.gcode.rib_program.rib_gcode")
     p = rotary_post(post)
     check_rotary_tool(geometry, job.tool_diameter_mm)
     cyl = geometry.cylinder

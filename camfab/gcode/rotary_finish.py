@@ -34,14 +34,16 @@ from typing import Any
 
 import numpy as np
 
+from ..design.cylinder_spec import Feature
 from ..design.roller_section import RollerSection
-from ..errors import GeometryError, Problem, SpecError
+from ..errors import ApiError, GeometryError, Problem, SpecError
 from ..geom2d import dot
 from ..offset.cutter import concave_limit
 from ..offset.groove import flank_cutter_problem
 
 __all__ = ["cutter_contact", "flank_path", "flank_at", "cutter_penetration", "pitch_distance", "twist_overcut",
-           "check_finishing_tool", "finishing_direction", "TWIST_SHARE", "largest_overcut", "refuse_off_radial_axis"]
+           "check_finishing_tool", "finishing_direction", "TWIST_SHARE", "largest_overcut", "refuse_off_radial_axis",
+           "require_groove"]
 
 #: the share of the tolerance the twist overcut may take (the rest: the chords and the rounding)
 TWIST_SHARE = 0.5
@@ -236,3 +238,10 @@ def finishing_direction(flank: int, sense: int, climb: bool) -> int:
     milling keeps the material on the travel's right: the −z flank for σ = +1 going forwards."""
     forwards_is_climb = flank * sense < 0
     return 1 if forwards_is_climb == climb else -1
+
+
+def require_groove(geometry: Any, what: str, instead: str) -> None:
+    """Refuse a rib where ``what`` (a function of the groove's) would take its flanks for a groove's walls: the
+    caller chooses by ``[cylinder] feature`` and calls ``instead`` for a rib."""
+    if geometry.cylinder.feature is Feature.RIB:
+        raise ApiError(f"{what} is the groove's; a rib's is {instead}")

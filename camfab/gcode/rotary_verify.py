@@ -38,7 +38,7 @@ import numpy as np
 
 from ..results import Finding, IssueCode
 from .model import Job
-from .rotary_finish import cutter_penetration, finishing_direction, flank_path, pitch_distance
+from .rotary_finish import cutter_penetration, finishing_direction, flank_path, pitch_distance, require_groove
 from .rotary_read import RotaryMove, RotaryReadError, read_rotary
 from .verify import VerifyReport
 
@@ -380,7 +380,8 @@ def read_or_refused(program: str | bytes, tol: float) -> list[RotaryMove] | Rota
 def verify_rotary_program(program: str | bytes, geometry: Any, job: Job, *, tol: float) -> RotaryVerifyReport:
     """``camfab verify`` of a grooved cylindrical cam's 4-axis program (module notes); ``job`` cut to the
     groove's depth (:func:`~camfab.gcode.rotary.cylinder_job`).  A rib's program is verified by
-    :func:`~camfab.gcode.rib_verify.verify_rib_program`."""
+    :func:`~camfab.gcode.rib_verify.verify_rib_program` (a rib here: ApiError)."""
+    require_groove(geometry, "verify_rotary_program", "camfab.gcode.rib_verify.verify_rib_program")
     moves = read_or_refused(program, tol)
     if isinstance(moves, RotaryVerifyReport):
         return moves

@@ -20,20 +20,22 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..discretize import (
-    ArcDiscretisation,
     ParametricCurve,
     arcs,
     measure_deviation,
+    measure_within,
     points_at,
     polyline,
     validate_tol,
 )
-from ..errors import GeometryError
+from ..discretize.tolerance import within
+from ..errors import GeometryError, InternalError
+from ..geom2d import ArcChain
 from ..tolerances import DEFAULT_EXPORT_TOL_MM
 from .corners import corner_note, cornered_curve, profile_corners
 from .outline import translating_outline
 
-__all__ = ["profile_curve", "pitch_curve", "offset_curve", "concave_limit", "ToolCentrePath",
+__all__ = ["profile_curve", "pitch_curve", "offset_curve", "concave_limit", "ToolCentrePath", "offset_loop",
            "tool_centre_path", "shapely_offset", "shapely_guard", "guard_samples", "roller_envelope_deviation",
            "QUAD_SEGS", "JOIN_STYLE", "GUARD_SAMPLES", "GUARD_MIN_MM"]
 
@@ -173,7 +175,7 @@ class ToolCentrePath:
     """An exact tool-centre curve and its arc discretisation (mm)."""
 
     curve: ParametricCurve
-    arcs: ArcDiscretisation
+    arcs: ArcChain  # max_deviation measured
     tool_radius: float
     shapely_deviation: float  # shapely buffer vs the exact offset (mm)
     tol: float
@@ -181,12 +183,37 @@ class ToolCentrePath:
     @property
     def max_deviation(self) -> float:
         """Measured deviation of the arc chain from the exact tool-centre curve."""
-        return self.arcs.max_deviation
+        if self.arcs.max_deviation is None:  # a fit or an offset loop, measured: never None
+            raise InternalError("a tool-centre path's arcs carry no measured deviation")
+        return float(self.arcs.max_deviation)
+
+
+def offset_loop(fit: ArcChain, distance: float, exact: ParametricCurve, tol: float) -> ArcChain | None:
+    """``fit`` (arcs of a closed curve) offset by ``distance`` (outward > 0), as the arcs of ``exact`` (that
+    curve's exact offset): concentric arcs, exact for a tangent-continuous chain
+    (:meth:`~camfab.geom2d.ArcChain.offset_g1`), kept with their deviation from ``exact`` measured within
+    ``tol`` (:func:`~camfab.discretize.measure_within`); None for a chain with a corner, an arc the offset would
+    shrink away, or an offset farther than ``tol`` from ``exact`` (the caller fits ``exact`` itself)."""
+    loop = fit.offset_g1(distance)
+    if loop is None:
+        log.info("offset by %g mm: the arc chain has a corner or an arc below that radius, so it has no exact "
+                 "offset; the offset curve is fitted on its own", distance)
+        return None
+    dev = float(measure_within(loop, exact, tol).max)
+    if not within(dev, tol):
+        log.info("offset by %g mm: the arcs offset deviate %.3g mm > tol = %g mm from the exact offset; the offset "
+                 "curve is fitted on its own", distance, dev, tol)
+        return None
+    return loop.with_deviation(dev)
 
 
 def tool_centre_path(contact, tool_radius: float, *, tol: float = DEFAULT_EXPORT_TOL_MM,
-                     label: str = "") -> ToolCentrePath:
+                     label: str = "", profile_arcs: ArcChain | None = None) -> ToolCentrePath:
     """Tool-centre path for milling the periphery of one profile with a cutter of ``tool_radius``.
+
+    ``profile_arcs`` (arcs of the profile, e.g. the plate files' fit) make the path when their offset by the
+    tool radius lies within ``tol`` of the exact offset, measured (:func:`offset_loop`); otherwise, and without
+    them, the exact offset is arc-fitted within ``tol``.
 
     Raises
     ------
@@ -201,8 +228,8 @@ def tool_centre_path(contact, tool_radius: float, *, tol: float = DEFAULT_EXPORT
     _refuse_if_too_big(contact, tool_radius, label)
     exact = offset_curve(contact, tool_radius)
     dev = shapely_guard(profile_curve(contact), exact, tool_radius, label)
-    fit = arcs(exact, tol=tol)
-    return ToolCentrePath(exact, fit, tool_radius, dev, tol)
+    fit = offset_loop(profile_arcs, tool_radius, exact, tol) if profile_arcs is not None else None
+    return ToolCentrePath(exact, fit if fit is not None else arcs(exact, tol=tol), tool_radius, dev, tol)
 
 
 def guard_samples(curve: ParametricCurve, n: int = GUARD_SAMPLES) -> tuple[np.ndarray, float]:

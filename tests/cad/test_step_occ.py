@@ -96,14 +96,19 @@ def test_every_example_step_passes_occ_checks(name, tmp_path):
 
 
 def test_the_checker_finds_the_old_wedge_solid(tmp_path):
-    """The analyser is live: the wedge's arc fit written as it was before the limit (an arc of radius ~2.2e7 mm,
-    a cylinder face) fails its curve-on-surface check (test_step_passes_occ_checks: with the limit it passes)."""
+    """The analyser is live: the wedge's arc fit as the fitter once wrote it, before the limit (kept in
+    tests/cad/data: an arc of radius ~2.2e7 mm, a cylinder face), fails its curve-on-surface check
+    (test_step_passes_occ_checks: with the limit it passes)."""
+    import json
+
     from camfab.cad import step
     from camfab.cad.plate import PlateSpec
+    from camfab.geom2d import ArcChain
 
+    data = json.loads((Path(__file__).parent / "data" / "wedge_fit_67222e9.json").read_text())
+    fit = ArcChain.from_bulges(data["starts"], data["bulges"], closed=True)
+    assert max(fit.radii[~fit.is_line]) > 1e7
     cam = pipeline.load("wedge_translating")
-    fit = cam.shapes().profiles[0]
-    assert max(fit.radii[~fit.is_line]) > 1e6
     path = tmp_path / "old.step"
     m = cam.spec.manufacturing
     plate = PlateSpec(m.thickness_mm, m.bore_mm, m.keyway, m.hub_diameter_mm, m.hub_length_mm)

@@ -23,16 +23,31 @@ def _inscribed(n: int) -> np.ndarray:
 
 
 @pytest.mark.parametrize("n", [600, 1000, 3000])
-def test_an_inscribed_polygon_deviates_by_its_sagitta(n):
-    """A regular n-gon inscribed in a circle: the two-way deviation is the sagitta R·(1 − cos(π/n)), exactly."""
+def test_a_polygon_has_corners_so_it_gets_the_full_measurement(n):
+    """A regular n-gon inscribed in a circle deviates by its sagitta R·(1 − cos(π/n)); a chain with corners gets
+    no certificate (the curve inside a corner puts a first-order kink in the distance): the full measurement."""
     sagitta = R * (1.0 - math.cos(math.pi / n))
     dev = measure_within(_inscribed(n), circle(), TOL)
-    if sagitta < TOL:
-        assert dev.max <= sagitta * (1 + 1e-9)
-        assert dev.max >= sagitta - CERTIFY_SHARE * TOL  # a certified sample maximum is at most the gap below
-    else:  # no certificate: the full measurement's own value
-        assert dev.max == measure_deviation(_inscribed(n), circle()).max
-        assert dev.max == pytest.approx(sagitta, rel=1e-6)
+    assert dev.max == measure_deviation(_inscribed(n), circle()).max
+    assert dev.max == pytest.approx(sagitta, rel=1e-6)
+
+
+def test_a_g1_chain_is_certified_below_the_full_measurement(monkeypatch):
+    """The fit of an ellipse moved 0.3 tol: tangent-continuous, so certified with fewer samples (the full
+    measurement is not called) — a value within the gap below the full measurement's."""
+    import camfab.discretize.within as within_mod
+
+    curve = ellipse()
+    fit = arcs(curve, tol=TOL / 2)
+    moved = ArcChain.from_bulges(fit.starts + np.array([0.3 * TOL, 0.0]), fit.bulges, closed=True)
+    full = measure_deviation(moved, curve).max
+
+    def refused(*args, **kwargs):
+        raise AssertionError("the full measurement ran")
+
+    monkeypatch.setattr(within_mod, "measure_deviation", refused)
+    dev = measure_within(moved, curve, TOL).max
+    assert full - CERTIFY_SHARE * TOL <= dev <= full + 1e-12
 
 
 @pytest.mark.parametrize("make", [circle, ellipse, limacon])

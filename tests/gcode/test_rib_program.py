@@ -197,3 +197,17 @@ def test_a_cutter_too_large_is_refused_naming_the_field(design, tmp_path, capsys
     with pytest.raises(SpecError) as exc:
         check_rib_tool(geometry, tight * 1.01, 0.01)
     assert exc.value.problems[0].path == "manufacturing.tool_diameter_mm" and "gouge a rib flank" in str(exc.value)
+
+
+def test_the_grooves_functions_refuse_a_rib(setup):
+    """The caller chooses by [cylinder] feature; the groove's program and verify given a rib say so (an ApiError
+    naming the rib's function) instead of taking its flanks for a groove's walls."""
+    from camfab.errors import ApiError
+    from camfab.gcode.rotary import rotary_gcode
+    from camfab.gcode.rotary_verify import verify_rotary_program
+
+    geometry, job, tol, text = setup
+    with pytest.raises(ApiError, match="rib_gcode"):
+        rotary_gcode(geometry, job, tol, "linuxcnc")
+    with pytest.raises(ApiError, match="verify_rib_program"):
+        verify_rotary_program(text, geometry, job, tol=tol)

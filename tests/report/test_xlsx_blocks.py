@@ -63,3 +63,24 @@ def test_blocks_refuse_text_and_overlap():
         NumberBlocks().add(ws, 6, [(1, ["=cmd|' /C calc'!A0"])])
     with pytest.raises(ValueError, match="different lengths"):
         NumberBlocks().add(ws, 6, [(1, [1.0]), (2, [1.0, 2.0])])
+
+
+def test_the_patch_takes_lxml_forms_and_never_drops_the_numbers():
+    """lxml's writer (openpyxl uses it when installed) writes ``<dimension ref="A1"/>`` and ``<sheetData/>``;
+    the numbers go in all the same, and XML without a ``<sheetData>`` or a cell added inside the block after
+    ``add`` is an InternalError, never a sheet without its numbers or with a duplicate row."""
+    from camfab.errors import InternalError
+
+    wb = openpyxl.Workbook()
+    ws = wb.active
+    blocks = NumberBlocks()
+    blocks.add(ws, 1, [(2, [1.5, 2.5])])
+    (patch,) = blocks.patches().values()
+    out = patch(b'<worksheet><dimension ref="A1"/><sheetData/></worksheet>')
+    assert out == (b'<worksheet><dimension ref="B1:B2" /><sheetData><row r="1"><c r="B1" t="n"><v>1.5</v></c>'
+                   b'</row><row r="2"><c r="B2" t="n"><v>2.5</v></c></row></sheetData></worksheet>')
+    with pytest.raises(InternalError, match="sheetData"):
+        patch(b'<worksheet><dimension ref="A1"/></worksheet>')
+    ws["C2"] = 4.0
+    with pytest.raises(InternalError, match="inside its number block"):
+        patch(b'<worksheet><dimension ref="A1"/><sheetData/></worksheet>')
