@@ -14,7 +14,7 @@ from camfab.cli import main
 
 PACKAGE = Path(camfab.__file__).resolve().parent
 #: modules whose job is to talk to the user on stdout/stderr
-PRINTING = {"cli.py", "cli_design.py"}  # the command line's presentation modules
+PRINTING = {"cli.py", "cli_design.py", "__main__.py"}  # the command line's presentation modules, its console entry
 #: module-level logging calls that would log to (or configure) the root logger
 ROOT_CALLS = {"basicConfig", "debug", "info", "warning", "warn", "error", "exception", "critical", "log"}
 
@@ -63,8 +63,8 @@ def test_pitch_curve_fit_of_its_own_is_logged(caplog):
     with caplog.at_level(logging.INFO, logger="camfab"):
         loop = _pitch_loop(coarse, c.roller_radius, pitch_curve(c), 0.001)
     assert loop.max_deviation <= 0.001
-    msgs = [r.getMessage() for r in _records(caplog) if r.name == "camfab.cad.export"]
-    assert len(msgs) == 1 and "> tol = 0.001 mm" in msgs[0] and "fit of its own" in msgs[0]
+    msgs = [r.getMessage() for r in _records(caplog) if r.name == "camfab.offset.cutter"]  # offset_loop's
+    assert len(msgs) == 1 and "> tol = 0.001 mm" in msgs[0] and "fitted on its own" in msgs[0]
 
 
 def test_arc_spline_fallback_is_logged(caplog):

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InternalError
+from ..errors import ApiError, InternalError
 
 __all__ = ["NumberBlocks", "workbook_bytes"]
 
@@ -39,12 +39,12 @@ class NumberBlocks:
         a value is a real number (NaN/±inf and None give an empty cell).  Nothing at or below ``first_row``
         may be written to ``ws`` through openpyxl; one block per sheet."""
         if any(ws is w for w, _, _ in self._blocks):
-            raise ValueError(f"a second number block for sheet {ws.title!r}")
+            raise ApiError(f"a second number block for sheet {ws.title!r}")
         cols = sorted(((int(c), _texts(vals)) for c, vals in columns), key=lambda cv: cv[0])
         if len({len(v) for _, v in cols}) > 1:
-            raise ValueError("number block columns of different lengths")
+            raise ApiError("number block columns of different lengths")
         if any(c.row >= first_row for c in ws._cells.values()):
-            raise ValueError(f"sheet {ws.title!r} has openpyxl cells inside its number block")
+            raise ApiError(f"sheet {ws.title!r} has openpyxl cells inside its number block")
         self._blocks.append((ws, first_row, cols))
 
     def patches(self) -> dict[str, Callable[[bytes], bytes]]:
@@ -64,7 +64,7 @@ def _texts(vals: Any) -> list[str | None]:
             out.append(None)
             continue
         if isinstance(v, (bool, str)):
-            raise TypeError(f"not a number for a number block: {v!r}")
+            raise ApiError(f"not a number for a number block: {v!r}")
         f = float(v)
         out.append(f"{f:.16g}" if math.isfinite(f) else None)
     return out

@@ -9,6 +9,7 @@ import zipfile
 import numpy as np
 import pytest
 
+from camfab.errors import ApiError
 from camfab.formats.camdas_workbook import fixed_zip
 from camfab.formats.xlsx_blocks import NumberBlocks, workbook_bytes
 
@@ -57,11 +58,11 @@ def test_blocks_refuse_text_and_overlap():
     wb = openpyxl.Workbook()
     ws = wb.active
     ws["A5"] = "x"
-    with pytest.raises(ValueError, match="inside its number block"):
+    with pytest.raises(ApiError, match="inside its number block"):
         NumberBlocks().add(ws, 3, [(1, [1.0])])
-    with pytest.raises(TypeError):
+    with pytest.raises(ApiError, match="not a number"):
         NumberBlocks().add(ws, 6, [(1, ["=cmd|' /C calc'!A0"])])
-    with pytest.raises(ValueError, match="different lengths"):
+    with pytest.raises(ApiError, match="different lengths"):
         NumberBlocks().add(ws, 6, [(1, [1.0]), (2, [1.0, 2.0])])
 
 
