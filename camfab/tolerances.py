@@ -11,6 +11,7 @@ __all__ = [
     "MIN_EXPORT_TOL_MM",
     "MAX_EXPORT_TOL_MM",
     "PROFILE_FIT_SHARE",
+    "profile_fit_tolerance",
     "MAX_ARC_RADIUS_MM",
     "ARC_RADIUS_OVER_SIZE",
     "arc_radius_limit",
@@ -47,3 +48,10 @@ def arc_radius_limit(size_mm: float, cap_mm: float = float("inf")) -> float:
     """The largest arc radius written for a part of ``size_mm`` (its largest distance from the cam centre):
     ``max(MAX_ARC_RADIUS_MM, ARC_RADIUS_OVER_SIZE · size)``, at most ``cap_mm`` (the controller's limit)."""
     return min(cap_mm, max(MAX_ARC_RADIUS_MM, ARC_RADIUS_OVER_SIZE * float(size_mm)))
+
+
+def profile_fit_tolerance(tol: float) -> float:
+    """The tolerance (mm) of a plate profile's one arc fit for files within ``tol``: ``PROFILE_FIT_SHARE·tol``,
+    never below :data:`MIN_EXPORT_TOL_MM` (at the finest tolerances the fit takes all of ``tol`` and an STL,
+    which needs the other share for its facets, is refused)."""
+    return max(tol * PROFILE_FIT_SHARE, MIN_EXPORT_TOL_MM)

@@ -16,13 +16,13 @@ from pathlib import Path
 import numpy as np
 
 from ..design.kinds import ContactKind
-from ..discretize import arcs, arcs_within_radius, measure_within, validate_tol
+from ..discretize import ToleranceError, arcs, arcs_within_radius, measure_within, validate_tol
 from ..discretize.curve import discontinuities
 from ..errors import GeometryError
 from ..geom2d import ArcChain
 from ..io import atomic_write, inside, safe_stem
 from ..offset.cutter import ToolCentrePath, offset_loop, pitch_curve, profile_curve, tool_centre_path
-from ..tolerances import PROFILE_FIT_SHARE, arc_radius_limit
+from ..tolerances import MIN_EXPORT_TOL_MM, PROFILE_FIT_SHARE, arc_radius_limit, profile_fit_tolerance
 from . import dxf as dxf_mod
 from . import step, stl
 from .artifact import Artifact, CamShapes
@@ -47,7 +47,7 @@ def cam_shapes(geometry, *, tol: float, with_pitch: bool = True) -> CamShapes:
     for i, c in enumerate(geometry.profiles):
         curve = profile_curve(c)
         _require_continuous(curve, tol)
-        profiles.append(arcs(curve, tol=tol * PROFILE_FIT_SHARE))
+        profiles.append(arcs(curve, tol=profile_fit_tolerance(tol)))
         curves.append(curve)
         # a groove's flanks share one pitch curve, the inner flank's offset (the outer flank's offset by +w lies
         # 2w off it: measured far from every sample, then fitted again, for nothing)
@@ -172,14 +172,25 @@ def _stl_artifacts(spec, curves, plate: PlateSpec, tol: float, say: Callable[[st
     deviation of the flattened polyline measured."""
     out = []
     n = len(curves)
-    rest = tol * (1.0 - PROFILE_FIT_SHARE)
+    rest = stl_facet_tolerance(tol)
     for i, curve in enumerate(curves):
         say(f"STL{_suffix(i, n)}")
-        fine = fits[i] if fits else arcs(curve, tol=tol * PROFILE_FIT_SHARE)
+        fine = fits[i] if fits else arcs(curve, tol=profile_fit_tolerance(tol))
         dev = float(measure_within(fine.flatten(rest), curve, tol).max)
         data = stl.dumps(fine, plate, tol=rest, name=spec.name)
         out.append(Artifact(f"{safe_stem(spec.name)}{_suffix(i, n)}.stl", data, "stl", None, dev))
     return out
+
+
+def stl_facet_tolerance(tol: float) -> float:
+    """How far (mm) an STL's facets may lie from the plate fit's arcs: the rest of ``tol`` after
+    :func:`~camfab.tolerances.profile_fit_tolerance`; a tolerance too fine to leave the facets any is refused."""
+    rest = tol - profile_fit_tolerance(tol)
+    if rest < tol * (1.0 - PROFILE_FIT_SHARE) * (1.0 - 1e-12):
+        raise ToleranceError(f"an STL within {tol:g} mm needs a tolerance of at least "
+                             f"{MIN_EXPORT_TOL_MM / PROFILE_FIT_SHARE:g} mm (one share for the arcs, the other for "
+                             "the facets); give a coarser --tol for the STL")
+    return rest
 
 
 def solid_outlines(shapes: CamShapes, tol: float) -> tuple[list, list[float]]:

@@ -23,10 +23,10 @@ from ..geom2d import ArcChain
 from ..io import safe_stem
 from ..offset.groove import groove_tool_paths
 from ..textsafe import plain
-from ..tolerances import PROFILE_FIT_SHARE
+from ..tolerances import profile_fit_tolerance
 from . import dxf as dxf_mod
 from . import step
-from .export import Artifact, CamShapes, plate_of, solid_outlines
+from .export import Artifact, CamShapes, plate_of, solid_outlines, stl_facet_tolerance
 from .plate import PlateSpec, bore_loop, circle_loop
 from .stepheader import design_meta
 
@@ -59,8 +59,8 @@ def groove_artifacts(spec, geometry, formats: list[str], *, shapes: CamShapes, t
     if "stl" in formats:
         # the flanks' plate fit (within PROFILE_FIT_SHARE·tol) when built, else the same fit here; flattened within
         # the rest of tol
-        fine = list(shapes.profiles) or [arcs(c, tol=tol * PROFILE_FIT_SHARE) for c in shapes.curves]
-        rest = tol * (1.0 - PROFILE_FIT_SHARE)
+        rest = stl_facet_tolerance(tol)
+        fine = list(shapes.profiles) or [arcs(c, tol=profile_fit_tolerance(tol)) for c in shapes.curves]
         dev = max(float(measure_within(f.flatten(rest), c, tol).max) for f, c in zip(fine, shapes.curves, strict=True))
         data = _stl_bytes(groove_mesh(outline, fine[0], fine[1], plate, depth, tol=rest), spec.name, rest)
         out.append(Artifact(f"{stem}.stl", data, "stl", None, dev))
