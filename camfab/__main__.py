@@ -7,7 +7,6 @@ the fitter").  This runs before numpy is imported (``import camfab`` imports no 
 """
 from __future__ import annotations
 
-import contextlib
 import os
 import signal
 import sys
@@ -40,10 +39,10 @@ def main(argv: list[str] | None = None) -> int:
       interrupted``, exit 130, as one during the command; numpy's import may turn it into an ``ImportError``
       ("PyCapsule_Import could not import module datetime"), which counts as the interrupt when SIGINT came.
     - Once the command has returned, SIGINT is ignored: the process ends with the command's code.
-    - An interrupted command ends the process with ``os._exit(130)`` once stdout and stderr are flushed (the
-      command has removed what it was writing): CPython 3.11 had sometimes set its "unhandled
-      KeyboardInterrupt" flag although camfab caught the interrupt, and then killed the process by SIGINT on its
-      way out. So this function returns only when the command was not interrupted."""
+    - An interrupted command returns 130 after :func:`forget_caught_interrupt`: CPython 3.11 had sometimes set
+      its "unhandled KeyboardInterrupt" flag although camfab caught the interrupt, and then killed the process by
+      SIGINT on its way out (-2 to a parent). The interpreter's own finalisation still runs (the pool's
+      semaphores, Dask's workers)."""
     came: list[int] = []
     own = threading.current_thread() is threading.main_thread() and \
         signal.getsignal(signal.SIGINT) is signal.default_int_handler
@@ -70,11 +69,31 @@ def main(argv: list[str] | None = None) -> int:
     if own:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
     if code == EXIT_INTERRUPTED:
-        for stream in (sys.stdout, sys.stderr):
-            with contextlib.suppress(Exception):
-                stream.flush()
-        os._exit(code)
+        forget_caught_interrupt()
     return code
+
+
+#: CPython's flag that makes ``Py_RunMain`` kill the process by SIGINT at exit (``Python/pythonrun.c``, 3.8-3.11)
+UNHANDLED_INTERRUPT_FLAG = "_Py_UnhandledKeyboardInterrupt"
+
+
+def forget_caught_interrupt() -> bool:
+    """Clear CPython's "unhandled KeyboardInterrupt" flag for an interrupt camfab has caught; True if cleared.
+
+    CPython sets the flag whenever a ``KeyboardInterrupt`` ends code it runs through ``run_eval_code_obj`` (the
+    ``PyRun_*`` functions: ``exec`` of a string, as ``dataclasses`` and ``namedtuple`` do while a module is
+    imported), caught or not, and then ``python -m`` ends by SIGINT instead of its exit code. Read and cleared
+    through ``ctypes``; where the symbol is not exported (CPython 3.12 keeps the flag inside ``_PyRuntime``;
+    other interpreters) nothing is cleared, and a parent may see the process end by SIGINT after the same cleanup
+    (a shell shows 130 either way) -- docs/decisions.md, "Ctrl-C from start to exit"."""
+    try:
+        import ctypes
+
+        flag = ctypes.c_int.in_dll(ctypes.pythonapi, UNHANDLED_INTERRUPT_FLAG)
+    except (ImportError, AttributeError, ValueError, OSError):
+        return False
+    flag.value = 0
+    return True
 
 
 def _interrupted() -> int:

@@ -71,3 +71,34 @@ def test_ctrl_c_at_any_moment_of_run_exits_130_and_leaves_no_partial_file(tmp_pa
         if p.returncode == 0:
             assert files == complete, delay
     assert 130 in codes, codes  # at least one interrupt landed before the command was over
+
+
+# a module run by ``python -m`` that catches an interrupt raised inside ``exec`` of a string (as dataclasses'
+# generated methods run), then returns 130 through sys.exit, clearing CPython's flag first when asked
+CAUGHT = '''import os, signal, sys
+from camfab.__main__ import forget_caught_interrupt
+try:
+    exec("import os, signal\\nos.kill(os.getpid(), signal.SIGINT)\\nfor _ in range(10**7): pass")
+except KeyboardInterrupt:
+    pass
+if sys.argv[1:] == ["forget"]:
+    assert forget_caught_interrupt()
+sys.exit(130)
+'''
+
+
+@linux_only
+def test_a_caught_interrupt_ends_the_process_with_130_not_by_the_signal(tmp_path):
+    """CPython 3.11 marks a KeyboardInterrupt that ended ``exec`` of a string as unhandled even when it was caught,
+    and ``python -m`` then kills itself by SIGINT (-2) at exit; ``forget_caught_interrupt`` clears the mark, so
+    the interpreter's normal finalisation runs and the exit code is 130."""
+    (tmp_path / "caught_interrupt.py").write_text(CAUGHT)
+    env = dict(_env(), PYTHONPATH=os.pathsep.join((str(ROOT), str(tmp_path))))
+
+    def run(*args: str) -> int:
+        return subprocess.run([sys.executable, "-m", "caught_interrupt", *args], env=env, timeout=120,
+                              capture_output=True).returncode
+
+    assert run("forget") == 130
+    if sys.implementation.name == "cpython" and sys.version_info[:2] == (3, 11):
+        assert run() == -signal.SIGINT  # the mark is real: without clearing it, the process dies by the signal
