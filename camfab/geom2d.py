@@ -282,7 +282,14 @@ class ArcChain:
         Every vertex is on the chain; a closed chain's first vertex is not repeated at the end, an
         open chain's last end is included.
         """
+        return self.flatten_sagitta(tol)[0]
+
+    def flatten_sagitta(self, tol: float) -> tuple[np.ndarray, float]:
+        """:meth:`flatten`'s vertices and its largest sagitta: the largest distance (mm, ``<= tol``; 0 for a chain
+        of lines) between one of its chords and the arc it stands for, ``2 r sin²(φ/4)`` for a chord of angle φ
+        on an arc of radius r.  Both ways, the polyline is within that distance of the chain."""
         out = []
+        sagitta = 0.0
         for p0, p1, b in self.segments():
             out.append(p0[None, :])
             if abs(b) < 1e-15:
@@ -291,13 +298,14 @@ class ArcChain:
             c = math.hypot(*(p1 - p0))
             r = c / (2 * math.sin(abs(th) / 2))
             n = max(1, math.ceil(abs(th) / (2 * math.acos(max(-1.0, 1 - tol / r)))))
+            sagitta = max(sagitta, 2.0 * r * math.sin(abs(th) / (4 * n)) ** 2)
             centre = bulge_centre(p0, p1, b)
             a0 = math.atan2(*(p0 - centre)[::-1])
             ang = a0 + th * np.arange(1, n) / n
             out.append(centre + r * np.column_stack([np.cos(ang), np.sin(ang)]))
         if not self.closed:
             out.append(self.ends[-1:])
-        return np.concatenate(out)
+        return np.concatenate(out), sagitta
 
     def offset_g1(self, distance: float, *, angle_tol: float = 1e-9) -> ArcChain | None:
         """The closed chain offset outward by ``distance`` mm (inward if negative), exactly, or None.

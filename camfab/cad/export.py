@@ -18,6 +18,7 @@ import numpy as np
 from ..design.kinds import ContactKind
 from ..discretize import ToleranceError, arcs, arcs_within_radius, measure_within, validate_tol
 from ..discretize.curve import discontinuities
+from ..discretize.tolerance import within
 from ..errors import GeometryError
 from ..geom2d import ArcChain
 from ..io import atomic_write, inside, safe_stem
@@ -176,10 +177,22 @@ def _stl_artifacts(spec, curves, plate: PlateSpec, tol: float, say: Callable[[st
     for i, curve in enumerate(curves):
         say(f"STL{_suffix(i, n)}")
         fine = fits[i] if fits else arcs(curve, tol=profile_fit_tolerance(tol))
-        dev = float(measure_within(fine.flatten(rest), curve, tol).max)
+        dev = flattened_deviation(fine, curve, tol, rest)
         data = stl.dumps(fine, plate, tol=rest, name=spec.name)
         out.append(Artifact(f"{safe_stem(spec.name)}{_suffix(i, n)}.stl", data, "stl", None, dev))
     return out
+
+
+def flattened_deviation(fit: ArcChain, curve, tol: float, rest: float) -> float:
+    """The deviation (mm) from ``curve`` of ``fit`` flattened within ``rest`` (:meth:`ArcChain.flatten`, what an
+    STL's facets follow): the fit's own measured deviation plus the flattening's largest sagitta, by the triangle
+    inequality (every chord is within its sagitta of its arc, both ways); measured on the polyline when the fit
+    carries no deviation or the sum is not within ``tol`` (docs/decisions.md, "The STL's deviation is the fit's
+    plus the sagitta")."""
+    points, sagitta = fit.flatten_sagitta(rest)
+    if fit.max_deviation is not None and within(fit.max_deviation + sagitta, tol):
+        return float(fit.max_deviation) + sagitta
+    return float(measure_within(points, curve, tol).max)
 
 
 def stl_facet_tolerance(tol: float) -> float:

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..design.kinds import CamKind
-from ..discretize import arcs, measure_within
+from ..discretize import arcs
 from ..errors import GeometryError
 from ..geom2d import ArcChain
 from ..io import safe_stem
@@ -26,7 +26,7 @@ from ..textsafe import plain
 from ..tolerances import profile_fit_tolerance
 from . import dxf as dxf_mod
 from . import step
-from .export import Artifact, CamShapes, plate_of, solid_outlines, stl_facet_tolerance
+from .export import Artifact, CamShapes, flattened_deviation, plate_of, solid_outlines, stl_facet_tolerance
 from .plate import PlateSpec, bore_loop, circle_loop
 from .stepheader import design_meta
 
@@ -61,7 +61,7 @@ def groove_artifacts(spec, geometry, formats: list[str], *, shapes: CamShapes, t
         # the rest of tol
         rest = stl_facet_tolerance(tol)
         fine = list(shapes.profiles) or [arcs(c, tol=profile_fit_tolerance(tol)) for c in shapes.curves]
-        dev = max(float(measure_within(f.flatten(rest), c, tol).max) for f, c in zip(fine, shapes.curves, strict=True))
+        dev = max(flattened_deviation(f, c, tol, rest) for f, c in zip(fine, shapes.curves, strict=True))
         data = _stl_bytes(groove_mesh(outline, fine[0], fine[1], plate, depth, tol=rest), spec.name, rest)
         out.append(Artifact(f"{stem}.stl", data, "stl", None, dev))
     if "step" in formats:

@@ -77,6 +77,34 @@ def test_stl_watertight_volume_and_deviation():
     assert d.max <= 1e-3
 
 
+@pytest.mark.parametrize("name", ["ejemplo9rt", "constant_width", "groove_translating", "valve_exhaust_ej1"])
+def test_the_stl_deviation_bounds_the_measured_one(name):
+    """The STL's deviation is the plate fit's plus the flattening's largest sagitta (triangle inequality, no
+    measurement of the polyline): never below the deviation of the flattened polyline measured on the exact
+    curve, and within tol; a fit that carries no deviation is measured instead (docs/decisions.md, "The STL's
+    deviation is the fit's plus the sagitta")."""
+    from camfab.cad.export import flattened_deviation, stl_facet_tolerance
+
+    from camfab.formats import load_design
+
+    spec = load_design(EXAMPLES / f"{name}.toml")
+    geom = geometry_from_spec(spec)
+    tol = spec.manufacturing.tolerance_mm
+    shapes = cam_shapes(geom, tol=tol, with_pitch=False)
+    rest = stl_facet_tolerance(tol)
+    (art,) = build_artifacts(spec, geom, ["stl"], tol=tol, shapes=shapes)
+    devs = []
+    for fit, curve in zip(shapes.profiles, shapes.curves, strict=True):
+        measured = measure_deviation(fit.flatten(rest), curve).max
+        bound = flattened_deviation(fit, curve, tol, rest)
+        assert measured <= bound <= tol
+        assert bound - measured <= 0.2 * tol  # a bound, not a blind tol
+        unmeasured = fit.with_deviation(None)
+        assert flattened_deviation(unmeasured, curve, tol, rest) == pytest.approx(measured, rel=1e-6)
+        devs.append(bound)
+    assert art.deviation_mm == max(devs)
+
+
 def test_same_export_twice_is_byte_identical():
     spec = DESIGNS["ejemplo9rt"]()
     geom = geometry_from_spec(spec)

@@ -55,6 +55,20 @@ def test_flatten_within_sagitta():
         assert sag.max() <= tol
 
 
+def test_flatten_sagitta_is_the_largest_distance_of_a_chord_from_its_arc():
+    """``flatten_sagitta`` gives ``flatten``'s vertices and its largest sagitta, which equals the largest distance of
+    a chord's midpoint from the circle (all arcs of these loops centred on the origin), and is within ``tol``."""
+    for loop, r in ((circle_loop(25.0), 25.0), (_regular_arc_loop(40.0, 4), 40.0), (_regular_arc_loop(7.5, 3), 7.5)):
+        for tol in (1e-2, 1e-3, 1e-4, 1e-6):
+            pts, sagitta = loop.flatten_sagitta(tol)
+            assert np.array_equal(pts, loop.flatten(tol))
+            mids = (pts + np.roll(pts, -1, axis=0)) / 2
+            assert sagitta == pytest.approx(float((r - np.hypot(*mids.T)).max()), rel=1e-9, abs=1e-12)
+            assert 0 < sagitta <= tol
+    lines = ArcChain.from_polyline(np.array([[0.0, 0.0], [10.0, 0.0], [10.0, 5.0]]))
+    assert lines.flatten_sagitta(1e-3)[1] == 0.0
+
+
 def test_stl_watertight_volume_within_chordal_bound():
     trimesh = pytest.importorskip("trimesh")
     from camfab.cad import stl
