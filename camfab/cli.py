@@ -324,15 +324,10 @@ def cmd_verify(args: argparse.Namespace) -> int:
     job = pipeline.gcode_job(cam.spec, tol=tol, overrides=_job_overrides(args))
     data = Path(args.program).read_bytes()  # a missing file is an I/O error (3); an unreadable one a finding
     rep: VerifyReport
-    if cam.spec.cam.kind == "cylindrical":  # the 4-axis program on the cylinder (gcode.rotary_verify, gcode.rib_verify)
-        from .design.cylinder_spec import Feature
-        from .gcode.rib_verify import verify_rib_program
-        from .gcode.rotary import cylinder_job
-        from .gcode.rotary_verify import verify_rotary_program
+    if cam.spec.cam.kind == "cylindrical":  # the 4-axis program of the groove or rib (camfab.gcode.cylinder)
+        from .gcode.cylinder import verify_cylinder_program
 
-        rib = getattr(cam.spec.cylinder, "feature", None) is Feature.RIB
-        check = verify_rib_program if rib else verify_rotary_program
-        rep = check(data, cam.geometry, cylinder_job(job, cam.geometry), tol=tol)
+        rep = verify_cylinder_program(data, cam.geometry, job, tol=tol)
     elif cam.spec.cam.kind == "groove":  # both flanks are the targets (camfab.gcode.groove)
         from .gcode.groove import verify_groove_program
 

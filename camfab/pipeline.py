@@ -352,18 +352,20 @@ def _suffix(i: int, n: int) -> str:
     return f"_cam{i + 1}" if n > 1 else ""
 
 
-def _tool_paths(cam: Cam, req: Request) -> bool:
-    return bool(req.tool_paths if req.tool_paths is not None else Output.GCODE in req.outputs)
+def _contour_paths(cam: Cam, req: Request, tol: float) -> tuple | None:
+    """The plate program's tool-centre paths (None without a tool), made once per cam for the DXF's TOOL_PATH
+    layer and the G-code (docs/decisions.md, "The DXF tool path is the program's")."""
+    from .gcode.cam import contour_paths
+
+    return contour_paths(cam.spec, cam.geometry, req.machining, tol=tol, post=req.post, cache=cam._tool_paths,
+                         profiles=cam.shapes(tol).profiles)
 
 
 def _dxf(cam: Cam, req: Request) -> list[Artifact]:
-    from .gcode.cam import contour_paths  # the G-code's tool paths (docs/decisions.md, "The DXF tool path is …")
-
-    tol, draw = cam.tolerance(req.tol), _tool_paths(cam, req) and cam.spec.cam.kind != "groove"
-    paths = draw and contour_paths(cam.spec, cam.geometry, req.machining, tol=tol, post=req.post, cache=cam._tool_paths,
-                                   profiles=cam.shapes(tol).profiles)
+    tol, draw = cam.tolerance(req.tol), bool(Output.GCODE in req.outputs if req.tool_paths is None else req.tool_paths)
+    paths = _contour_paths(cam, req, tol) if draw and cam.spec.cam.kind != "groove" else None
     return build_artifacts(cam.spec, cam.geometry, ["dxf"], tol=tol, dxf_flavour=req.dxf_flavour,
-                           tool_paths=_tool_paths(cam, req), shapes=cam.shapes(tol), tool_centre=paths or None)
+                           tool_paths=draw, shapes=cam.shapes(tol), tool_centre=paths)
 
 
 def _stl(cam: Cam, req: Request) -> list[Artifact]:
@@ -431,7 +433,7 @@ def _assembly(cam: Cam, req: Request) -> list[Artifact]:
 
 def _gcode(cam: Cam, req: Request) -> list[Artifact]:
     from .gcode import dumps
-    from .gcode.cam import cam_program, contour_paths
+    from .gcode.cam import cam_program
     from .gcode.groove import groove_gcode
 
     tol = cam.tolerance(req.tol)
@@ -439,18 +441,14 @@ def _gcode(cam: Cam, req: Request) -> list[Artifact]:
     job = gcode_job(cam.spec, tol=tol, overrides=req.machining)
     m = machining_of(cam.spec, req.machining)
     n = len(cam.geometry.profiles)
-    if cam.spec.cam.kind == "cylindrical":  # the 4-axis program of the groove (gcode.rotary) or rib (gcode.rib_program)
-        from .design.cylinder_spec import Feature
-        from .gcode.rib_program import rib_gcode
-        from .gcode.rotary import cylinder_job, rotary_gcode
+    if cam.spec.cam.kind == "cylindrical":  # the 4-axis program of the groove or rib (camfab.gcode.cylinder)
+        from .gcode.cylinder import cylinder_gcode
 
-        program = rib_gcode if getattr(cam.spec.cylinder, "feature", None) is Feature.RIB else rotary_gcode
-        data, moves, dev = program(cam.geometry, cylinder_job(job, cam.geometry), tol, req.post)
+        data, moves, dev = cylinder_gcode(cam.geometry, job, tol, req.post)
         return [Artifact(f"{safe_stem(cam.name)}.nc", data, "gcode", moves, dev, req.post)]
     if cam.spec.cam.kind == "groove":  # one program mills the slot of both flanks
         return [Artifact(f"{safe_stem(cam.name)}.nc", *groove_gcode(cam.geometry, job, tol, m, req.post), req.post)]
-    out, paths = [], contour_paths(cam.spec, cam.geometry, req.machining, tol=tol, post=req.post,
-                                   cache=cam._tool_paths, profiles=cam.shapes(tol).profiles)
+    out, paths = [], _contour_paths(cam, req, tol)
     for i, contact in enumerate(cam.geometry.profiles):
         cp = cam_program(contact, job, tol=tol, compensation=m.compensation, arcs_allowed=not m.lines_only,
                          post=req.post, path=paths[i] if paths else None)
