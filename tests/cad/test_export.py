@@ -84,7 +84,6 @@ def test_the_stl_deviation_bounds_the_measured_one(name):
     curve, and within tol; a fit that carries no deviation is measured instead (docs/decisions.md, "The STL's
     deviation is the fit's plus the sagitta")."""
     from camfab.cad.export import flattened_deviation, stl_facet_tolerance
-
     from camfab.formats import load_design
 
     spec = load_design(EXAMPLES / f"{name}.toml")
