@@ -38,11 +38,13 @@ __all__ = ["developed_curves", "developed_dxf", "grooved_cylinder", "cylinder_so
            "solid_mesh", "solid_stl", "loft_sections", "track_loft", "LOFT_SECTIONS"]
 
 #: sections of the groove's (and the rib's) loft per turn to begin with: the points the periodic B-spline through
-#: the 3D pitch curve passes through, doubled (at most 4 times) until it lies within the tolerance (cost: 4.7 s CPU
-#: at 48)
+#: the 3D pitch curve passes through, doubled (at most 4 times) until it lies within the tolerance (the sections of
+#: the example at 48: 0.6 s CPU, docs/decisions.md, "Cylinder sections: all planes' secant steps at once")
 LOFT_SECTIONS = 48
 #: how far past the outer surface the groove tool reaches (mm), so the cut leaves no skin
 CLEARANCE_MM = 1.0
+#: how far (rad) from a section plane's cam angle its flank crossing is looked for
+NEAR_RAD = 0.6
 #: radii (groove bottom to past the outer surface) at which each section holds the exact flank points
 SECTION_RADII = 6
 
@@ -98,27 +100,41 @@ def _wrap(geometry: CylindricalGeometry, r: float, xz: np.ndarray) -> np.ndarray
     return np.stack([r * np.cos(a), r * np.sin(a), xz[:, 1]], axis=1)
 
 
-def _crossing(geometry: CylindricalGeometry, r: float, contact, grid: tuple, plane: tuple) -> np.ndarray:
-    """The point of the exact flank ``contact`` (its contact curve on the cylinder r) where it crosses the plane
-    (point, unit normal) near the plane's cam angle: bracketed on ``grid`` (cam angles and the flank's wrapped
-    points there), then refined by secant steps."""
-    p0, normal, theta = plane
+def _crossings(geometry: CylindricalGeometry, r: float, contact, grid: tuple, planes: tuple) -> np.ndarray:
+    """The points ``(n, 3)`` of the exact flank ``contact`` (its contact curve on the cylinder r) where it crosses
+    each of the n planes (points, unit normals, cam angles), near the plane's cam angle: bracketed on ``grid``
+    (cam angles and the flank's wrapped points there), then refined by up to four secant steps, all planes'
+    steps in one evaluation of the flank each (a plane whose step would divide by zero keeps its point)."""
+    p0, normal, theta = planes
     angles, on_grid = grid
-
-    def side(x):
-        return (_wrap(geometry, r, contact.evaluate(np.atleast_1d(x)).point) - p0) @ normal
-
-    d = (on_grid - p0) @ normal
-    near = np.abs((angles - theta + math.pi) % (2 * math.pi) - math.pi) < 0.6
-    i = int(np.nonzero(near & (np.sign(d) != np.sign(np.roll(d, -1))))[0][0])
-    g0, g1 = angles[i], angles[(i + 1) % angles.size] + (2 * math.pi if i + 1 == angles.size else 0.0)
-    d0, d1 = d[i], d[(i + 1) % angles.size]
+    m, n = angles.size, len(theta)
+    h = float(angles[1] - angles[0])
+    half = int(math.ceil(NEAR_RAD / h)) + 2  # grid points on either side of a plane's angle that can be near it
+    brackets = np.empty((4, n))
+    for k in range(n):
+        if 2 * half + 2 < m:  # the window around the plane's angle (wrapped), one point past its end
+            idx = np.arange(int(round(theta[k] / h)) - half, int(round(theta[k] / h)) + half + 2) % m
+        else:
+            idx = np.arange(m + 1) % m
+        d = (on_grid[idx] - p0[k]) @ normal[k]
+        near = np.abs((angles[idx[:-1]] - theta[k] + math.pi) % (2 * math.pi) - math.pi) < NEAR_RAD
+        cross = np.nonzero(near & (np.sign(d[:-1]) != np.sign(d[1:])))[0]
+        if cross.size == 0:
+            raise ExportError(f"a flank of the groove does not cross the section plane at "
+                              f"{math.degrees(theta[k]):.6g}° on the radius {r:g} mm: check the design for an undercut")
+        q = int(cross[np.argmin(idx[cross])])  # the crossing first on the grid, as over the whole grid
+        i = int(idx[q])
+        brackets[:, k] = angles[i], angles[(i + 1) % m] + (2 * math.pi if i + 1 == m else 0.0), d[q], d[q + 1]
+    g0, g1, d0, d1 = brackets
+    going = np.ones(len(theta), dtype=bool)
     for _ in range(4):
-        if d1 == d0:
+        going &= d1 != d0
+        if not going.any():
             break
-        g0, g1, d0 = g1, g1 - d1 * (g1 - g0) / (d1 - d0), d1
-        d1 = float(side(g1)[0])
-    return _wrap(geometry, r, contact.evaluate(np.array([g1])).point)[0]
+        a = going
+        g0[a], g1[a], d0[a] = g1[a], g1[a] - d1[a] * (g1[a] - g0[a]) / (d1[a] - d0[a]), d1[a]
+        d1[a] = np.einsum("ij,ij->i", _wrap(geometry, r, contact.evaluate(g1[a]).point) - p0[a], normal[a])
+    return _wrap(geometry, r, contact.evaluate(g1).point)
 
 
 def groove_sections(geometry: CylindricalGeometry, n: int, radii: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -138,8 +154,7 @@ def groove_sections(geometry: CylindricalGeometry, n: int, radii: np.ndarray) ->
         for j, r in enumerate(map(float, radii)):
             contact = geometry.at_radius(r, flank)
             on_grid = (grid, _wrap(geometry, r, contact.evaluate(grid).point))  # evaluated once for all sections
-            for k in range(n):
-                out[k, f, j] = _crossing(geometry, r, contact, on_grid, (points[k], along[k], theta[k]))
+            out[:, f, j] = _crossings(geometry, r, contact, on_grid, (points, along, theta))
     return theta, out
 
 
