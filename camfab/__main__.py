@@ -70,7 +70,24 @@ def main(argv: list[str] | None = None) -> int:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
     if code == EXIT_INTERRUPTED:
         forget_caught_interrupt()
+        quiet_leftovers()
     return code
+
+
+def quiet_leftovers() -> None:
+    """After an interrupt: finalise now what the interrupted command left suspended, and report none of their
+    cleanup errors. An xlsx writer stopped inside openpyxl's worksheet stream (a generator writing into a zip
+    member the command had closed) printed "Exception ignored in ... ValueError: I/O operation on closed file"
+    when the garbage collector closed it at exit; the command has reported the interrupt and removed what it was
+    writing, so such errors are noise (docs/decisions.md, "Ctrl-C from start to exit")."""
+    import gc
+
+    sys.unraisablehook = _ignore_unraisable
+    gc.collect()
+
+
+def _ignore_unraisable(unraisable: Any) -> None:
+    return None
 
 
 #: CPython's flag that makes ``Py_RunMain`` kill the process by SIGINT at exit (``Python/pythonrun.c``, 3.8-3.11)

@@ -16,6 +16,9 @@ PACKAGE = Path(camfab.__file__).resolve().parent
 #: modules whose job is to talk to the user on stdout/stderr
 PRINTING = {"cli.py", "cli_design.py", "__main__.py"}  # the command line's presentation modules, its console entry
 #: module-level logging calls that would log to (or configure) the root logger
+#: a library's logger camfab filters, never logs through: the local Dask workers' preload drops the heartbeat
+#: failure a closing worker's own close causes (docs/decisions.md, "Ctrl-C from start to exit")
+FILTERED_LOGGERS = {("dask_worker.py", "distributed.worker")}
 ROOT_CALLS = {"basicConfig", "debug", "info", "warning", "warn", "error", "exception", "critical", "log"}
 
 
@@ -116,7 +119,8 @@ def test_no_library_module_prints_and_every_logger_is_camfab():
                 if f.attr == "getLogger":
                     arg = call.args[0] if call.args else None
                     ok = (isinstance(arg, ast.Name) and arg.id == "__name__") or \
-                        (isinstance(arg, ast.Constant) and str(arg.value).split(".")[0] == "camfab")
+                        (isinstance(arg, ast.Constant) and str(arg.value).split(".")[0] == "camfab") or \
+                        (isinstance(arg, ast.Constant) and (rel, arg.value) in FILTERED_LOGGERS)
                     if not ok:
                         loggers.append(f"{rel}:{call.lineno}: {ast.unparse(call)}")
                 elif f.attr in ROOT_CALLS:

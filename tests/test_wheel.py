@@ -117,6 +117,19 @@ _API = textwrap.dedent("""
 """)
 
 
+def _see_this_environment(python: Path, cwd: Path) -> None:
+    """When the tests run in a virtual environment (the project's .venv), its site-packages hold dependencies the
+    base interpreter may lack (threadpoolctl on a fresh machine): a ``.pth`` file makes the new environment see
+    them after its own site-packages. Their ``.pth`` files are not processed, so the checkout's editable install
+    stays out and camfab comes from the wheel."""
+    if sys.prefix == sys.base_prefix:
+        return
+    import site
+
+    purelib = _sh([python, "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"], cwd=cwd).stdout.strip()
+    Path(purelib, "camfab_test_parent_env.pth").write_text("\n".join(site.getsitepackages()) + "\n", encoding="utf-8")
+
+
 def _verdict(name: str) -> str:
     import camfab
 
@@ -141,6 +154,7 @@ def test_the_wheel_installs_and_runs_from_another_folder(tmp_path):
     _sh([sys.executable, "-m", "venv", "--system-site-packages", "--without-pip", venv], cwd=tmp_path)
     bindir = venv / ("Scripts" if os.name == "nt" else "bin")
     python = bindir / ("python.exe" if os.name == "nt" else "python")
+    _see_this_environment(python, tmp_path)
     _sh([python, "-m", "pip", "install", "--no-deps", "--no-index", "-q", wheel], cwd=tmp_path)
 
     elsewhere = tmp_path / "elsewhere"  # not the checkout
