@@ -14,6 +14,8 @@ import threading
 from collections.abc import MutableMapping
 from typing import Any
 
+from .exitcodes import EXIT_INTERRUPTED
+
 #: variables any BLAS build reads for its thread count; a user's explicit setting of any of them wins
 BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "GOTO_NUM_THREADS")
 
@@ -26,9 +28,6 @@ def one_blas_thread_by_default(environ: MutableMapping[str, str] = os.environ) -
 
 
 one_blas_thread_by_default()
-
-#: the exit code of an interrupted command (``camfab.cli.EXIT_INTERRUPTED``: 128 + SIGINT)
-EXIT_INTERRUPTED = 130
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -70,7 +69,8 @@ def main(argv: list[str] | None = None) -> int:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
     if code == EXIT_INTERRUPTED:
         forget_caught_interrupt()
-        quiet_leftovers()
+        if own:  # the process's own entry: its exit is near
+            quiet_leftovers()
     return code
 
 

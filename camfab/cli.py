@@ -21,6 +21,7 @@ from typing import Any
 from . import pipeline
 from .cad.kind_exports import applicable, kind_exporter
 from .errors import ApiError, CamfabError, InternalError, MissingDependencyError, SpecError, UnreachableError
+from .exitcodes import EXIT_BROKEN_PIPE, EXIT_CHECKS, EXIT_INPUT, EXIT_INTERRUPTED, EXIT_IO, EXIT_OK
 from .io import atomic_write, inside, output_folder, write_all
 from .pipeline import Cam, Output, Request
 from .results import Severity, Verdict
@@ -30,9 +31,6 @@ from .version import __version__
 
 __all__ = ["main", "register", "COMMANDS", "UsageError"]
 
-EXIT_OK, EXIT_CHECKS, EXIT_INPUT, EXIT_IO = 0, 1, 2, 3
-EXIT_BROKEN_PIPE = 128 + 13  # 128 + SIGPIPE: what a shell reports for a command whose reader went away
-EXIT_INTERRUPTED = 128 + 2  # 128 + SIGINT: what a shell reports for a command ended by Ctrl-C
 #: every subcommand: name → (run(args) -> exit code, add_arguments(parser), help)
 COMMANDS: dict[str, tuple[Callable[[argparse.Namespace], int], Callable[[argparse.ArgumentParser], None], str]] = {}
 

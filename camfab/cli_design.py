@@ -15,10 +15,11 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from .cli import EXIT_CHECKS, EXIT_OK, UsageError, register
+from .cli import UsageError, register
 from .design.assemble import check_design
 from .design.mechanisms import geometry_from_spec
 from .design.spec import DesignSpec, design_from_dict
+from .exitcodes import EXIT_CHECKS, EXIT_OK
 from .formats.toml_write import design_data, dumps_design
 from .io import atomic_write, output_folder, safe_stem
 from .results import Verdict

@@ -51,7 +51,8 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "camfab.package_dask": BASE,  # Dask imported inside its functions only
     "camfab.cli": ("camfab",),
     "camfab.terminal": (),
-    "camfab.__main__": ("camfab.cli",),
+    "camfab.exitcodes": (),
+    "camfab.__main__": ("camfab.cli", "camfab.exitcodes"),
     "camfab": ("camfab",),  # the façade re-exports
 }
 #: calls that read or write files

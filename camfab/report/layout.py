@@ -9,6 +9,8 @@ turned off (docs/decisions.md "Plot layout").  Figures are one column of axes (t
 """
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
 __all__ = ["fixed_layout", "legend_extent", "text_size"]
@@ -144,6 +146,11 @@ def fixed_layout(fig) -> None:
         _fix_titles(ax)
 
 
+#: each legend's packed box and the resolution it was measured at, kept as long as the legend lives (beside the
+#: legend, not on it: no attribute of camfab's on matplotlib's objects)
+_PACKED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
 def legend_extent(legend, renderer):
     """``legend.get_window_extent(renderer)``, the legend's packed box (its texts and handles, which do not change
     once it is made, nor with where its axes are) measured once per legend and renderer resolution: the layout
@@ -152,10 +159,10 @@ def legend_extent(legend, renderer):
     packer = legend._legend_box  # matplotlib's packer of the legend's entries (Legend.get_window_extent uses it)
     if getattr(legend, "_mode", None) is not None:
         return legend.get_window_extent(renderer)
-    kept = getattr(legend, "_camfab_packed", None)
+    kept = _PACKED.get(legend)
     if kept is None or kept[0] != renderer.dpi:
         kept = (renderer.dpi, packer.get_bbox(renderer))
-        legend._camfab_packed = kept
+        _PACKED[legend] = kept
     bbox = kept[1]
     return bbox.translated(*packer.get_offset(bbox, renderer))
 
