@@ -169,8 +169,8 @@ def profile_curves(geometry, tol: float) -> list:
 def _stl_artifacts(spec, curves, plate: PlateSpec, tol: float, say: Callable[[str], None],
                    fits: Sequence[ArcChain] = ()) -> list[Artifact]:
     """One STL per profile curve: its arcs within ``PROFILE_FIT_SHARE·tol`` (``fits``, the plate's own fit, when
-    the caller has them; fitted here otherwise: the same arcs), flattened within the rest of ``tol``, the
-    deviation of the flattened polyline measured."""
+    the caller has them; fitted here otherwise: the same arcs), flattened within the rest of ``tol``; the
+    deviation is :func:`flattened_deviation`'s (the fit's plus the largest sagitta)."""
     out = []
     n = len(curves)
     rest = stl_facet_tolerance(tol)
