@@ -333,20 +333,9 @@ def contour_toolpath(path_entities, job: Job, *, roughing_contours=None,
     items += bore_items
     notes += bore_notes
     z_clear = job.clearance_mm
+    entries = _entries(passes, outside, stock, cw, rho, comp_len, r_tool, compensation)
     for kind, label, segs, z in passes:
-        P, C, q_in, q_out, lead_cw, a, b = _lead_geometry(segs, cw, rho, comp_len)
-        first = a if compensation else q_in
-        last = b if compensation else q_out
-        n = outward_normal(segs[0].tangent(0.0), cw)
-        E = first + _exit_distance(stock, first, n, r_tool + ENTRY_CLEARANCE_MM) * n
-        line = first[None, :] + np.linspace(0.0, 1.0, 65)[:, None] * (E - first)[None, :]
-        pts = np.array([q_in, q_out, first, last])
-        if np.any(outside(pts) <= 0.0):
-            raise GeometryError(f"{label}: the lead-in/lead-out near {tuple(P)} falls inside the contour; "
-                                "reduce job.lead_radius_mm")
-        if np.any(outside(line) <= (r_tool if compensation else 0.0)):
-            raise GeometryError(f"{label}: the entry from outside the stock along the normal at {tuple(P)} would cut "
-                                "into the part; reduce job.lead_radius_mm")
+        P, C, q_in, q_out, lead_cw, a, b, first, last, E = entries[id(segs)]
         items.append(Comment(label))
         items += [Rapid(E[0], E[1], job.safe_z_mm), Rapid(E[0], E[1], z_clear),
                   Feed(E[0], E[1], z, job.plunge_feed_mm_min)]
@@ -368,6 +357,47 @@ def contour_toolpath(path_entities, job: Job, *, roughing_contours=None,
     items.append(Spindle(0.0))
     return Program(job=job, items=tuple(items), compensation=compensation, contour=finish,
                    roughing=tuple(rough), notes=tuple(notes))
+
+
+def _entries(passes, outside, stock, cw: bool, rho: float, comp_len: float, r_tool: float, compensation
+             ) -> dict[int, tuple]:
+    """Every distinct contour's lead geometry and entry point (by ``id``; a contour repeated at each depth level
+    has the same ones), its lead points and entry line checked outside the part in one call of ``outside`` for
+    all contours (each point's distance is its own: the same values as one call per pass).
+
+    Raises
+    ------
+    GeometryError
+        For the first pass whose lead-in/lead-out falls inside the contour, or whose entry along the normal
+        would cut into the part.
+    """
+    geo: dict[int, tuple] = {}
+    checks = []
+    for _, label, segs, _ in passes:
+        if id(segs) in geo:
+            continue
+        P, C, q_in, q_out, lead_cw, a, b = _lead_geometry(segs, cw, rho, comp_len)
+        first = a if compensation else q_in
+        last = b if compensation else q_out
+        n = outward_normal(segs[0].tangent(0.0), cw)
+        E = first + _exit_distance(stock, first, n, r_tool + ENTRY_CLEARANCE_MM) * n
+        line = first[None, :] + np.linspace(0.0, 1.0, 65)[:, None] * (E - first)[None, :]
+        geo[id(segs)] = (P, C, q_in, q_out, lead_cw, a, b, first, last, E)
+        checks.append((label, P, np.array([q_in, q_out, first, last]), line))
+    if not checks:
+        return geo
+    d = outside(np.concatenate([x for _, _, pts, line in checks for x in (pts, line)]))
+    at = 0
+    for label, P, pts, line in checks:
+        d_pts, d_line = d[at:at + len(pts)], d[at + len(pts):at + len(pts) + len(line)]
+        at += len(pts) + len(line)
+        if np.any(d_pts <= 0.0):
+            raise GeometryError(f"{label}: the lead-in/lead-out near {tuple(P)} falls inside the contour; "
+                                "reduce job.lead_radius_mm")
+        if np.any(d_line <= (r_tool if compensation else 0.0)):
+            raise GeometryError(f"{label}: the entry from outside the stock along the normal at {tuple(P)} would cut "
+                                "into the part; reduce job.lead_radius_mm")
+    return geo
 
 
 #: the feed moves along a contour at one height, and a closed contour restarted at its point nearest a target
