@@ -26,15 +26,26 @@ _LEVELS = 6
 _KD_K = 32
 
 
+def _column_min(a: np.ndarray) -> np.ndarray:
+    """``a.min(axis=0)`` of an ``(N, 2)`` array: the same values, an order of magnitude faster for a few thousand
+    rows (numpy's reduction over the leading axis of a two-column array is a slow strided loop)."""
+    return np.array([a[:, 0].min(), a[:, 1].min()])
+
+
+def _column_max(a: np.ndarray) -> np.ndarray:
+    """``a.max(axis=0)`` of an ``(N, 2)`` array (as :func:`_column_min`)."""
+    return np.array([a[:, 0].max(), a[:, 1].max()])
+
+
 def _candidates(sites: np.ndarray, q: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray] | None:
     """Every (query row, site index) pair whose site lies in the 3×3 cells around the query's cell, grouped by
     query row in increasing order, or None when the grid would need more cells than int64 keys can number.
 
     Keys number the cells column by column, so a query's 3×3 cells are three runs of consecutive keys (one
     ``searchsorted`` pair each)."""
-    origin = sites.min(axis=0)
+    origin = _column_min(sites)
     cs = np.floor((sites - origin) / cell)
-    nx, ny = cs.max(axis=0) + 1
+    nx, ny = _column_max(cs) + 1
     if nx * ny > 2.0 ** 60:
         return None
     ny_i = int(ny)
@@ -97,7 +108,10 @@ def grid_nearest(q: np.ndarray, sites: np.ndarray, cell: float,
     n, m = q.shape[0], sites.shape[0]
     best = np.full(n, np.inf)
     arg = np.zeros(n, dtype=np.int64)
-    extent = float(np.ptp(np.vstack([sites, q]), axis=0).max()) if n else 0.0
+    # the largest side of the box around sites and queries (np.ptp of both stacked, without the copy and the slow
+    # reductions; np.minimum / np.maximum propagate a NaN as those reductions do)
+    extent = float((np.maximum(_column_max(sites), _column_max(q)) - np.minimum(_column_min(sites), _column_min(q))
+                    ).max()) if n else 0.0
     todo = np.arange(n)
     cell = max(float(cell), 1e-12 * max(extent, 1.0))
     for _ in range(_LEVELS):

@@ -19,7 +19,7 @@ from ..errors import GeometryError
 from ..geom2d import ArcChain, dot
 from .chain import Chain
 from .curve import ParametricCurve, derivatives_at, points_at
-from .entities import entity_distance, entity_point
+from .entities import entity_point, local_distance
 from .grid import grid_nearest
 from .results import ArcDiscretisation, Deviation, Discretisation
 from .surrogate import HermiteSurrogate, sample_nodes
@@ -87,42 +87,60 @@ class _CurveProjector:
         # twice the typical spacing: a query near the curve is settled in the finest grid; one far from it (or
         # near a sparse stretch) on a coarser one
         self.cell = 2.0 * float(np.median(np.hypot(step[:, 0], step[:, 1])))
+        # contiguous per-interval columns for the Newton iterations (gathered once per query and interval; the
+        # same values as gathering the (4, n, 2) coefficients and splitting them, without strided arithmetic):
+        # the cubic's coefficients by component, ``2·c₂`` (a power of two: exact), the interval widths, and the
+        # sites by component for the distances of the nearest-sample grid
+        self._cx = tuple(np.ascontiguousarray(c[:, 0]) for c in sur.coef)
+        self._cy = tuple(np.ascontiguousarray(c[:, 1]) for c in sur.coef)
+        self._width = sur.x[1:] - sur.x[:-1]
+        self._site_x = np.ascontiguousarray(self.sites[:, 0])
+        self._site_y = np.ascontiguousarray(self.sites[:, 1])
 
     def nearest(self, x: np.ndarray) -> np.ndarray:
         """Index of the curve sample nearest to each ``x`` ``(N, 2)``."""
-        sites = self.sites
+        sx, sy = self._site_x, self._site_y
 
         def dist(p: np.ndarray, j: np.ndarray) -> np.ndarray:
-            w = p - sites[j]
-            return np.hypot(w[:, 0], w[:, 1])
+            return np.hypot(p[:, 0] - sx[j], p[:, 1] - sy[j])
 
-        return grid_nearest(x, sites, self.cell, dist)[1]
+        return grid_nearest(x, self.sites, self.cell, dist)[1]
 
     def project(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Distance from each ``x`` ``(N, 2)`` to the curve, the foot parameter and its smooth piece."""
+        """Distance from each ``x`` ``(N, 2)`` to the curve, the foot parameter and its smooth piece.
+
+        Newton's iterations run on the two components as separate ``(N, 2)`` arrays (one column per
+        interval), each product and sum the same as on the ``(N, 2, 2)`` points in the same order."""
         j = self.nearest(x)
         if self.curve.closed:
             iv = np.stack([(j - 1) % self.n, j], axis=1)  # (N, 2)
         else:
             iv = np.stack([np.maximum(j - 1, 0), np.minimum(j, self.n - 1)], axis=1)
-        a, h = self.x[iv], self.x[iv + 1] - self.x[iv]
-        c = self.sur.coef[:, iv]
-        xx = x[:, None, :]
+        a, h = self.x[iv], self._width[iv]
+        c0x, c1x, c2x, c3x = (c[iv] for c in self._cx)
+        c0y, c1y, c2y, c3y = (c[iv] for c in self._cy)
+        c2x2, c2y2 = 2 * c2x, 2 * c2y
+        qx, qy = x[:, 0, None], x[:, 1, None]
         u = 0.5 * h
         for _ in range(6):
-            uu = u[..., None]
-            p = c[0] + uu * (c[1] + uu * (c[2] + uu * c[3]))
-            d = c[1] + uu * (2 * c[2] + 3 * uu * c[3])
-            dd = 2 * c[2] + 6 * uu * c[3]
-            r = p - xx
-            g = dot(r, d)
-            hess = dot(d, d) + dot(r, dd)
-            step = g / np.where(hess > 0, hess, np.maximum(dot(d, d), 1e-300))
+            # p = c₀ + u(c₁ + u(c₂ + u c₃)), d = c₁ + u(2c₂ + (3u) c₃), dd = 2c₂ + (6u) c₃, r = p − x
+            u3, u6 = 3 * u, 6 * u
+            rx = c0x + u * (c1x + u * (c2x + u * c3x)) - qx
+            ry = c0y + u * (c1y + u * (c2y + u * c3y)) - qy
+            dx = c1x + u * (c2x2 + u3 * c3x)
+            dy = c1y + u * (c2y2 + u3 * c3y)
+            g = rx * dx + ry * dy
+            dd = dx * dx + dy * dy
+            hess = dd + (rx * (c2x2 + u6 * c3x) + ry * (c2y2 + u6 * c3y))
+            step = g / np.where(hess > 0, hess, np.maximum(dd, 1e-300))
             u = np.clip(u - step, 0.0, h)
         t = a + u
-        diff = xx - points_at(self.curve, t)
-        dist = np.hypot(diff[..., 0], diff[..., 1])
-        best = dist.argmin(axis=1)
+        foot = points_at(self.curve, t)
+        dist = np.hypot(qx - foot[..., 0], qy - foot[..., 1])
+        # argmin over the two intervals (a reduction over an axis of two is slow): argmin takes the first NaN, so
+        # the second interval when it is strictly nearer, or when it alone is NaN
+        d0, d1 = dist[:, 0], dist[:, 1]
+        best = ((d1 < d0) | (np.isnan(d1) & ~np.isnan(d0))).astype(np.intp)
         rows = np.arange(x.shape[0])
         return dist[rows, best], t[rows, best], self.sur.piece[iv[rows, best]]
 
@@ -275,13 +293,42 @@ def measure_deviation(entities, curve: ParametricCurve, *, samples: int = 20000,
 
 def _near_entities(chain: Chain, q: np.ndarray, ent: np.ndarray, reach: int = 1) -> np.ndarray:
     """Distance from each point ``q`` ``(..., 2)`` to the nearest of the entities ``ent - reach … ent + reach``
-    (``ent`` of ``q``'s leading shape; cyclic): an upper bound of its distance to the chain, exact when the
-    nearest entity is among them."""
-    off = np.arange(-reach, reach + 1)
-    j = (ent[..., None] + off) % chain.n
-    d = entity_distance(q[..., None, :], chain.start[j], chain.tangent[j], chain.curvature[j], chain.length[j],
-                        chain.end[j])
-    return d.min(axis=-1)
+    (``ent`` of ``q``'s leading shape, or broadcasting to it; cyclic): an upper bound of its distance to the
+    chain, exact when the nearest entity is among them.
+
+    The hot loop of :func:`measure_fit` (~10⁴ points × 3 entities, several times per fit): the chain's entities
+    are laid out once as a table of contiguous columns, padded by ``reach`` entities at both ends, so that the
+    ``2·reach + 1`` neighbours are plain column gathers with the neighbour axis first (no modulo, no gathers of
+    ``(…, 2)`` rows, contiguous rows for the element-wise arithmetic and the running minimum).  The distance to
+    ``ent`` is taken first; a neighbour's end distance provably above it is skipped (it cannot be the minimum).
+    Every distance that can be the minimum is :func:`~camfab.discretize.entities.entity_distance`'s, operation
+    for operation, so the result is the same bit for bit."""
+    n = chain.n
+    ent = np.broadcast_to(ent, q.shape[:-1]).ravel()
+    if ent.size and (ent.min() < 0 or ent.max() >= n):
+        ent = ent % n
+    slots = np.arange(-reach, n + reach) % n  # the entity of every padded slot
+    table = np.stack([chain.start[:, 0], chain.start[:, 1], chain.tangent[:, 0], chain.tangent[:, 1],
+                      chain.curvature, chain.length, chain.end[:, 0], chain.end[:, 1]])[:, slots]
+    # slot of entity ent + off is ent + off + reach; the row of ``ent`` itself first (see below)
+    idx = ent + np.concatenate([[reach], np.delete(np.arange(2 * reach + 1), reach)])[:, None]
+    s0, s1, t0, t1, k, length, e0, e1 = (np.take(col, idx) for col in table)
+    flat = q.reshape(-1, 2)
+    q0, q1 = flat[:, 0], flat[:, 1]
+    w0, w1 = q0 - s0, q1 - s1
+    x = w0 * t0 + w1 * t1  # dot(w, tangent)
+    y = t0 * w1 - t1 * w0  # cross(tangent, w)
+    f0, f1 = q0 - e0, q1 - e1
+    # the distance to ``ent`` first: a neighbour's end distance can only matter when below it, and where the point
+    # is far from that end (nearly everywhere) its two hypot are skipped (local_distance's ``above``)
+    best = local_distance(x[0], y[0], k[0], length[0], w0[0], w1[0], f0[0], f1[0])
+    if reach:
+        rest = local_distance(x[1:].ravel(), y[1:].ravel(), k[1:].ravel(), length[1:].ravel(), w0[1:].ravel(),
+                              w1[1:].ravel(), f0[1:].ravel(), f1[1:].ravel(), np.tile(best, 2 * reach))
+        for row in rest.reshape(2 * reach, -1):
+            # distances are never -0 (nor zeros of mixed signs): the minimum is the same in any order
+            best = np.minimum(best, row)
+    return best.reshape(q.shape[:-1])
 
 
 def _fit_curve_to_chain(chain: Chain, curve: ParametricCurve, samples: int, gap: float,
