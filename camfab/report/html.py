@@ -383,10 +383,12 @@ def render_report(spec, geometry, report, *, standalone: bool = False, frames: i
     from .cylinder_animation import CYLINDER_ANIMATION_CAPTION, cylinder_animation_data, is_cylindrical
     from .cylinder_plot import UNROLLED_PLOT_TEXT
     from .figpool import reusing_figures
-    from .plots import report_figures
+    from .plots import plot_style, report_figures
     from .vibration_plot import VIBRATION_PLOT_TEXT, vibration_figures
 
-    with reusing_figures():  # the figures of the previous design drawn again (byte-identical, cheaper)
+    # the figures of the previous design drawn again (byte-identical, cheaper); one style block around every
+    # figure and save (the ones each enters inside it cost nothing)
+    with reusing_figures(), plot_style():
         files, plots = plot_files({**report_figures(spec, geometry, report),
                                    **vibration_figures(spec, geometry, report)},
                                   standalone=standalone, png=png,

@@ -56,6 +56,11 @@ def _tick_labels(axis) -> list[str]:
     return [s for s in axis.get_major_formatter().format_ticks(list(locs)) if s]
 
 
+def _labelled(axis) -> bool:
+    """Whether the axis draws its major tick labels (below or left of the axes)."""
+    return axis.get_major_ticks(numticks=1)[0].label1.get_visible()
+
+
 def _tick_room(renderer, axis, vertical: bool, labels: list[str] | None = None) -> float:
     """Points taken beside the axes by an axis's tick marks and labels (0 when its labels are hidden);
     ``labels``: its :func:`_tick_labels` when the caller has them."""
@@ -120,7 +125,8 @@ def fixed_layout(fig) -> None:
     left = right = 0.0
     tops, bottoms = [], []
     for ax in axes:  # each axis's ticks located and formatted once (its formatter's offset set by that call)
-        ylabels, xlabels = _tick_labels(ax.yaxis), _tick_labels(ax.xaxis)
+        ylabels = _tick_labels(ax.yaxis)
+        xlabels = _tick_labels(ax.xaxis) if _labelled(ax.xaxis) else []  # not for a shared axis' hidden labels
         left = max(left, _tick_room(renderer, ax.yaxis, True, ylabels) + _label_room(renderer, ax.yaxis.label))
         legend = ax.get_legend()
         if legend is not None and legend.get_visible():
@@ -172,8 +178,12 @@ def _no_engine(fig) -> None:
     with any engine set ``savefig`` draws the whole figure once more (without output) before the real draw."""
     import matplotlib
 
-    with matplotlib.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
+    rc = matplotlib.rcParams
+    if not rc["figure.autolayout"] and not rc["figure.constrained_layout.use"]:  # as they are (no rc_context to pay)
         fig.set_layout_engine(None)  # with both rc settings off this sets no engine (matplotlib's documented rule)
+        return
+    with matplotlib.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
+        fig.set_layout_engine(None)
 
 
 def _fix_titles(ax) -> None:

@@ -19,6 +19,7 @@ from __future__ import annotations
 import contextlib
 import io
 import math
+import threading
 from typing import Any
 
 import numpy as np
@@ -51,13 +52,29 @@ _RC = {"font.size": 9, "axes.titlesize": 10, "axes.labelsize": 9, "legend.fontsi
        "figure.dpi": 100, "savefig.dpi": 110}
 
 
+#: how deep the current thread is in :func:`plot_style` blocks
+_STYLE = threading.local()
+
+
 @contextlib.contextmanager
 def plot_style():
-    """The report's matplotlib settings (a ``rc_context``; nothing global is changed)."""
+    """The report's matplotlib settings (a ``rc_context``; nothing global is changed).
+
+    Inside another ``plot_style`` whose settings still hold, nothing is entered: the outer block restores every
+    setting at its end.  A ``rc_context`` copies all ~300 settings on entry (~0.5 ms); a report enters one per
+    figure and per save, which :func:`camfab.report.html.render_report` now makes nested in its own."""
     import matplotlib
 
-    with matplotlib.rc_context(_RC):
+    depth = getattr(_STYLE, "depth", 0)
+    if depth and all(matplotlib.rcParams[k] == v for k, v in _RC.items()):
         yield
+        return
+    with matplotlib.rc_context(_RC):
+        _STYLE.depth = depth + 1
+        try:
+            yield
+        finally:
+            _STYLE.depth = depth
 
 
 def new_figure(width: float, height: float):
@@ -171,6 +188,10 @@ def svaj_figure(spec, prog, *, n: int = _N):
     names = {"S": "Displacement S", "V": "Velocity V", "A": "Acceleration A", "J": "Jerk J"}
     with plot_style():
         fig, axes = figure_with_axes("svaj", 9.0, 8.6, lambda f: f.subplots(4, 1, sharex=True))
+        # the shared x view fixed first: each axhline below computes the stale view (matplotlib's get_ybound),
+        # which with x still automatic also autoscaled x over all four axes (~10 % of a report).  Nothing drawn
+        # here puts x into the data limits through the view, and the y limits never depend on the x view
+        x_axis(axes[-1], axis)
         for k, ((q, colour), ax) in enumerate(zip(_SVAJ, axes, strict=True)):
             ax.plot(x * axis.scale, vals[k], color=colour)
             ax.axhline(0.0, color="0.2", lw=0.6)
@@ -184,7 +205,6 @@ def svaj_figure(spec, prog, *, n: int = _N):
             ax.set_title(names[q], loc="left", fontsize=9)
             ax.margins(y=0.18)
         _segment_labels(axes[0], prog, axis)
-        x_axis(axes[-1], axis)
         speed = (f"ω = {spec.speed:.4g} rad/s ({spec.speed * 30 / math.pi:.4g} rpm)" if axis.closed
                  else f"v = {spec.speed:.4g} mm/s")
         fig.suptitle(f"{mpl_text(spec.name)}: motion diagrams at {speed}", fontsize=11)

@@ -17,6 +17,7 @@ reader (tests/report/test_svgfig.py) can map a curve back to data.
 """
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any
 from xml.sax.saxutils import escape
@@ -65,7 +66,24 @@ def _color(c: Any, alpha: float | None = None) -> tuple[str, float]:
     return f"#{round(r * 255):02x}{round(g * 255):02x}{round(b * 255):02x}", a
 
 
+#: ``_paint`` attributes by (kind, colour, alpha): a figure paints with a handful of colours, hundreds of times
+_PAINTS: dict[tuple, str] = {}
+
+
 def _paint(kind: str, c: Any, alpha: float | None = None) -> str:
+    try:
+        key = (kind, c, alpha)
+        got = _PAINTS.get(key)
+    except TypeError:  # an unhashable colour (an RGBA array): not kept
+        return _new_paint(kind, c, alpha)
+    if got is None:
+        if len(_PAINTS) > 4096:
+            _PAINTS.clear()
+        got = _PAINTS[key] = _new_paint(kind, c, alpha)
+    return got
+
+
+def _new_paint(kind: str, c: Any, alpha: float | None) -> str:
     hexa, a = _color(c, alpha)
     if a <= 0:
         return f'{kind}="none"'
@@ -76,12 +94,16 @@ def _polyline(xy: np.ndarray) -> str:
     """``d`` of a polyline in display coordinates (already y down), broken at non-finite points; 0.01 px."""
     ok = np.isfinite(xy).all(axis=1)
     parts = []
-    start = np.flatnonzero(ok & ~np.r_[False, ok[:-1]])
-    stop = np.flatnonzero(ok & ~np.r_[ok[1:], False])
+    if len(xy) and ok.all():  # the common case: one run
+        start, stop = np.array([0]), np.array([len(xy) - 1])
+    else:
+        start = np.flatnonzero(ok & ~np.r_[False, ok[:-1]])
+        stop = np.flatnonzero(ok & ~np.r_[ok[1:], False])
     for a, b in zip(start, stop, strict=True):
         pts = xy[a:b + 1] + 0.0  # no "-0.00"
-        # one C-level %-format of the whole array: ~10x faster than a format call per number
-        parts.append("M%.2f,%.2f" % tuple(pts[0]) + "L%.2f,%.2f" * (len(pts) - 1) % tuple(pts[1:].ravel()))  # noqa: UP031
+        # one C-level %-format of the whole array: ~10x faster than a format call per number (of Python floats:
+        # tolist() makes them ~10x faster than numpy's scalars)
+        parts.append(("M%.2f,%.2f" + "L%.2f,%.2f" * (len(pts) - 1)) % tuple(pts.ravel().tolist()))  # noqa: UP031
     return "".join(parts)
 
 
@@ -107,6 +129,7 @@ def _path_d(path, trans, height: float) -> str:
     return "".join(out)
 
 
+@functools.lru_cache(maxsize=4096)  # tick labels and legend texts recur in every figure
 def _shown(text: str) -> str:
     """The characters matplotlib shows for a text without mathtext: ``\\$`` is a dollar sign
     (:func:`camfab.textsafe.mpl_text` escapes them); control characters, which XML cannot hold, become spaces.
@@ -311,13 +334,18 @@ class _Writer:
     def segments(self, a: Any, clipped: str) -> None:
         """A line collection (the segment junctions): one path per segment, each with its colour and style."""
         colors, widths, styles = a.get_color(), a.get_linewidth(), a.get_linestyle()
-        trans = a.get_transform()
-        for i, seg in enumerate(a.get_segments()):
-            if len(seg) < 2:
-                continue
-            xy = trans.transform(np.asarray(seg, dtype=float))
-            xy[:, 1] = self.h - xy[:, 1]
-            attrs = self.line_attrs(colors[i % len(colors)], widths[i % len(widths)], "-", styles[i % len(styles)])
+        segs = [(i, np.asarray(seg, dtype=float)) for i, seg in enumerate(a.get_segments()) if len(seg) >= 2]
+        if not segs:
+            return
+        # one transform of every segment's points (each point's arithmetic is that of a transform of it alone)
+        xy_all = a.get_transform().transform(np.concatenate([seg for _, seg in segs]))
+        xy_all[:, 1] = self.h - xy_all[:, 1]
+        at = 0
+        for i, seg in segs:
+            xy, at = xy_all[at:at + len(seg)], at + len(seg)
+            colour = colors[i % len(colors)]
+            attrs = self.line_attrs(tuple(colour) if isinstance(colour, np.ndarray) else colour,  # kept by _paint
+                                    widths[i % len(widths)], "-", styles[i % len(styles)])
             if attrs:
                 self.out.append(f'<path d="{_polyline(xy)}" fill="none" {attrs}{clipped}/>')
 
@@ -396,6 +424,14 @@ class _Writer:
         locs = locs[(locs >= lo - 1e-9 * span) & (locs <= hi + 1e-9 * span)]
         return locs, list(axis.get_major_formatter().format_ticks(list(locs)))
 
+    def _tick_pixels(self, ax, axis, vertical: bool) -> list[float]:
+        """Display x (or y, ``vertical``) of the axis's major ticks: one transform of them all (each point's
+        arithmetic is the same as a transform of it alone)."""
+        locs, _ = self._ticks(axis)
+        pts = np.zeros((len(locs), 2))
+        pts[:, 1 if vertical else 0] = locs
+        return ax.transData.transform(pts)[:, 1 if vertical else 0].tolist()
+
     def grid(self, ax) -> None:
         b = ax.bbox
         for axis, horizontal in ((ax.xaxis, False), (ax.yaxis, True)):
@@ -403,19 +439,16 @@ class _Writer:
             g = tick.gridline
             if not g.get_visible():
                 continue
-            locs, _ = self._ticks(axis)
             attrs = self.line_attrs(g.get_color(), g.get_linewidth(), g.get_linestyle(),
                                     getattr(g, "_dash_pattern", None), g.get_alpha(), "projecting")
             if not attrs:
                 continue
             d = []
-            for v in locs:
+            for p in self._tick_pixels(ax, axis, horizontal):
                 if horizontal:
-                    _, yy = ax.transData.transform((0.0, v))
-                    d.append(f"M{_num(b.x0)},{_num(self.y(yy))}H{_num(b.x1)}")
+                    d.append(f"M{_num(b.x0)},{_num(self.y(p))}H{_num(b.x1)}")
                 else:
-                    xx, _ = ax.transData.transform((v, 0.0))
-                    d.append(f"M{_num(xx)},{_num(self.y(b.y0))}V{_num(self.y(b.y1))}")
+                    d.append(f"M{_num(p)},{_num(self.y(b.y0))}V{_num(self.y(b.y1))}")
             if d:
                 self.out.append(f'<path class="grid" d="{"".join(d)}" fill="none" {attrs}/>')
 
@@ -439,22 +472,20 @@ class _Writer:
             tick = axis.get_major_ticks(numticks=1)[0]
             if tick.tick2line.get_visible() or tick.label2.get_visible() or tick.get_tickdir() != "out":
                 raise _Unsupported("ticks")
-            locs, labels = self._ticks(axis)
+            _, labels = self._ticks(axis)
             size = tick.get_tick_padding()  # the tick length (points) for outward ticks
             mark = tick.tick1line
             pad = (tick.get_pad() + size) * self.pt
             lab = tick.label1
             d = []
-            for v, s in zip(locs, labels, strict=True):
+            for p, s in zip(self._tick_pixels(ax, axis, vertical), labels, strict=True):
                 if vertical:
-                    _, p = ax.transData.transform((0.0, v))
                     if mark.get_visible():
                         d.append(f"M{_num(b.x0)},{_num(self.y(p))}h{_num(-size * self.pt)}")
                     if lab.get_visible():
                         self.text(s, b.x0 - pad, p, size=lab.get_fontsize(), color=lab.get_color(), ha="right",
                                   va="center", cls=cls)
                 else:
-                    p, _ = ax.transData.transform((v, 0.0))
                     if mark.get_visible():
                         d.append(f"M{_num(p)},{_num(self.y(b.y0))}v{_num(size * self.pt)}")
                     if lab.get_visible():
