@@ -28,6 +28,7 @@ from ..discretize import (
     polyline,
     validate_tol,
 )
+from ..discretize.grid import ring_distance
 from ..discretize.tolerance import within
 from ..errors import GeometryError, InternalError
 from ..geom2d import ArcChain
@@ -254,14 +255,11 @@ def shapely_guard(profile: ParametricCurve, exact: ParametricCurve, tool_radius:
     hole (:func:`shapely_offset`), and every sample of the exact offset must lie on its boundary within the
     guard's resolution, else the exact offset folds or crosses itself (a neck, a loop) where the buffer does not.
     Returns the largest distance found (mm)."""
-    import shapely
-
     base, res = guard_samples(profile)
     buffered = shapely_offset(base, tool_radius)
     q, res_q = guard_samples(exact)
-    ring = np.asarray(buffered.exterior.coords)
-    edges = shapely.STRtree(shapely.linestrings(np.stack([ring[:-1], ring[1:]], axis=1)))
-    dev = float(edges.query_nearest(shapely.points(q), return_distance=True, all_matches=False)[1].max())
+    # each sample's exact distance to the buffer's boundary (its segments), on grids rather than shapely's STRtree
+    dev = float(ring_distance(q, np.asarray(buffered.exterior.coords)).max())
     joins = tool_radius * (1.0 - math.cos(math.pi / (4 * QUAD_SEGS)))  # a round join's chord vs its arc
     allow = max(GUARD_MIN_MM, 2.0 * (res + res_q + joins))
     if dev > allow:

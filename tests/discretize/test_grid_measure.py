@@ -121,3 +121,34 @@ def test_an_arc_moved_5um_is_caught(monkeypatch):
     for dev in (measure_deviation(moved, curve), _with_kdtree(monkeypatch, lambda: measure_deviation(moved, curve))):
         assert 5e-3 - base.max - 1e-6 <= dev.max <= 5e-3 + base.max + 1e-6
         assert dev.curve_to_entities > 4e-3 - base.max and dev.entities_to_curve > 4e-3 - base.max
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_ring_distance_is_the_distance_to_the_nearest_segment(seed):
+    """ring_distance (the shapely guard's distances) against shapely's STRtree nearest segment and against every
+    segment by brute force: points near a wavy ring with uneven vertices and a few long segments, and points far
+    inside and outside it (answered on the coarser grids)."""
+    import shapely
+
+    from camfab.discretize.grid import ring_distance
+
+    rng = np.random.default_rng(seed)
+    th = np.sort(rng.uniform(0.0, 2 * np.pi, 1500))
+    th[200:260] = th[200]  # zero-length segments
+    th = np.concatenate([th[:600], th[700:]])  # one long segment
+    r = 80.0 + 5.0 * np.sin(3 * th)
+    ring = np.column_stack([r * np.cos(th), r * np.sin(th)])
+    ring = np.vstack([ring, ring[:1]])
+    near = ring[:-1] + rng.normal(0.0, 0.05, (ring.shape[0] - 1, 2))
+    q = np.vstack([near, rng.uniform(-120.0, 120.0, (40, 2))])
+    got = ring_distance(q, ring)
+    tree = shapely.STRtree(shapely.linestrings(np.stack([ring[:-1], ring[1:]], axis=1)))
+    ref = tree.query_nearest(shapely.points(q), return_distance=True, all_matches=False)[1]
+    np.testing.assert_allclose(got, ref, rtol=1e-12, atol=1e-12)
+    a, b = ring[:-1], ring[1:]
+    ab = b - a
+    l2 = np.einsum("ij,ij->i", ab, ab)
+    w = q[:, None, :] - a[None]
+    t = np.clip(np.einsum("nij,ij->ni", w, ab) / np.where(l2 > 0, l2, 1.0), 0.0, 1.0)
+    brute = np.hypot(*np.moveaxis(w - t[..., None] * ab[None], -1, 0)).min(axis=1)
+    np.testing.assert_allclose(got, brute, rtol=1e-12, atol=1e-12)
