@@ -7,6 +7,8 @@ knots and curvatures together until the local extrema of the deviation share one
 """
 from __future__ import annotations
 
+from typing import Literal
+
 import numpy as np
 
 from ..geom2d import TWO_PI, cross, dot
@@ -72,19 +74,44 @@ def _hermite_rows(F: np.ndarray, f: np.ndarray, fp: np.ndarray) -> np.ndarray:
     return np.hstack([F[:-1], f[:-1], fp[:-1], f[1:], fp[1:]])
 
 
-def _hermite_at(x: np.ndarray, s: np.ndarray, rows: np.ndarray) -> np.ndarray:
+def _hermite_at(x: np.ndarray, grid: tuple, rows: np.ndarray) -> np.ndarray:
     """``F(x) = ∫₀ˣ f`` between grid points: integral of the cubic Hermite interpolant of ``f`` (``rows``: the
-    :func:`_hermite_rows` of ``F``, ``f``, ``fp``)."""
-    i = np.minimum(np.maximum(np.searchsorted(s, x, side="right") - 1, 0), s.size - 2)  # (np.clip: 10× the call)
-    h = s[i + 1] - s[i]
-    tau = np.minimum(np.maximum((x - s[i]) / np.where(h > 0, h, 1.0), 0.0), 1.0)
+    :func:`_hermite_rows` of ``F``, ``f``, ``fp``; ``grid``: the :func:`_hermite_grid` of the grid ``s``).
+
+    The interval of ``x`` is ``searchsorted(s[1:-1], x, "right")``: the number of grid points ``<= x`` less one,
+    clipped to ``[0, n - 2]`` (the first point counts for every ``x >= s[0]`` and no inner one below it, the last
+    only where the clip gives ``n - 2`` anyway), one call instead of four; the interval widths are the grid's,
+    computed once."""
+    inner, lo, width, safe = grid
+    i = inner.searchsorted(x, side="right")  # (the method: np.searchsorted's wrapper costs as much as the search)
+    h = width[i]
+    tau = np.minimum(np.maximum((x - lo[i]) / safe[i], 0.0), 1.0)
     t2, t3, t4 = tau * tau, tau ** 3, tau ** 4
-    w = (h * (tau - t3 + 0.5 * t4), h * h * (0.25 * t4 - 2.0 * t3 / 3.0 + 0.5 * t2),
-         h * (t3 - 0.5 * t4), h * h * (0.25 * t4 - t3 / 3.0))
+    hh, h4, q4 = h * h, 0.5 * t4, 0.25 * t4  # (each used twice: the same values)
+    w = (h * (tau - t3 + h4), hh * (q4 - 2.0 * t3 / 3.0 + 0.5 * t2), h * (t3 - h4), hh * (q4 - t3 / 3.0))
     r = rows[i]
     q = r.shape[1] // 5
     return (r[:, :q] + w[0][:, None] * r[:, q:2 * q] + w[1][:, None] * r[:, 2 * q:3 * q]
             + w[2][:, None] * r[:, 3 * q:4 * q] + w[3][:, None] * r[:, 4 * q:])
+
+
+def _hermite_grid(s: np.ndarray) -> tuple:
+    """What :func:`_hermite_at` reads of the grid ``s``: its inner points, interval starts and widths, and the
+    widths with empty intervals (a junction's two points) as 1."""
+    width = s[1:] - s[:-1]
+    return s[1:-1], s[:-1], width, np.where(width > 0, width, 1.0)
+
+
+def _stack_order(fortran: bool) -> Literal["C", "F"]:
+    """The memory order of a matrix preallocated for what ``np.vstack`` / ``np.hstack`` used to assemble.
+
+    ``np.concatenate`` lays its result out like its inputs: Fortran order only when every input with no axis of
+    length 1 is Fortran-ordered, else C order (numpy's ``PyArray_CreateMultiSortedStridePerm``), and the BLAS
+    products of a matrix round differently in the two orders (the kernel a product takes depends on it: a
+    closure matrix filled in C order changed an example's arcs, docs/decisions.md).  So each preallocated matrix
+    takes the order its stacking gave: ``fortran`` is that condition worked out for its inputs (a transposed
+    ``(m, 2)`` block is Fortran-ordered, a single row has an axis of length 1)."""
+    return "F" if fortran else "C"
 
 
 def _lawson(A: np.ndarray, b: np.ndarray, C: np.ndarray, dvec: np.ndarray, iters: int = _LAWSON_ITERS):
@@ -102,7 +129,7 @@ def _lawson(A: np.ndarray, b: np.ndarray, C: np.ndarray, dvec: np.ndarray, iters
     for _ in range(iters):
         M = AZ * w[:, None]
         H = AZ.T @ M
-        H[np.diag_indices_from(H)] += 1e-14 * np.trace(H) + 1e-300
+        H.reshape(-1)[::H.shape[0] + 1] += 1e-14 * H.trace() + 1e-300  # (its diagonal)
         y = np.linalg.solve(H, -(M.T @ r0))
         k = kp + Z @ y
         e = r0 + AZ @ y
@@ -151,8 +178,10 @@ class SpanModel:
         self._nm = _hermite_rows(np.hstack([self.N, self.M]), np.hstack([nrm, self.m_fp[0]]),
                                  np.hstack([dn, self.m_fp[1]]))
         self._last_key: bytes | None = None
+        self._grid = _hermite_grid(s)
         self._grid_rows = np.arange(s.size)
-        self._cols = np.arange(s.size)[None, :]  # (arc indices: never more arcs than grid points)
+        self._before: dict = {}  # per arc count: row j marks the arcs before arc j
+        self._n0, self._n1 = nrm[:, 0].copy(), nrm[:, 1].copy()
         self._rows: dict = {}  # the rows of the fixed curvatures, per arc count
         self._last_nm: tuple[np.ndarray, np.ndarray] = (np.empty((0, 2)), np.empty((0, 2)))
 
@@ -160,7 +189,7 @@ class SpanModel:
         """``(N(x), M(x))`` between grid points (the last query is cached)."""
         key = x.tobytes()
         if self._last_key != key:
-            v = _hermite_at(x, self.s, self._nm)
+            v = _hermite_at(x, self._grid, self._nm)
             self._last_key, self._last_nm = key, (v[:, :2], v[:, 2:])
         return self._last_nm
 
@@ -171,7 +200,13 @@ class SpanModel:
 
     def closure(self, knots: np.ndarray):
         """``(C, d, parts)`` of the knots: ``C k = d`` closes the span; ``parts`` (what :meth:`matrix` and
-        :meth:`deviation` share): arc lengths, ``G = M - x·N`` at the knots, the arc of every grid point."""
+        :meth:`deviation` share): arc lengths, ``G = M - x·N`` at the knots, the arc of every grid point.
+
+        The knots increase (placed by a cumulative density, moved only while every arc keeps a share of its
+        length), so the arc of a grid point, the number of knots ``<= s`` less one clipped to ``[0, m - 1]``, is
+        the number of interior knots ``<= s`` (one ``searchsorted``, as in :func:`_hermite_at`).  ``C`` is filled
+        in place, in the memory order ``np.vstack([ℓ·L/m, Dk_endᵀ, fixed rows])`` gave it (:func:`_stack_order`:
+        Fortran unless there are two fixed rows), so that every product with it rounds as before."""
         ell = knots[1:] - knots[:-1]
         # V_j(s) = ∫ clip(s' - x_j, 0, ℓ_j)·n ds' from the prefix integrals N = ∫ n, M = ∫ s'·n:
         # after arc j (s > x_{j+1}) n·V_j = n·W_j + ℓ_j·n·N(s), W_j = [M - x·N] from x_j to x_{j+1};
@@ -179,21 +214,31 @@ class SpanModel:
         Nx, Mx = self.NM_at(knots)
         G = Mx - knots[:, None] * Nx                                        # (m + 1, 2)
         m = ell.size
-        jj = np.minimum(np.maximum(np.searchsorted(knots, self.s, side="right") - 1, 0), m - 1)
+        jj = knots[1:-1].searchsorted(self.s, side="right")
         Dk_end = (Mx[1:] - Mx[:-1]) - knots[:-1, None] * (Nx[1:] - Nx[:-1]) + ell[:, None] * (self.N[-1] - Nx[1:])
         rows, d = self._fixed_rows(m)
-        C = np.vstack([ell * (self.L / m), Dk_end.T])  # (vstack, not filled in place: see the decisions)
-        if rows.shape[0]:
-            C = np.vstack([C, rows])
+        C = np.empty((3 + rows.shape[0], m), order=_stack_order(rows.shape[0] < 2))
+        np.multiply(ell, self.L / m, out=C[0])
+        C[1:3] = Dk_end.T
+        C[3:] = rows
         return C, d, (ell, G, jj)
 
     def matrix(self, knots: np.ndarray, parts) -> np.ndarray:
-        """``A`` (``e = A k + b`` on the grid) of the knots (``parts`` from :meth:`closure`)."""
+        """``A`` (``e = A k + b`` on the grid) of the knots (``parts`` from :meth:`closure`).
+
+        Row ``i`` keeps the arcs before its own (columns ``< jj[i]``): row ``jj[i]`` of a per-count table, one
+        ``take`` instead of a broadcast comparison; the gathers are ``take`` s too, and ``n·G`` the sum of
+        :func:`~camfab.geom2d.dot` on contiguous columns (the same products and sums)."""
         ell, G, jj = parts
-        nrm = self.nrm
-        full = nrm @ (G[1:] - G[:-1]).T + self.nN[:, None] * ell[None, :]
-        A = np.where(self._cols[:, :ell.size] < jj[:, None], full, 0.0)
-        A[self._grid_rows, jj] = self.nM - knots[jj] * self.nN - dot(nrm, G[jj])
+        m = ell.size
+        full = self.nrm @ (G[1:] - G[:-1]).T
+        full += self.nN[:, None] * ell[None, :]  # (in place: the same sums, one (n, m) array fewer)
+        before = self._before.get(m)
+        if before is None:
+            before = self._before[m] = np.arange(m)[None, :] < np.arange(m)[:, None]
+        A = np.where(before.take(jj, axis=0), full, 0.0)
+        Gj = G.take(jj, axis=0)
+        A[self._grid_rows, jj] = self.nM - knots.take(jj) * self.nN - (self._n0 * Gj[:, 0] + self._n1 * Gj[:, 1])
         return A
 
     def _fixed_rows(self, m: int):
@@ -214,28 +259,33 @@ class SpanModel:
                 vals.append(kf * self.L)
         return np.array(rows).reshape(-1, m), np.array(vals)
 
-    def knot_jacobian(self, knots: np.ndarray, k: np.ndarray):
-        """Derivatives of ``e`` (grid) and of ``C k - d`` with respect to the interior knots.
+    def knot_jacobian(self, knots: np.ndarray, k: np.ndarray, p: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """Derivatives of ``e`` at the grid points ``p`` and of ``C k - d`` with respect to the interior knots.
 
-        Moving knot ``x_j`` by ``δ`` turns every later tangent by ``(k_{j-1} - k_j)·δ``.
+        Moving knot ``x_j`` by ``δ`` turns every later tangent by ``(k_{j-1} - k_j)·δ``.  The closure rows go
+        to ``out`` (``C.shape[0]`` rows, those of the fixed curvatures 0); the grid rows are returned, only those
+        of ``p`` computed (each element is the same product of its own row either way).
         """
         xi = knots[1:-1]
         Nx = self.NM_at(knots)[0][1:-1]
         jump = k[:-1] - k[1:]
-        B = np.where(self.s[:, None] <= xi[None, :], 0.0, (self.nN[:, None] - self.nrm @ Nx.T) * jump)
-        Bc = np.vstack([jump * (self.L / k.size), ((self.N[-1][None] - Nx) * jump[:, None]).T])
-        n_fixed = self._fixed_rows(k.size)[0].shape[0]
-        if n_fixed:
-            Bc = np.vstack([Bc, np.zeros((n_fixed, xi.size))])
-        return B, Bc
+        if p.size < 2:  # (one row would be numpy's vector-matrix product, which may round otherwise)
+            B = np.where(self.s[:, None] <= xi[None, :], 0.0, (self.nN[:, None] - self.nrm @ Nx.T) * jump)[p]
+        else:
+            B = np.where(self.s[p, None] <= xi[None, :], 0.0, (self.nN[p, None] - self.nrm[p] @ Nx.T) * jump)
+        np.multiply(jump, self.L / k.size, out=out[0])
+        out[1:3] = ((self.N[-1][None] - Nx) * jump[:, None]).T
+        out[3:] = 0.0
+        return B
 
 
 def _local_extrema(e: np.ndarray) -> np.ndarray:
     """Grid indices where ``|e|`` has a local maximum."""
     ae = np.abs(e)
-    left = np.concatenate([[-np.inf], ae[:-1]])
-    right = np.concatenate([ae[1:], [-np.inf]])
-    return np.flatnonzero((ae >= left) & (ae >= right) & (ae > 0))
+    keep = ae > 0
+    keep[1:] &= ae[1:] >= ae[:-1]
+    keep[:-1] &= ae[:-1] >= ae[1:]
+    return np.flatnonzero(keep)
 
 
 def _normal_equations(J: np.ndarray, r: np.ndarray):
@@ -252,17 +302,42 @@ def _damped_step(lin, m: int, mu: float) -> np.ndarray:
     the SVD least squares only when they are singular."""
     J, r, H, g, scale = lin
     H = H.copy()
-    idx = np.arange(m, 2 * m - 1)
-    H[idx, idx] += (mu * scale[idx]) ** 2
+    n = H.shape[0]
+    H.reshape(-1)[m * (n + 1):(2 * m - 1) * (n + 1):n + 1] += (mu * scale[m:2 * m - 1]) ** 2  # (its diagonal)
     try:
         y = np.linalg.solve(H, g) * scale
     except np.linalg.LinAlgError:
         y = None
-    if y is None or not np.all(np.isfinite(y)):
+    if y is None or not np.isfinite(y).all():
         damp = np.zeros((m - 1, 2 * m))
         damp[:, m:2 * m - 1] = np.eye(m - 1) * mu
         y, *_ = np.linalg.lstsq(np.vstack([J, damp]), np.concatenate([r, np.zeros(m - 1)]), rcond=None)
     return y
+
+
+def _linearisation(model: SpanModel, A: np.ndarray, C: np.ndarray, d: np.ndarray, knots: np.ndarray, k: np.ndarray,
+                   e: np.ndarray, p: np.ndarray):
+    """:func:`_normal_equations` of the Gauss-Newton step at the extrema ``p``: the system
+    ``[[A[p], B[p], -sign(e[p])], wc·[C, Bc, 0]] y ≈ [-e[p], wc·(d - C k)]`` (``B``, ``Bc``: the
+    :meth:`~SpanModel.knot_jacobian`; ``wc`` weighs the closure rows to 1e3 of its largest entry).
+
+    The matrix is filled in place, in the memory order ``np.vstack([np.hstack(...), ...])`` gave it
+    (:func:`_stack_order`: Fortran only for one extremum and fewer than two fixed rows)."""
+    m, n_p = k.size, p.size
+    J = np.empty((n_p + C.shape[0], 2 * m), order=_stack_order(n_p == 1 and C.shape[0] < 5))
+    Cj = J[n_p:]
+    J[:n_p, :m] = A[p]
+    J[:n_p, m:2 * m - 1] = model.knot_jacobian(knots, k, p, Cj[:, m:2 * m - 1])
+    ep = e[p]
+    np.negative(np.sign(ep), out=J[:n_p, 2 * m - 1])
+    Cj[:, :m] = C
+    Cj[:, 2 * m - 1] = 0.0
+    wc = 1e3 / max(float(np.abs(Cj).max()), 1e-300)
+    Cj *= wc
+    r = np.empty(J.shape[0])
+    np.negative(ep, out=r[:n_p])
+    np.multiply(wc, d - C @ k, out=r[n_p:])
+    return _normal_equations(J, r)
 
 
 def equioscillate(model: SpanModel, knots: np.ndarray, iters: int = _EQUI_ITERS):
@@ -287,11 +362,7 @@ def equioscillate(model: SpanModel, knots: np.ndarray, iters: int = _EQUI_ITERS)
         emax, knots, k, e = best
         if lin is None:
             p = _local_extrema(e)
-            B, Bc = model.knot_jacobian(knots, k)
-            J = np.hstack([A[p], B[p], -np.sign(e[p])[:, None]])
-            Cj = np.hstack([C, Bc, np.zeros((C.shape[0], 1))])
-            wc = 1e3 / max(float(np.abs(Cj).max()), 1e-300)
-            lin = _normal_equations(np.vstack([J, wc * Cj]), np.concatenate([-e[p], wc * (d - C @ k)]))
+            lin = _linearisation(model, A, C, d, knots, k, e, p)
             level = np.abs(e[p])
             level_spread = 1.0 - float(level.min()) / emax if level.size else 1.0
         y = _damped_step(lin, m, lam * emax / hmean)
@@ -301,7 +372,7 @@ def equioscillate(model: SpanModel, knots: np.ndarray, iters: int = _EQUI_ITERS)
         for alpha in (1.0, 0.5, 0.25):
             xn = knots.copy()
             xn[1:-1] += alpha * dx
-            if not np.all(xn[1:] - xn[:-1] >= shortest):
+            if not (xn[1:] - xn[:-1] >= shortest).all():
                 continue
             C2, d2, parts = model.closure(xn)
             k2 = k + alpha * dk
