@@ -122,6 +122,8 @@ def _dxf_pieces(text: str, extra: Callable[[str, str], str] | None = None) -> li
 def dxf_string(text: str, *, limit: int = DXF_MAX) -> str:
     """A DXF string value (a header variable, a custom property): one line, carets escaped, at most
     ``limit`` characters.  A newline can no longer start a group code, so no entity can be injected."""
+    if _untouched(text, "^", limit):
+        return text
     return _take(_dxf_pieces(text), limit)
 
 
@@ -136,7 +138,18 @@ def _text_extra(c: str, nxt: str) -> str:
 def dxf_text(text: str, *, limit: int = DXF_MAX) -> str:
     """The value of a DXF TEXT entity: :func:`dxf_string` plus its special codes (``%%``, ``\\U+``) made
     literal."""
+    if _untouched(text, "^%\\", limit):
+        return text
     return _take(_dxf_pieces(text, _text_extra), limit)
+
+
+def _untouched(text: Any, specials: str, limit: int | None = None) -> bool:
+    """Whether the escaping would give ``text`` back as it is: a printable ``str`` (nothing for :func:`plain`)
+    without any of ``specials`` (nothing to escape) and, when a ``limit`` is given, no longer than it (nothing
+    to cut).  The common case on a drawing sheet (labels, values, notes), spared the character-by-character
+    pass."""
+    return (type(text) is str and text.isprintable() and (limit is None or len(text) <= limit)
+            and not any(c in text for c in specials))
 
 
 def _mtext_extra(c: str, nxt: str) -> str:
@@ -150,6 +163,8 @@ def _mtext_extra(c: str, nxt: str) -> str:
 def dxf_mtext(text: str) -> str:
     """Text to place inside an MTEXT entity's content: no line breaks (``\\P`` can only come from camfab),
     inline codes, grouping braces, carets and ``%%`` codes literal.  ezdxf splits long content itself."""
+    if _untouched(text, "^%\\{}"):
+        return text
     return "".join(_dxf_pieces(text, _mtext_extra))
 
 

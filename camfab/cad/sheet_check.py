@@ -43,24 +43,40 @@ def _rotated_box(x: float, y: float, local: tuple[float, float, float, float], d
     a = math.radians(deg)
     c, s = math.cos(a), math.sin(a)
     u0, v0, u1, v1 = local
-    uv = np.array([(u0, v0), (u1, v0), (u1, v1), (u0, v1)])
-    return np.column_stack([x + uv[:, 0] * c - uv[:, 1] * s, y + uv[:, 0] * s + uv[:, 1] * c])
+    # the corner arithmetic in floats, in the order of the former array expression (x + u c - v s,
+    # y + u s + v c): the same values, without numpy's overhead on four points (a sheet measures ~150 boxes)
+    return np.array([(x + u * c - v * s, y + u * s + v * c) for u, v in ((u0, v0), (u1, v0), (u1, v1), (u0, v1))],
+                    dtype=float)
+
+
+#: a TEXT alignment's name -> (where its box starts along the text, in widths; its bottom and top, in heights)
+#: (a bare LEFT, CENTER, RIGHT, ALIGNED or FIT sits on the baseline: a quarter height below it for descenders)
+_TEXT_ANCHOR: dict[str, tuple[float, float, float]] = {}
+
+
+def _text_anchor(name: str) -> tuple[float, float, float]:
+    got = _TEXT_ANCHOR.get(name)
+    if got is None:
+        v, _, hname = name.partition("_") if "_" in name else ("BASELINE", "", name)
+        got = _TEXT_ANCHOR[name] = (-_HALIGN.get(hname, 0.0), {"TOP": -1.0, "MIDDLE": -0.5}.get(v, -0.25),
+                                    {"TOP": 0.0, "MIDDLE": 0.5}.get(v, 1.0))
+    return got
 
 
 def _text_box(e) -> tuple[str, np.ndarray]:
     """A TEXT's or MTEXT's text and its conservative box (:func:`text_width`; TEXT from the baseline less a
     quarter height for descenders to the cap height; MTEXT lines at :data:`NOTE_PITCH`)."""
     if e.dxftype() == "TEXT":
-        align, p1, p2 = e.get_placement()
-        h = e.dxf.height
-        w = text_width(e.dxf.text, h)
-        name = align.name  # e.g. MIDDLE_CENTER, BOTTOM_LEFT, LEFT
-        v, _, hname = name.partition("_") if "_" in name else ("BASELINE", "", name)
-        at = p1 if name in ("LEFT",) else (p2 if p2 is not None else p1)
-        u0 = -_HALIGN.get(hname, 0.0) * w
-        v0 = {"TOP": -h, "MIDDLE": -h / 2, "BOTTOM": -0.25 * h}.get(v, -0.25 * h)
-        v1 = {"TOP": 0.0, "MIDDLE": h / 2}.get(v, h)
-        return e.dxf.text, _rotated_box(at[0], at[1], (u0, v0, u0 + w, v1), e.dxf.rotation)
+        dxf = e.dxf
+        h, text = dxf.height, dxf.text
+        w = text_width(text, h)
+        name = e.get_align_enum().name  # e.g. MIDDLE_CENTER, BOTTOM_LEFT, LEFT
+        # where Text.get_placement puts it: a LEFT text at its insert, any other at its align point (the insert
+        # when it has none)
+        at = dxf.insert if name == "LEFT" else dxf.get("align_point", dxf.insert)
+        fu, fv0, fv1 = _text_anchor(name)
+        u0 = fu * w
+        return text, _rotated_box(at[0], at[1], (u0, fv0 * h, u0 + w, fv1 * h), dxf.rotation)
     lines = e.text.split("\\P")
     h = e.dxf.char_height
     w, tall = max(text_width(line, h) for line in lines), h + (len(lines) - 1) * h * NOTE_PITCH
@@ -79,12 +95,39 @@ def _segments(e, flat: float = 0.05) -> list[tuple[float, float, float, float]]:
     from ezdxf import path as ezpath
 
     kind = e.dxftype()
+    if kind == "LINE":  # what the path of a LINE flattens to (its two end points), without building the path
+        a, b = e.dxf.start, e.dxf.end
+        return [(a.x, a.y, b.x, b.y)]
     if kind == "INSERT":
         return [s for v in e.virtual_entities() for s in _segments(v, flat)]
-    if kind not in ("LINE", "LWPOLYLINE", "ARC", "CIRCLE", "SOLID"):
+    if kind not in ("LWPOLYLINE", "ARC", "CIRCLE", "SOLID"):
         return []
+    if kind == "LWPOLYLINE":
+        straight = _straight_polyline(e)
+        if straight is not None:
+            return straight
     pts = [(p.x, p.y) for p in ezpath.make_path(e).flattening(flat)]
     return [(a[0], a[1], b[0], b[1]) for a, b in zip(pts[:-1], pts[1:], strict=True)]
+
+
+def _straight_polyline(e) -> list[tuple[float, float, float, float]] | None:
+    """The segments of an LWPOLYLINE of straight lines in the drawing plane (a rectangle of the frame, title
+    block or lift table) as ezdxf's path of it flattens to (``ezdxf.path.tools.add_2d_polyline``: a line to
+    every vertex, and back to the first when closed unless the last is there already), without building the
+    path; None for any other polyline (bulges, elevation or a tilted plane: the path decides)."""
+    from ezdxf.math import Vec3
+    from ezdxf.path.tools import IS_CLOSE_TOL
+
+    dxf = e.dxf
+    if dxf.elevation or tuple(Vec3(dxf.extrusion)) != (0.0, 0.0, 1.0):  # (exactly: the OCS is no transform)
+        return None
+    pts = e.get_points("xyb")
+    if any(abs(b) >= 1e-6 for _, _, b in pts):  # (add_2d_polyline takes a smaller bulge for none)
+        return None
+    xy = [(float(x), float(y)) for x, y, _ in pts]
+    if e.closed and len(xy) > 1 and not Vec3(xy[0]).isclose(Vec3(xy[-1]), rel_tol=IS_CLOSE_TOL, abs_tol=0):
+        xy.append(xy[0])
+    return [(a[0], a[1], b[0], b[1]) for a, b in zip(xy[:-1], xy[1:], strict=True)]
 
 
 def sheet_items(doc, layout: SheetLayout) -> SheetItems:
@@ -92,38 +135,37 @@ def sheet_items(doc, layout: SheetLayout) -> SheetItems:
     block, lift table and notes, by position for the side view (right of ``layout.side``'s left edge),
     the rest is the cam view; a DIMENSION's lines and text are owned by it."""
     texts, segs, groups, owners, refs = [], [], [], [], []
+    side = layout.side[0] if layout.side is not None else None
 
-    def group_of(e, x: float) -> str:
-        g = _GROUP_OF_LAYER.get(e.dxf.layer)
-        if g:
-            return g
-        return "side" if layout.side is not None and x >= layout.side[0] else "view"
+    def group_at(x: float) -> str:  # an item on no layer of its own: the side view or the cam view
+        return "side" if side is not None and x >= side else "view"
 
     for e in doc.modelspace():
-        if e.dxf.layer == "FRAME" or e.dxftype() == "POINT":
+        layer, kind = e.dxf.layer, e.dxftype()
+        if layer == "FRAME" or kind == "POINT":
             continue
-        if e.dxftype() == "DIMENSION":
+        g = _GROUP_OF_LAYER.get(layer)  # (a position is found only for the items that need one)
+        if kind == "DIMENSION":
             block = doc.blocks.get(e.dxf.geometry)
             lines = [s for t in block for s in _segments(t)]
-            x = min(s[0] for s in lines)
-            g = group_of(e, x)
+            g = g or group_at(min(s[0] for s in lines))
             for text, box in _dimension_quads(doc, e):
                 texts.append((text, g, e.dxf.handle, box))
             segs += lines
             groups += [g] * len(lines)
             owners += [e.dxf.handle] * len(lines)
             refs += [False] * len(lines)
-        elif e.dxftype() in ("TEXT", "MTEXT"):
+        elif kind in ("TEXT", "MTEXT"):
             text, box = _text_box(e)
-            texts.append((text, group_of(e, float(box[:, 0].min())), "", box))
+            texts.append((text, g or group_at(min(box[:, 0].tolist())), "", box))
         else:
             lines = _segments(e)
             if lines:
-                g = group_of(e, min(min(s[0], s[2]) for s in lines))
+                g = g or group_at(min(min([s[0] for s in lines]), min([s[2] for s in lines])))
                 segs += lines
                 groups += [g] * len(lines)
                 owners += [""] * len(lines)
-                refs += [e.dxf.layer in REFERENCE_LAYERS] * len(lines)
+                refs += [layer in REFERENCE_LAYERS] * len(lines)
     return SheetItems(texts, np.array(segs, dtype=float).reshape(-1, 4), groups, owners, np.array(refs, dtype=bool))
 
 
@@ -294,32 +336,157 @@ class Occupancy:
         self.quads = [q for *_, q in it.texts]
         self.segments = it.segments[~it.seg_reference]
         self.frame = layout.frame
+        seg_group = np.array(it.seg_group) if len(it.segments) else None
         for g in ("title", "table", "notes", "side"):  # the other groups' boxes: no view text may enter them
             pts = [q for _, grp, _, q in it.texts if grp == g]
-            segs = it.segments[np.array([x == g for x in it.seg_group], dtype=bool)] if len(it.segments) else []
-            pts += [seg.reshape(2, 2) for seg in segs]
-            if pts:
-                allp = np.vstack(pts)
+            if seg_group is not None:  # the group's segments' end points, all at once
+                pts.append(it.segments[seg_group == g].reshape(-1, 2))
+            allp = np.vstack(pts) if pts else np.empty((0, 2))
+            if len(allp):
                 self.quads.append(_quad((allp[:, 0].min(), allp[:, 1].min(), allp[:, 0].max(), allp[:, 1].max())))
 
     def free(self, quads: list[np.ndarray], segments: np.ndarray) -> bool:
+        # Each test below is first asked of the items near enough to matter: when none is (clear bounds, or a
+        # gap on a separating axis, see _plain), its answer is known (no crossing, no overlap) and the full test
+        # is skipped; otherwise the full test runs as ever, on everything.  Most positions tried are free, so
+        # most tests are skipped.
         x0, y0, x1, y1 = self.frame
         for q in quads:
-            if q[:, 0].min() < x0 or q[:, 1].min() < y0 or q[:, 0].max() > x1 or q[:, 1].max() > y1:
+            xs, ys = q[:, 0].tolist(), q[:, 1].tolist()  # (four corners: plain floats compare faster)
+            box = (min(xs), min(ys), max(xs), max(ys))
+            if box[0] < x0 or box[1] < y0 or box[2] > x1 or box[3] > y1:
                 return False
-            if len(self.segments) and _crosses(q, self.segments).any():
+            plain = _plain_box(q)
+            if len(self.segments) and not (plain and self._segments_clear(q, box)) \
+                    and _crosses(q, self.segments).any():
                 return False
-            if _any_overlap(q, self._stacked()):
+            if not (plain and self._quads_apart(box[0], box[1], box[2], box[3]).all()) \
+                    and _any_overlap(q, self._stacked()):
                 return False
-        return not (len(segments) and self.quads and _any_crosses(self._stacked(), segments))
+        if not (len(segments) and self.quads):
+            return True
+        sb = _segment_bounds(segments)  # (k, 4): each of the new lines against every box
+        if self._quads_apart(sb[None, :, 0], sb[None, :, 1], sb[None, :, 2], sb[None, :, 3]).all():
+            return True
+        return not _any_crosses(self._stacked(), segments)
 
     def _stacked(self) -> np.ndarray:
-        """:attr:`quads` as one (m, 4, 2) array (made again when a box was added)."""
+        """:attr:`quads` as one (m, 4, 2) array (made again when the list has changed length)."""
         st = getattr(self, "_stack", None)
         if st is None or len(st) != len(self.quads):
             st = self._stack = np.array(self.quads, dtype=float).reshape(-1, 4, 2)
         return st
 
+    def _box_info(self) -> tuple[np.ndarray, np.ndarray]:
+        """The bounds (m, 4) and plainness (m,) of :meth:`_stacked` (made again with it)."""
+        st = self._stacked()
+        got = getattr(self, "_info", None)
+        if got is None or got[0] is not st:
+            got = self._info = (st, _quad_bounds(st), _plain(st))
+        return got[1], got[2]
+
+    def _quads_apart(self, bx0, by0, bx1, by1) -> np.ndarray:
+        """Which boxes of :attr:`quads` are plain (:func:`_plain`) and clear of the bounds ``b`` by more than
+        :data:`_NEAR` on x or y: (m,) for one bounds given as floats, (m, k) for k given as (1, k) arrays."""
+        b, plain = self._box_info()
+        if np.ndim(bx0):  # several bounds: a column per box of the sheet
+            b, plain = b[:, :, None], plain[:, None]
+        return plain & ((b[:, 2] < bx0 - _NEAR) | (b[:, 0] > bx1 + _NEAR) | (b[:, 3] < by0 - _NEAR)
+                        | (b[:, 1] > by1 + _NEAR))
+
+    def _segment_bounds(self) -> np.ndarray:
+        """The bounds (n, 4) of :attr:`segments` (made again when they have changed)."""
+        got = getattr(self, "_seg_bounds", None)
+        if got is None or got[0] is not self.segments:
+            got = self._seg_bounds = (self.segments, _segment_bounds(self.segments))
+        return got[1]
+
+    def _segments_clear(self, q: np.ndarray, box: tuple[float, float, float, float]) -> bool:
+        """Whether every segment of :attr:`segments` is clear of the plain box ``q`` (bounds ``box``): its
+        bounds apart from ``box``, or a gap above :data:`_NEAR` on a separating axis (:func:`_gap_apart`)."""
+        near = np.flatnonzero(~_apart(self._segment_bounds(), box))
+        if len(near) > 16:  # (a box among many lines: the full test is as quick)
+            return False
+        return all(_gap_apart(q, s) for s in self.segments[near].tolist())
+
     def add(self, quads: list[np.ndarray], segments: np.ndarray) -> None:
+        st, info = getattr(self, "_stack", None), getattr(self, "_info", None)
+        if st is not None and len(st) == len(self.quads) and len(quads):  # the stack grows with the list
+            new = np.array(quads, dtype=float).reshape(-1, 4, 2)
+            self._stack = np.concatenate([st, new])
+            if info is not None and info[0] is st:
+                self._info = (self._stack, np.concatenate([info[1], _quad_bounds(new)]),
+                              np.concatenate([info[2], _plain(new)]))
         self.quads += quads
-        self.segments = np.vstack([self.segments.reshape(-1, 4), segments.reshape(-1, 4)])
+        old, sb = self.segments, getattr(self, "_seg_bounds", None)
+        segments = segments.reshape(-1, 4)
+        self.segments = np.vstack([old.reshape(-1, 4), segments])
+        if sb is not None and sb[0] is old:
+            self._seg_bounds = (self.segments, np.vstack([sb[1], _segment_bounds(segments)]))
+
+
+#: how far apart (paper mm, on x or y) two items' bounds must lie for :meth:`Occupancy.free` to take them as
+#: clear of each other without the full test; any positive distance would do (the tests' rim ``eps`` absorbs
+#: rounding), this one is also far above it
+_NEAR = 1e-6
+
+
+def _plain(quads: np.ndarray) -> np.ndarray:
+    """Which boxes (m, 4, 2) are plain parallelograms (finite, no edge of zero length, opposite edges equal to
+    rounding) — the text boxes of a sheet.  For those, bounds clear of another item's bounds imply the full
+    tests' answer: :func:`_any_overlap` finds two such boxes apart, as separating axes among their edge normals
+    are certain to exist for disjoint parallelograms, and :func:`_crosses` finds a segment clear of such a box
+    (it leaves the box's line through an edge, beyond which its projection on that edge's normal clears the
+    box's, shrunk by the rim); a degenerate box has no such normals, so the full test decides."""
+    e1, e2 = quads[:, 1] - quads[:, 0], quads[:, 3] - quads[:, 0]
+    skew = np.abs(quads[:, 0] + quads[:, 2] - quads[:, 1] - quads[:, 3]).max(axis=1)
+    size = np.abs(quads).max(axis=(1, 2))
+    return (np.isfinite(quads).all(axis=(1, 2)) & (np.hypot(e1[:, 0], e1[:, 1]) > 0)
+            & (np.hypot(e2[:, 0], e2[:, 1]) > 0) & (skew <= 1e-9 * (1.0 + size)))
+
+
+def _plain_box(q: np.ndarray) -> bool:
+    """:func:`_plain` of one box, in floats."""
+    (ax, ay), (bx, by), (cx, cy), (dx, dy) = q.tolist()
+    coords = (ax, ay, bx, by, cx, cy, dx, dy)
+    if not all(math.isfinite(v) for v in coords):
+        return False
+    skew = max(abs(ax + cx - bx - dx), abs(ay + cy - by - dy))
+    return (math.hypot(bx - ax, by - ay) > 0 and math.hypot(dx - ax, dy - ay) > 0
+            and skew <= 1e-9 * (1.0 + max(abs(v) for v in coords)))
+
+
+def _gap_apart(q: np.ndarray, seg: list[float]) -> bool:
+    """Whether the segment ``seg`` (x0, y0, x1, y1) lies more than :data:`_NEAR` from the plain box ``q`` along
+    one of the separating axes of the two (the box's edge normals, the segment's normal), in floats: then the
+    two are apart and :func:`_crosses` finds no crossing (see :func:`_plain`)."""
+    (ax, ay), (bx, by), (cx, cy), (dx, dy) = q.tolist()
+    x0, y0, x1, y1 = seg
+    for nx, ny in ((ay - by, bx - ax), (ay - dy, dx - ax), (y0 - y1, x1 - x0)):
+        norm = math.hypot(nx, ny)
+        if norm == 0:
+            continue
+        nx, ny = nx / norm, ny / norm
+        p = (ax * nx + ay * ny, bx * nx + by * ny, cx * nx + cy * ny, dx * nx + dy * ny)
+        s0, s1 = x0 * nx + y0 * ny, x1 * nx + y1 * ny
+        if min(s0, s1) - max(p) > _NEAR or min(p) - max(s0, s1) > _NEAR:
+            return True
+    return False
+
+
+def _quad_bounds(quads: np.ndarray) -> np.ndarray:
+    """Each box's bounds (m, 4): x0, y0, x1, y1."""
+    return np.concatenate([quads.min(axis=1), quads.max(axis=1)], axis=1)
+
+
+def _segment_bounds(seg: np.ndarray) -> np.ndarray:
+    """Each segment's bounds (n, 4): x0, y0, x1, y1."""
+    seg = seg.reshape(-1, 4)
+    return np.column_stack([np.minimum(seg[:, 0], seg[:, 2]), np.minimum(seg[:, 1], seg[:, 3]),
+                            np.maximum(seg[:, 0], seg[:, 2]), np.maximum(seg[:, 1], seg[:, 3])])
+
+
+def _apart(bounds: np.ndarray, box: tuple[float, float, float, float]) -> np.ndarray:
+    """Which of the bounds (n, 4) lie clear of ``box`` by more than :data:`_NEAR` on x or y."""
+    return ((bounds[:, 2] < box[0] - _NEAR) | (bounds[:, 0] > box[2] + _NEAR)
+            | (bounds[:, 3] < box[1] - _NEAR) | (bounds[:, 1] > box[3] + _NEAR))
