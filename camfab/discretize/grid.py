@@ -14,7 +14,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-__all__ = ["grid_nearest", "ring_distance"]
+__all__ = ["grid_nearest"]
 
 #: each level's cells are this many times the previous level's
 _GROWTH = 2.0
@@ -157,27 +157,3 @@ def _kdtree_pass(q: np.ndarray, sites: np.ndarray, distance: Callable[[np.ndarra
     sure = (k == sites.shape[0]) | (dm[:, -1] - reach >= d[rows, j] * (1.0 + 1e-9))
     return todo[~sure]
 
-
-def ring_distance(q: np.ndarray, ring: np.ndarray) -> np.ndarray:
-    """Exact distance from each point ``q`` ``(N, 2)`` to the closed polyline ``ring`` ``(M + 1, 2)`` (its last
-    vertex repeating the first, as shapely's ``exterior.coords``): the smallest point-to-segment distance over
-    every segment, found on the grids of :func:`grid_nearest` with each segment standing for its midpoint
-    (``reach`` half the longest segment: a segment lies within that of its midpoint).
-
-    What shapely's ``STRtree.query_nearest`` over the segments answered (the same minimum; GEOS rounds the
-    point-to-segment distance its own way, so the last bits may differ), without building a tree of ~5 000
-    line strings and its per-query overhead (~11 ms for a tool path's 2 048 guard samples)."""
-    q = np.asarray(q, dtype=float).reshape(-1, 2)
-    a, b = ring[:-1], ring[1:]
-    ab = b - a
-    l2 = ab[:, 0] * ab[:, 0] + ab[:, 1] * ab[:, 1]
-    inv = np.divide(1.0, l2, out=np.zeros_like(l2), where=l2 > 0)  # a zero-length segment: its start point
-    half = 0.5 * float(np.sqrt(l2.max())) if l2.size else 0.0
-
-    def dist(p: np.ndarray, j: np.ndarray) -> np.ndarray:
-        wx, wy = p[:, 0] - a[j, 0], p[:, 1] - a[j, 1]
-        t = np.minimum(np.maximum((wx * ab[j, 0] + wy * ab[j, 1]) * inv[j], 0.0), 1.0)
-        return np.hypot(wx - t * ab[j, 0], wy - t * ab[j, 1])
-
-    cell = 2.0 * float(np.median(np.sqrt(l2))) if l2.size else 1.0
-    return grid_nearest(q, 0.5 * (a + b), cell, dist, reach=half)[0]

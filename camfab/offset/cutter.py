@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..discretize import (
+    Chain,
     ParametricCurve,
     arcs,
     measure_deviation,
@@ -28,7 +29,6 @@ from ..discretize import (
     polyline,
     validate_tol,
 )
-from ..discretize.grid import ring_distance
 from ..discretize.tolerance import within
 from ..errors import GeometryError, InternalError
 from ..geom2d import ArcChain
@@ -258,8 +258,8 @@ def shapely_guard(profile: ParametricCurve, exact: ParametricCurve, tool_radius:
     base, res = guard_samples(profile)
     buffered = shapely_offset(base, tool_radius)
     q, res_q = guard_samples(exact)
-    # each sample's exact distance to the buffer's boundary (its segments), on grids rather than shapely's STRtree
-    dev = float(ring_distance(q, np.asarray(buffered.exterior.coords)).max())
+    # each sample's exact distance to the buffer's boundary (its segments: Chain.distance's grids, not an STRtree)
+    dev = float(Chain.from_polyline(np.asarray(buffered.exterior.coords), closed=True).distance(q)[0].max())
     joins = tool_radius * (1.0 - math.cos(math.pi / (4 * QUAD_SEGS)))  # a round join's chord vs its arc
     allow = max(GUARD_MIN_MM, 2.0 * (res + res_q + joins))
     if dev > allow:

@@ -124,13 +124,11 @@ def test_an_arc_moved_5um_is_caught(monkeypatch):
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
-def test_ring_distance_is_the_distance_to_the_nearest_segment(seed):
-    """ring_distance (the shapely guard's distances) against shapely's STRtree nearest segment and against every
-    segment by brute force: points near a wavy ring with uneven vertices and a few long segments, and points far
-    inside and outside it (answered on the coarser grids)."""
+def test_polyline_chain_distance_is_the_distance_to_the_nearest_segment(seed):
+    """Chain.from_polyline(...).distance (the shapely guard's distances) against shapely's STRtree nearest
+    segment and against every segment by brute force: points near a wavy ring with uneven vertices and a few long
+    segments, and points far inside and outside it (answered on the coarser grids)."""
     import shapely
-
-    from camfab.discretize.grid import ring_distance
 
     rng = np.random.default_rng(seed)
     th = np.sort(rng.uniform(0.0, 2 * np.pi, 1500))
@@ -141,7 +139,7 @@ def test_ring_distance_is_the_distance_to_the_nearest_segment(seed):
     ring = np.vstack([ring, ring[:1]])
     near = ring[:-1] + rng.normal(0.0, 0.05, (ring.shape[0] - 1, 2))
     q = np.vstack([near, rng.uniform(-120.0, 120.0, (40, 2))])
-    got = ring_distance(q, ring)
+    got = Chain.from_polyline(ring, closed=True).distance(q)[0]
     tree = shapely.STRtree(shapely.linestrings(np.stack([ring[:-1], ring[1:]], axis=1)))
     ref = tree.query_nearest(shapely.points(q), return_distance=True, all_matches=False)[1]
     np.testing.assert_allclose(got, ref, rtol=1e-12, atol=1e-12)
