@@ -61,6 +61,7 @@ from ..brent import brentq
 
 __all__ = [
     "horner",
+    "derivative_rows",
     "Law",
     "Dwell",
     "Polynomial",
@@ -105,7 +106,7 @@ def horner(c: Sequence[float] | np.ndarray, u: Any) -> Any:
     return out
 
 
-def _derivative_rows(coeffs: Sequence[float], count: int) -> list[tuple[float, ...]]:
+def derivative_rows(coeffs: Sequence[float], count: int) -> list[tuple[float, ...]]:
     """Ascending coefficients of the 0th … (count − 1)th derivatives (a constant's
     derivative is ``(0.0,)``)."""
     cur = np.asarray(coeffs, dtype=float)
@@ -261,12 +262,12 @@ class Polynomial(Law):
     def __init__(self, coeffs: Sequence[float], name: str = "", title: str = "", cv: float = 0.0,
                  ca: float = 0.0, cj: float = 0.0) -> None:
         super().__init__(name, title, cv, ca, cj)
-        self._rows = _derivative_rows(coeffs, 6)
+        self._rows = derivative_rows(coeffs, 6)
 
     def coefficients(self, nu: int) -> tuple[float, ...]:
         """Ascending coefficients of ``f⁽ᵛ⁾``."""
         if nu >= len(self._rows):
-            self._rows = _derivative_rows(self._rows[0], nu + 1)
+            self._rows = derivative_rows(self._rows[0], nu + 1)
         return self._rows[nu]
 
     def coefficient_rows(self, orders: Sequence[int], width: int) -> np.ndarray:

@@ -332,6 +332,23 @@ def test_hermite_coefficients_solve_the_spec_systems(seed):
     assert c345 == pytest.approx([0, 0, 0, 10, -15, 6], abs=1e-12)
 
 
+def test_low_order_derivatives_at_one_are_numpys_bit_for_bit():
+    """The closed-form derivatives at u = 1 that hermite_coefficients uses round as numpy's Polynomial.deriv(k)(1.0)
+    did (the knot tables' coefficients, and so every file of a knot design, stay the same bytes)."""
+    from camfab.design.segment import _derivatives_at_one
+
+    rng = np.random.default_rng(7)
+    for trial in range(3000):
+        m = 3 + trial % 2
+        a = rng.standard_normal(m) * 10.0 ** rng.uniform(-12, 12, size=m)
+        if trial % 5 == 0:
+            a[rng.integers(m)] = 0.0 if trial % 10 else -0.0
+        low = np.polynomial.Polynomial(list(a))
+        want = [(low.deriv(k) if k else low)(1.0) for k in range(m)]
+        got = _derivatives_at_one(list(a))
+        assert np.array(got).tobytes() == np.array(want, dtype=float).tobytes(), a
+
+
 def test_hermite_coefficients_rejects_bad_sizes():
     with pytest.raises(ValueError):
         hermite_coefficients([0, 0], [1, 0], 1.0)
