@@ -63,12 +63,19 @@ def _cylinder_step(cam: Any, req: Any) -> list[Artifact]:
 
 
 def _cylinder_stl(cam: Any, req: Any) -> list[Artifact]:
-    """``<stem>.stl``: the grooved (or ribbed) cylinder's solid tessellated by OpenCascade."""
+    """``<stem>.stl``: the grooved cylinder meshed from its exact surfaces with numpy (:mod:`.cylinder_mesh`, no
+    cadquery; its deviation the mesh's measured one), or the ribbed cylinder's solid tessellated by OpenCascade
+    (its deviation the loft's pitch path's)."""
+    if not _is_rib(cam):
+        from .cylinder_mesh import grooved_stl
+
+        data, dev = grooved_stl(cam.geometry, tol=cam.tolerance(req.tol), name=cam.name,
+                                bore_mm=float(cam.spec.manufacturing.bore_mm))
+        return [Artifact(f"{safe_stem(cam.name)}.stl", data, "stl", deviation_mm=dev)]
     from .cylinder import solid_stl
 
     solid, dev = cylinder_solid(cam, req)
-    data = solid_stl(solid, tol=cam.tolerance(req.tol), name=cam.name,
-                     what="ribbed cylinder" if _is_rib(cam) else "grooved cylinder")
+    data = solid_stl(solid, tol=cam.tolerance(req.tol), name=cam.name, what="ribbed cylinder")
     return [Artifact(f"{safe_stem(cam.name)}.stl", data, "stl", deviation_mm=dev)]
 
 

@@ -1,5 +1,6 @@
-"""A cylindrical run asking for the STEP and the STL builds the grooved cylinder once (the build is the slow
-part: the sections of the loft) and writes both from it."""
+"""A cylindrical run asking for the STEP and the STL builds the grooved cylinder's solid once (the build is the slow
+part: the sections of the loft), for the STEP; the STL is meshed from the exact surfaces without it
+(:mod:`camfab.cad.cylinder_mesh`)."""
 from __future__ import annotations
 
 from pathlib import Path

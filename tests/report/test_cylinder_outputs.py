@@ -102,14 +102,15 @@ def test_run_writes_the_report_with_the_unrolled_plot(cam, tmp_path):
     assert html.count('src="plots/unrolled.svg"') == 1 and "Unrolled groove" in html
 
 
-def test_missing_cadquery_skips_the_cylinder_stl_and_step(tmp_path, monkeypatch, capsys):
-    """Without cadquery a run of the cylindrical example writes the rest, names what it skipped, and exits 0."""
+def test_missing_cadquery_skips_the_cylinder_step(tmp_path, monkeypatch, capsys):
+    """Without cadquery a run of the cylindrical example writes the rest (the grooved cylinder's STL too: meshed
+    with numpy, :mod:`camfab.cad.cylinder_mesh`), names what it skipped, and exits 0."""
     import sys
 
     from camfab.cli import main
 
     monkeypatch.setitem(sys.modules, "cadquery", None)  # `import cadquery` raises ImportError
     assert main(["run", str(EXAMPLE), "-o", str(tmp_path), "--outputs", "dxf,step,stl,xlsx"]) == 0
-    assert sorted(p.name for p in tmp_path.iterdir() if p.suffix != ".lock") == ["BarrelCam.dxf", "BarrelCam.xlsx",
-                                                                                  "check.json"]
+    assert sorted(p.name for p in tmp_path.iterdir() if p.suffix != ".lock") == ["BarrelCam.dxf", "BarrelCam.stl",
+                                                                                  "BarrelCam.xlsx", "check.json"]
     assert "skipped (cadquery is missing" in capsys.readouterr().out
