@@ -168,7 +168,7 @@ def track_angles(geometry: Any, tol: float, scale: float = 1.0) -> np.ndarray:
     cum = np.concatenate([[0.0], np.cumsum(0.5 * (density + np.roll(density, -1)) * dt)])  # trapezoids, periodic
     n = max(64, int(math.ceil(cum[-1])))
     if n > MAX_TRIANGLES:
-        raise _refuse(f"{n} cam angles along the track would exceed the {MAX_TRIANGLES} triangles", tol)
+        raise _refuse(f"{n} cam angles along the track would exceed the cap of {MAX_TRIANGLES} triangles", tol)
     return np.interp(np.arange(n) * cum[-1] / n, cum, np.append(t, period))
 
 
@@ -300,6 +300,7 @@ def _bottom_error(geometry: Any, t: np.ndarray, strips: int, verts: np.ndarray, 
 
 
 def _build(geometry: Any, tol: float, bore_mm: float, scale: float) -> tuple[np.ndarray, np.ndarray, float]:
+    """One mesh (vertices, faces, measured deviation) with the sampling's densities times ``scale``."""
     cyl, sense = geometry.cylinder, geometry.mechanism.sense
     r_in, r_out, length = cyl.inner_radius_mm, cyl.outer_radius_mm, cyl.length_mm
     r_bore = 0.5 * bore_mm
@@ -313,7 +314,8 @@ def _build(geometry: Any, tol: float, bore_mm: float, scale: float) -> tuple[np.
     inner = max(int(math.ceil(scale * 2 * math.pi / circle_steps(r_bore, tol / 2))), 16) if r_bore > 0 else 0
     estimate = 4 * n * k + 2 * (n + outer) + 2 * (outer + max(inner, 1)) + 2 * inner
     if estimate > MAX_TRIANGLES:
-        raise _refuse(f"{estimate} triangles ({n} cam angles, {k} radii) would exceed the {MAX_TRIANGLES}", tol)
+        raise _refuse(f"{estimate} triangles ({n} cam angles, {k} radii) would exceed the cap of {MAX_TRIANGLES} "
+                      "triangles", tol)
     # each flank's cam angles: its bottom points' in the planes normal to the pitch curve at t, on every radius
     params = [np.broadcast_to(b, (k, n)) for b in bottom_angles(geometry, t)]
     rows = [flank_rows(geometry, f, radii, tf) for f, tf in zip((1, -1), params, strict=True)]  # +z, −z flank
@@ -323,7 +325,7 @@ def _build(geometry: Any, tol: float, bore_mm: float, scale: float) -> tuple[np.
     strips = max(1, int(math.ceil(scale * _across(np.stack([rows[0][1][0], rows[1][1][0]])) / (TWIST * tol))))
     if estimate + 2 * n * strips > MAX_TRIANGLES:
         raise _refuse(f"{estimate + 2 * n * strips} triangles ({n} cam angles, {k} radii, {strips} strips across "
-                      f"the bottom) would exceed the {MAX_TRIANGLES}", tol)
+                      f"the bottom) would exceed the cap of {MAX_TRIANGLES} triangles", tol)
     across = np.arange(1, strips)[:, None, None] / strips
     ring = 2 * math.pi * np.arange(outer) / outer
     hole = 2 * math.pi * np.arange(inner) / inner if r_bore > 0 else np.zeros(0)
@@ -334,8 +336,8 @@ def _build(geometry: Any, tol: float, bore_mm: float, scale: float) -> tuple[np.
             [np.zeros((1, 3)), np.array([[0.0, 0.0, length]])])  # the bore's circles or the axis's ends
     plus, minus, inside, low, high, bore_low, bore_high = np.cumsum([0] + [len(p) for p in pts])[:7]
     verts = np.concatenate(pts)
-    grids = [(_cells(n, plus + n * np.arange(k)), radii), (_cells(n, minus + n * np.arange(k)), radii),
-             (_cells(n, np.concatenate([[plus], inside + n * np.arange(strips - 1), [minus]])), None)]
+    grids = [_cells(n, plus + n * np.arange(k)), _cells(n, minus + n * np.arange(k)),  # +z flank, −z flank, bottom
+             _cells(n, np.concatenate([[plus], inside + n * np.arange(strips - 1), [minus]]))]
 
     def band(edge_a: int, ua: np.ndarray, edge_b: int, ub: np.ndarray) -> np.ndarray:
         local = zipper(ua, ub)
@@ -344,7 +346,7 @@ def _build(geometry: Any, tol: float, bore_mm: float, scale: float) -> tuple[np.
     up = np.array([0.0, 0.0, 1.0])
     bands = [band(plus + (k - 1) * n, rows[0][0][-1], high, ring), band(minus + (k - 1) * n, rows[1][0][-1], low, ring)]
     pieces: list[tuple[np.ndarray, np.ndarray | float]] = [
-        (_split(grids[0][0]), -up), (_split(grids[1][0]), up), (_split(grids[2][0]), 1.0), (bands[0], 1.0),
+        (_split(grids[0]), -up), (_split(grids[1]), up), (_split(grids[2]), 1.0), (bands[0], 1.0),
         (bands[1], 1.0)]
     if r_bore > 0:
         pieces += [(band(low, ring, bore_low, hole), -up), (band(high, ring, bore_high, hole), up),
@@ -354,9 +356,9 @@ def _build(geometry: Any, tol: float, bore_mm: float, scale: float) -> tuple[np.
         pieces += [(np.stack([np.full(outer, centre), edge + cell, edge + (cell + 1) % outer], 1), d)
                    for centre, edge, d in ((bore_low, low, -up), (bore_high, high, up))]
     faces = np.concatenate([_orient(verts, f, d) for f, d in pieces])
-    dev = max(_flank_error(geometry, 1, params[0], radii, verts, grids[0][0]),
-              _flank_error(geometry, -1, params[1], radii, verts, grids[1][0]),
-              _bottom_error(geometry, t, strips, verts, grids[2][0]),
+    dev = max(_flank_error(geometry, 1, params[0], radii, verts, grids[0]),
+              _flank_error(geometry, -1, params[1], radii, verts, grids[1]),
+              _bottom_error(geometry, t, strips, verts, grids[2]),
               float(cylinder_depth(verts[np.concatenate(bands)], r_out).max()),
               float(cylinder_depth(verts[pieces[-1][0]], r_bore).max()) if r_bore > 0 else 0.0)
     return verts, faces, dev

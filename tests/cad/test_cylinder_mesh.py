@@ -222,7 +222,7 @@ def test_zipper_walks_both_edges_once():
 
 
 def test_refused_beyond_the_triangle_cap_and_for_a_bad_bore(geometry):
-    with pytest.raises(ExportError, match=r"\[manufacturing\] tolerance_mm"):
+    with pytest.raises(ExportError, match=r"exceed the cap of 2000000 triangles.*\[manufacturing\] tolerance_mm"):
         cm.grooved_mesh(geometry, tol=1e-7)
     with pytest.raises(ExportError, match="bore_mm"):
         cm.grooved_mesh(geometry, tol=TOL, bore_mm=2 * geometry.cylinder.inner_radius_mm)
