@@ -337,7 +337,8 @@ def path_deviation(geometry: CylindricalGeometry, n: int = LOFT_SECTIONS, sample
 
 def cylinder_solid(geometry: CylindricalGeometry, *, tol: float, bore_mm: float = 0.0):
     """The grooved cylinder (:func:`grooved_cylinder` with :func:`loft_sections` sections) and the measured
-    deviation of its pitch path (mm): what the STEP, STL and IGES files and the assembly are made of."""
+    deviation of its pitch path (mm): what the STEP and IGES files and the assembly are made of (the exported STL
+    is meshed from the exact surfaces, :mod:`camfab.cad.cylinder_mesh`)."""
     n, dev = loft_sections(geometry, tol)
     return grooved_cylinder(geometry, n=n, bore_mm=bore_mm), dev
 
@@ -384,7 +385,8 @@ def solid_mesh(solid, tol: float):
 def cylinder_stl(geometry: CylindricalGeometry, *, tol: float, name: str = "cam",
                  bore_mm: float = 0.0) -> tuple[bytes, float]:
     """Binary STL of the grooved cylinder (the STEP's solid, :func:`solid_mesh` within ``tol``) and the loft's
-    pitch path's measured deviation (mm; the mesh adds at most ``tol``, OCC's linear deflection)."""
+    pitch path's measured deviation (mm; the mesh adds at most ``tol``, OCC's linear deflection); ``camfab export
+    --stl`` meshes the exact surfaces instead (:mod:`camfab.cad.cylinder_mesh`)."""
     solid, dev = cylinder_solid(geometry, tol=tol, bore_mm=bore_mm)
     return solid_stl(solid, tol=tol, name=name), dev
 

@@ -1,33 +1,34 @@
-"""The grooved cylinder's triangles from its exact surfaces (its STL, without OpenCascade, cadquery or trimesh).
+"""The grooved (or ribbed) cylinder's triangles from its exact surfaces (its STL, without OpenCascade, cadquery or
+trimesh).
 
-The part (:mod:`camfab.cad.cylinder`): the cylinder of outer radius R_o = R + depth/2, length L along +Z from
-z = 0, an optional bore, minus the groove.  Each surface is sampled on its own exact parametrisation, angles as
+The part (:mod:`camfab.cad.cylinder`, :mod:`camfab.cad.rib`): a groove's, the cylinder of outer radius
+R_o = R + depth/2, length L along +Z from z = 0, an optional bore, minus the groove; a rib's, the root cylinder
+(R_i = R − height/2) with the rib up to R_o.  Each surface is sampled on its own exact parametrisation, angles as
 developed angles u = x/r (a point of the developed cylinder r at x has the polar angle 90° + σ·u):
 
-* the groove bottom, flat across: in the plane normal to the 3D pitch curve at each of the mesh's cam angles θ,
-  the straight segment between the two flanks' points on the bottom radius r_i that lie in that plane
-  (:func:`bottom_angles`; the STEP's sections, :func:`~camfab.cad.cylinder.groove_sections`, to 2e-13 mm),
-  split into :func:`strips <twist>` across;
 * each flank (+z and −z), by (cam angle, radius): the developed flank on the cylinder r
-  (``geometry.at_radius(r, flank)``) at that flank's bottom-point cam angles, wrapped, on equally spaced radii
-  from r_i to R_o (:func:`radial_rows`);
-* the outer cylinder, as two bands: from z = 0 (a circle of equal steps) to the −z flank's top edge, and from the
-  +z flank's top edge to z = L, each zipped (:func:`zipper`) between its two edges by developed angle;
-* the end faces (the annulus between the outer circle and the bore's, zipped, or a fan to the axis) and the bore.
+  (``geometry.at_radius(r, flank)``), wrapped, on equally spaced radii from R_i to R_o (:func:`radial_rows`), at
+  a rib's mesh cam angles θ, at a groove's flank's bottom-point cam angles (next);
+* a groove's bottom, flat across: in the plane normal to the 3D pitch curve at each θ, the straight segment
+  between the two flanks' points on R_i that lie in that plane (:func:`bottom_angles`; the STEP's sections,
+  :func:`~camfab.cad.cylinder.groove_sections`, to 2e-13 mm), split into strips across (their :func:`twist`);
+  a rib's top, the band of R_o between its flanks' top edges (:func:`zipper`);
+* the sides' cylinder (a groove's R_o, a rib's R_i) as two bands: from z = 0 (a circle of equal steps) to the −z
+  flank's edge on it, and from the +z flank's edge to z = L, each zipped between its two edges by developed angle;
+* the end faces (the annulus between the sides' circle and the bore's, zipped, or a fan to the axis) and the bore.
 
 Every vertex is a point of the exact part (to rounding).  The cam angles θ come from a bound: each flank edge's
 chord error κ·h²/8 (κ its 3D curvature, on a dense grid) at most :data:`ALONG`·tol and its angular step on R_o at
 most the one whose sagitta on R_o is tol/2; the radii from the flank's second difference across the depth (chord
 error :data:`ACROSS`·tol) and each cell's twist (:data:`TWIST`·tol), the bottom's strips from its twist; the
-circles' steps from their sagitta (tol/2).  The mesh is then **measured**, and its deviation (:func:`grooved_mesh`,
-the STL's ``deviation_mm``) is that measurement: on the flanks and the bottom, each cell's edge and diagonal
+circles' steps from their sagitta (tol/2).  The mesh is then **measured**, and its deviation (:func:`part_mesh`,
+the STL's ``deviation_mm``) is that measurement: on the flanks and a groove's bottom, each cell's edge and diagonal
 midpoints and both facets' centroids against a point of the exact surface (the flank's on the probe's radius, at
 its interpolated cam angle moved by a Newton step along the track towards the probe; the bottom's at its
 interpolated plane angle and place across), an upper bound of each probe's distance from the surface; on the
 cylinders, each facet's largest depth inside its circle, exact; the end faces are planar (0).  A measurement above
 tol doubles the sampling (up to :data:`REFINE` times), then the export is refused; so is a mesh over
-:data:`MAX_TRIANGLES`.  The ribbed cylinder's STL (:mod:`camfab.cad.rib`) is still OpenCascade's tessellation of
-its STEP solid.
+:data:`MAX_TRIANGLES`.
 """
 from __future__ import annotations
 
@@ -39,7 +40,7 @@ import numpy as np
 from ..errors import ExportError
 from ..textsafe import plain
 
-__all__ = ["MAX_TRIANGLES", "grooved_mesh", "grooved_triangles", "grooved_stl", "zipper", "track_angles",
+__all__ = ["MAX_TRIANGLES", "part_mesh", "part_triangles", "part_stl", "zipper", "track_angles",
            "radial_rows", "circle_steps", "wrap", "flank_rows", "cylinder_depth"]
 
 #: the most triangles a grooved cylinder's mesh may have (50 bytes each in the STL: 100 MB)
@@ -59,7 +60,7 @@ _PROBES = np.array([[0.5, 0.5, 0, 0], [0.5, 0, 0, 0.5], [0, 0, 0.5, 0.5], [0.5, 
 
 
 def _refuse(what: str, tol: float) -> ExportError:
-    return ExportError(f"the grooved cylinder's STL: {what} with the {tol:g} mm tolerance. Give a larger "
+    return ExportError(f"the cylinder's STL: {what} with the {tol:g} mm tolerance. Give a larger "
                        "[manufacturing] tolerance_mm")
 
 
@@ -302,74 +303,84 @@ def _bottom_error(geometry: Any, t: np.ndarray, strips: int, verts: np.ndarray, 
 def _build(geometry: Any, tol: float, bore_mm: float, scale: float) -> tuple[np.ndarray, np.ndarray, float]:
     """One mesh (vertices, faces, measured deviation) with the sampling's densities times ``scale``."""
     cyl, sense = geometry.cylinder, geometry.mechanism.sense
+    rib = cyl.rib_width_mm is not None
     r_in, r_out, length = cyl.inner_radius_mm, cyl.outer_radius_mm, cyl.length_mm
-    r_bore = 0.5 * bore_mm
+    r_side, r_bore = r_in if rib else r_out, 0.5 * bore_mm  # the sides' cylinder: a rib's root, a groove's outside
     if r_bore >= r_in:
-        raise ExportError(f"the bore ([manufacturing] bore_mm = {bore_mm:g}) reaches the groove bottom (radius "
-                          f"{r_in:g} mm): make it smaller")
+        raise ExportError(f"the bore ([manufacturing] bore_mm = {bore_mm:g}) reaches the "
+                          f"{'rib root' if rib else 'groove bottom'} (radius {r_in:g} mm): make it smaller")
     t = track_angles(geometry, tol, scale)
     radii = radial_rows(geometry, tol, t, scale)
     n, k = len(t), len(radii)
-    outer = max(int(math.ceil(scale * 2 * math.pi / circle_steps(r_out, tol / 2))), 16)
+    outer = max(int(math.ceil(scale * 2 * math.pi / circle_steps(r_side, tol / 2))), 16)
     inner = max(int(math.ceil(scale * 2 * math.pi / circle_steps(r_bore, tol / 2))), 16) if r_bore > 0 else 0
-    estimate = 4 * n * k + 2 * (n + outer) + 2 * (outer + max(inner, 1)) + 2 * inner
+    estimate = 4 * n * k + 2 * (n + outer) + 2 * (outer + max(inner, 1)) + 2 * inner + 2 * n
     if estimate > MAX_TRIANGLES:
         raise _refuse(f"{estimate} triangles ({n} cam angles, {k} radii) would exceed the cap of {MAX_TRIANGLES} "
                       "triangles", tol)
-    # each flank's cam angles: its bottom points' in the planes normal to the pitch curve at t, on every radius
-    params = [np.broadcast_to(b, (k, n)) for b in bottom_angles(geometry, t)]
+    # each flank's cam angles on every radius: a groove's, its bottom points' in the planes normal to the pitch
+    # curve at t (the flat bottom's segments across); a rib's, t
+    params = [np.broadcast_to(b, (k, n)) for b in ((t, t) if rib else bottom_angles(geometry, t))]
     rows = [flank_rows(geometry, f, radii, tf) for f, tf in zip((1, -1), params, strict=True)]  # +z, −z flank
     for u, _ in rows:
         if not np.all(np.diff(u, axis=1) > 0) or np.any(u[:, -1] - u[:, 0] >= 2 * math.pi):
-            raise ExportError("a flank of the groove turns back along the track (an undercut): check the design")
-    strips = max(1, int(math.ceil(scale * _across(np.stack([rows[0][1][0], rows[1][1][0]])) / (TWIST * tol))))
+            raise ExportError(f"a flank of the {'rib' if rib else 'groove'} turns back along the track (an "
+                              "undercut): check the design")
+    strips = 0 if rib else max(1, int(math.ceil(scale * _across(np.stack([rows[0][1][0], rows[1][1][0]]))
+                                                / (TWIST * tol))))
     if estimate + 2 * n * strips > MAX_TRIANGLES:
         raise _refuse(f"{estimate + 2 * n * strips} triangles ({n} cam angles, {k} radii, {strips} strips across "
                       f"the bottom) would exceed the cap of {MAX_TRIANGLES} triangles", tol)
-    across = np.arange(1, strips)[:, None, None] / strips
+    across = np.arange(1, max(strips, 1))[:, None, None] / max(strips, 1)
     ring = 2 * math.pi * np.arange(outer) / outer
     hole = 2 * math.pi * np.arange(inner) / inner if r_bore > 0 else np.zeros(0)
     pts = [rows[0][1].reshape(-1, 3), rows[1][1].reshape(-1, 3),
            ((1 - across) * rows[0][1][0] + across * rows[1][1][0]).reshape(-1, 3),  # inside the bottom, +z to −z
-           wrap(sense, r_out, ring, 0.0), wrap(sense, r_out, ring, length)]
+           wrap(sense, r_side, ring, 0.0), wrap(sense, r_side, ring, length)]
     pts += ([wrap(sense, r_bore, hole, 0.0), wrap(sense, r_bore, hole, length)] if r_bore > 0 else
             [np.zeros((1, 3)), np.array([[0.0, 0.0, length]])])  # the bore's circles or the axis's ends
     plus, minus, inside, low, high, bore_low, bore_high = np.cumsum([0] + [len(p) for p in pts])[:7]
     verts = np.concatenate(pts)
-    grids = [_cells(n, plus + n * np.arange(k)), _cells(n, minus + n * np.arange(k)),  # +z flank, −z flank, bottom
-             _cells(n, np.concatenate([[plus], inside + n * np.arange(strips - 1), [minus]]))]
+    grids = [_cells(n, plus + n * np.arange(k)), _cells(n, minus + n * np.arange(k))]  # +z flank, −z flank
 
     def band(edge_a: int, ua: np.ndarray, edge_b: int, ub: np.ndarray) -> np.ndarray:
         local = zipper(ua, ub)
         return np.where(local < len(ua), edge_a + local, edge_b + local - len(ua))
 
-    up = np.array([0.0, 0.0, 1.0])
-    bands = [band(plus + (k - 1) * n, rows[0][0][-1], high, ring), band(minus + (k - 1) * n, rows[1][0][-1], low, ring)]
+    up, top = np.array([0.0, 0.0, 1.0]), (k - 1) * n
+    edge = 0 if rib else k - 1  # the flanks' row on the sides' cylinder
+    sides = [band(plus + edge * n, rows[0][0][edge], high, ring), band(minus + edge * n, rows[1][0][edge], low, ring)]
     pieces: list[tuple[np.ndarray, np.ndarray | float]] = [
-        (_split(grids[0]), -up), (_split(grids[1]), up), (_split(grids[2]), 1.0), (bands[0], 1.0),
-        (bands[1], 1.0)]
+        (_split(grids[0]), up if rib else -up), (_split(grids[1]), -up if rib else up), (sides[0], 1.0),
+        (sides[1], 1.0)]
+    if rib:  # the rib's top, between its flanks' top edges
+        pieces.append((band(minus + top, rows[1][0][-1], plus + top, rows[0][0][-1]), 1.0))
+    else:  # the groove's flat bottom, across from its +z flank to its −z flank
+        grids.append(_cells(n, np.concatenate([[plus], inside + n * np.arange(strips - 1), [minus]])))
+        pieces.append((_split(grids[2]), 1.0))
+    depth = [float(cylinder_depth(verts[np.concatenate(sides)], r_side).max()),
+             float(cylinder_depth(verts[pieces[-1][0]], r_out).max()) if rib else
+             _bottom_error(geometry, t, strips, verts, grids[2])]
     if r_bore > 0:
         pieces += [(band(low, ring, bore_low, hole), -up), (band(high, ring, bore_high, hole), up),
                    (_split(_cells(inner, np.array([bore_low, bore_high]))), -1.0)]
+        depth.append(float(cylinder_depth(verts[pieces[-1][0]], r_bore).max()))
     else:
         cell = np.arange(outer)
-        pieces += [(np.stack([np.full(outer, centre), edge + cell, edge + (cell + 1) % outer], 1), d)
-                   for centre, edge, d in ((bore_low, low, -up), (bore_high, high, up))]
+        pieces += [(np.stack([np.full(outer, centre), start + cell, start + (cell + 1) % outer], 1), d)
+                   for centre, start, d in ((bore_low, low, -up), (bore_high, high, up))]
     faces = np.concatenate([_orient(verts, f, d) for f, d in pieces])
     dev = max(_flank_error(geometry, 1, params[0], radii, verts, grids[0]),
-              _flank_error(geometry, -1, params[1], radii, verts, grids[1]),
-              _bottom_error(geometry, t, strips, verts, grids[2]),
-              float(cylinder_depth(verts[np.concatenate(bands)], r_out).max()),
-              float(cylinder_depth(verts[pieces[-1][0]], r_bore).max()) if r_bore > 0 else 0.0)
+              _flank_error(geometry, -1, params[1], radii, verts, grids[1]), *depth)
     return verts, faces, dev
 
 
-def grooved_mesh(geometry: Any, *, tol: float, bore_mm: float = 0.0) -> tuple[np.ndarray, np.ndarray, float]:
-    """The grooved cylinder's watertight mesh (see the module notes): vertices ``(v, 3)``, faces ``(m, 3)``
+def part_mesh(geometry: Any, *, tol: float, bore_mm: float = 0.0) -> tuple[np.ndarray, np.ndarray, float]:
+    """The grooved (or ribbed) cylinder's watertight mesh (see the module notes): vertices ``(v, 3)``, faces ``(m, 3)``
     (counter-clockwise seen from outside) and its measured deviation from the exact part (mm, ≤ ``tol``);
     refined up to :data:`REFINE` times while the measurement exceeds ``tol``, then refused (ExportError)."""
     if not (math.isfinite(tol) and tol > 0):
-        raise ExportError(f"the grooved cylinder's STL needs a positive tolerance, not {tol!r}: check "
+        raise ExportError(f"the cylinder's STL needs a positive tolerance, not {tol!r}: check "
                           "[manufacturing] tolerance_mm")
     scale = 1.0
     for _ in range(REFINE + 1):
@@ -390,21 +401,22 @@ def closed(faces: np.ndarray) -> bool:
     return bool(faces.size) and bool(np.all(edges[1:] != edges[:-1])) and bool(np.array_equal(edges, reverse))
 
 
-def grooved_triangles(geometry: Any, *, tol: float, bore_mm: float = 0.0) -> tuple[np.ndarray, float]:
-    """The grooved cylinder's triangles ``(m, 3, 3)`` (:func:`grooved_mesh`), checked closed and consistently
+def part_triangles(geometry: Any, *, tol: float, bore_mm: float = 0.0) -> tuple[np.ndarray, float]:
+    """The grooved (or ribbed) cylinder's triangles ``(m, 3, 3)`` (:func:`part_mesh`), checked closed and consistently
     wound (:func:`closed`) with a positive volume, and the mesh's measured deviation (mm)."""
-    verts, faces, dev = grooved_mesh(geometry, tol=tol, bore_mm=bore_mm)
+    verts, faces, dev = part_mesh(geometry, tol=tol, bore_mm=bore_mm)
     tri = verts[faces]
     volume = float(np.einsum("ij,ij->", tri[:, 0], np.cross(tri[:, 1], tri[:, 2]))) / 6.0
     if not closed(faces) or not volume > 0:
-        raise ExportError("the grooved cylinder's mesh is not a closed, outward-facing surface: check the design "
+        raise ExportError("the cylinder's mesh is not a closed, outward-facing surface: check the design "
                           "for an undercut or give another [manufacturing] tolerance_mm")
     return tri, dev
 
 
-def grooved_stl(geometry: Any, *, tol: float, name: str = "cam", bore_mm: float = 0.0) -> tuple[bytes, float]:
-    """Binary STL of the grooved cylinder (:func:`grooved_triangles`) and its measured deviation (mm)."""
+def part_stl(geometry: Any, *, tol: float, name: str = "cam", bore_mm: float = 0.0) -> tuple[bytes, float]:
+    """Binary STL of the grooved (or ribbed) cylinder (:func:`part_triangles`) and its measured deviation (mm)."""
     from .stl import stl_bytes
 
-    tri, dev = grooved_triangles(geometry, tol=tol, bore_mm=bore_mm)
-    return stl_bytes(tri, f"camfab {plain(name)} units=mm tol={tol:g} grooved cylinder"), dev
+    tri, dev = part_triangles(geometry, tol=tol, bore_mm=bore_mm)
+    what = "ribbed" if geometry.cylinder.rib_width_mm is not None else "grooved"
+    return stl_bytes(tri, f"camfab {plain(name)} units=mm tol={tol:g} {what} cylinder"), dev

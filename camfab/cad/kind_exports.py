@@ -31,7 +31,7 @@ def _cylinder_dxf(cam: Any, req: Any) -> list[Artifact]:
     return [Artifact(f"{safe_stem(cam.name)}.dxf", text.encode("utf-8"), "dxf", deviation_mm=dev)]
 
 
-#: each cam's cylinder solid by (tolerance, bore): built once per design and shared by its STEP, STL, IGES and
+#: each cam's cylinder solid by (tolerance, bore): built once per design and shared by its STEP, IGES and
 #: assembly (the build is the slow part of a cylindrical run), dropped with the cam
 _SOLIDS: weakref.WeakKeyDictionary[Any, dict[tuple[float, float], tuple[Any, float]]] = weakref.WeakKeyDictionary()
 
@@ -63,19 +63,12 @@ def _cylinder_step(cam: Any, req: Any) -> list[Artifact]:
 
 
 def _cylinder_stl(cam: Any, req: Any) -> list[Artifact]:
-    """``<stem>.stl``: the grooved cylinder meshed from its exact surfaces with numpy (:mod:`.cylinder_mesh`, no
-    cadquery; its deviation the mesh's measured one), or the ribbed cylinder's solid tessellated by OpenCascade
-    (its deviation the loft's pitch path's)."""
-    if not _is_rib(cam):
-        from .cylinder_mesh import grooved_stl
+    """``<stem>.stl``: the grooved (or ribbed) cylinder meshed from its exact surfaces with numpy
+    (:mod:`.cylinder_mesh`: no cadquery, no solid), its deviation the mesh's measured one."""
+    from .cylinder_mesh import part_stl
 
-        data, dev = grooved_stl(cam.geometry, tol=cam.tolerance(req.tol), name=cam.name,
-                                bore_mm=float(cam.spec.manufacturing.bore_mm))
-        return [Artifact(f"{safe_stem(cam.name)}.stl", data, "stl", deviation_mm=dev)]
-    from .cylinder import solid_stl
-
-    solid, dev = cylinder_solid(cam, req)
-    data = solid_stl(solid, tol=cam.tolerance(req.tol), name=cam.name, what="ribbed cylinder")
+    data, dev = part_stl(cam.geometry, tol=cam.tolerance(req.tol), name=cam.name,
+                         bore_mm=float(cam.spec.manufacturing.bore_mm))
     return [Artifact(f"{safe_stem(cam.name)}.stl", data, "stl", deviation_mm=dev)]
 
 
@@ -142,7 +135,7 @@ KIND_EXPORTERS: dict[str, dict[str, Callable[[Any, Any], list[Artifact]] | None]
 }
 
 #: a kind's own outputs that need cadquery: a run skips them with a warning when it is missing, as the STEP
-KIND_CAD_OUTPUTS: dict[str, frozenset[str]] = {"cylindrical": frozenset({"step", "stl", "iges", "assembly"})}
+KIND_CAD_OUTPUTS: dict[str, frozenset[str]] = {"cylindrical": frozenset({"step", "iges", "assembly"})}
 
 
 def not_applicable_reason(kind: str, output: str) -> str:

@@ -42,7 +42,8 @@ def ribbed_cylinder(geometry: CylindricalGeometry, *, n: int, bore_mm: float = 0
 
 def rib_solid(geometry: CylindricalGeometry, *, tol: float, bore_mm: float = 0.0):
     """The ribbed cylinder (:func:`ribbed_cylinder` with :func:`~camfab.cad.cylinder.loft_sections` sections) and
-    the measured deviation of its loft's pitch path (mm): what its STEP, STL and IGES files are made of."""
+    the measured deviation of its loft's pitch path (mm): what its STEP and IGES files and assembly are made of
+    (its exported STL is meshed from the exact surfaces, :mod:`camfab.cad.cylinder_mesh`)."""
     n, dev = loft_sections(geometry, tol)
     return ribbed_cylinder(geometry, n=n, bore_mm=bore_mm), dev
 
@@ -56,6 +57,7 @@ def rib_step(geometry: CylindricalGeometry, *, tol: float, name: str = "cam",
 
 def rib_stl(geometry: CylindricalGeometry, *, tol: float, name: str = "cam",
             bore_mm: float = 0.0) -> tuple[bytes, float]:
-    """Binary STL of the ribbed cylinder (its STEP solid tessellated within ``tol``) and its loft's path deviation."""
+    """Binary STL of the ribbed cylinder (its STEP solid tessellated by OpenCascade within ``tol``) and its loft's
+    path deviation; ``camfab export --stl`` meshes the exact surfaces instead (:mod:`camfab.cad.cylinder_mesh`)."""
     solid, dev = rib_solid(geometry, tol=tol, bore_mm=bore_mm)
     return solid_stl(solid, tol=tol, name=name, what="ribbed cylinder"), dev

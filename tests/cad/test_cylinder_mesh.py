@@ -1,7 +1,7 @@
-"""The grooved cylinder's STL meshed from its exact surfaces (:mod:`camfab.cad.cylinder_mesh`): closed and outward,
-every vertex on the exact part, the exact surfaces within the tolerance of the mesh and the mesh's facets within it
-of them, the STEP solid's volume and surface, no CAD or mesh library imported by ``camfab export --stl``, and bad
-input refused."""
+"""The grooved (and the ribbed) cylinder's STL meshed from its exact surfaces (:mod:`camfab.cad.cylinder_mesh`):
+closed and outward, every vertex on the exact part, the exact surfaces within the tolerance of the mesh and the
+mesh's facets within it of them, the STEP solid's volume and surface, no CAD or mesh library imported by
+``camfab export --stl``, and bad input refused."""
 from __future__ import annotations
 
 import json
@@ -33,21 +33,22 @@ def geometry():
 @pytest.fixture(scope="module", params=[0.0, BORE], ids=["solid", "bored"])
 def made(request, geometry):
     bore = request.param
-    verts, faces, dev = cm.grooved_mesh(geometry, tol=TOL, bore_mm=bore)
+    verts, faces, dev = cm.part_mesh(geometry, tol=TOL, bore_mm=bore)
     return bore, verts, faces, dev
 
 
-def _roller_distance(geometry, p: np.ndarray) -> np.ndarray:
+def _roller_distance(geometry, p: np.ndarray, shift: float = 0.0) -> np.ndarray:
     """Each point's smallest distance to the roller's axis over the cycle (a translating follower's: the radial
-    ray at the pitch point's polar angle, at its height), minimised over the cam angle (dense grid, then Newton
-    on the squared distance with numerical derivatives): a groove flank's points are the half width from it."""
+    ray at the pitch point's polar angle, at its height plus ``shift``: a rib's rollers), minimised over the cam
+    angle (dense grid, then Newton on the squared distance with numerical derivatives): a flank's points are the
+    half width from it."""
     sense = geometry.mechanism.sense
     R = geometry.cylinder.radius_mm
 
     def dist2(t):
         C, _ = geometry.at_radius(R).pitch(t)
         a = 0.5 * math.pi + sense * C[:, 0] / R
-        v = p - np.column_stack([0 * a, 0 * a, C[:, 1]])
+        v = p - np.column_stack([0 * a, 0 * a, C[:, 1] + shift])
         along = np.maximum(v[:, 0] * np.cos(a) + v[:, 1] * np.sin(a), 0.0)  # the ray out from the cam axis
         return np.einsum("ij,ij->i", v, v) - along ** 2
 
@@ -223,11 +224,11 @@ def test_zipper_walks_both_edges_once():
 
 def test_refused_beyond_the_triangle_cap_and_for_a_bad_bore(geometry):
     with pytest.raises(ExportError, match=r"exceed the cap of 2000000 triangles.*\[manufacturing\] tolerance_mm"):
-        cm.grooved_mesh(geometry, tol=1e-7)
+        cm.part_mesh(geometry, tol=1e-7)
     with pytest.raises(ExportError, match="bore_mm"):
-        cm.grooved_mesh(geometry, tol=TOL, bore_mm=2 * geometry.cylinder.inner_radius_mm)
+        cm.part_mesh(geometry, tol=TOL, bore_mm=2 * geometry.cylinder.inner_radius_mm)
     with pytest.raises(ExportError, match="tolerance_mm"):
-        cm.grooved_mesh(geometry, tol=0.0)
+        cm.part_mesh(geometry, tol=0.0)
 
 
 @pytest.mark.slow  # the STEP's solid (~6 s) and 500 distances to its surface
@@ -261,6 +262,74 @@ def test_the_step_solid_agrees(made, geometry):
                     .Value() for p in sample])
     assert far[:250].max() <= TOL, far[:250].max()  # the vertices: exact points; the loft within its deviation
     assert far.max() <= TOL + loft_dev, far.max()
+
+
+@pytest.fixture(scope="module")
+def rib(tmp_path_factory):
+    from tests.design.test_cylinder_rib import RIB_TOML
+
+    src = tmp_path_factory.mktemp("rib") / "rib.toml"
+    src.write_text(RIB_TOML, encoding="utf-8")
+    geometry = load(src).geometry
+    return geometry, *cm.part_mesh(geometry, tol=TOL, bore_mm=BORE)
+
+
+def test_rib_mesh_is_closed_and_on_the_exact_part(rib):
+    """The ribbed cylinder: closed and outward; every vertex off the end faces and the bore on a rib flank (the
+    half width from one of its two rollers' axes), the rib's top and root edges on their cylinders; the flank
+    facets within tol of the flanks; the STL's header names the ribbed cylinder."""
+    trimesh = pytest.importorskip("trimesh")
+    geometry, verts, faces, dev = rib
+    cyl, mech = geometry.cylinder, geometry.mechanism
+    assert cm.closed(faces) and is_closed_surface(verts[faces]) and 0 < dev <= TOL
+    mesh = trimesh.Trimesh(verts, faces, process=False)
+    assert mesh.is_volume and mesh.volume > math.pi * (cyl.inner_radius_mm ** 2 - (BORE / 2) ** 2) * cyl.length_mm
+    kind = _classify(geometry, verts, BORE)
+    rho = kind["rho"]
+    assert np.all((rho > cyl.inner_radius_mm - 1e-9) | kind["hole"]) and np.all(rho < cyl.outer_radius_mm + 1e-9)
+    w, off = mech.half_width(cyl.radius_mm), mech.rib_offset_mm
+    flank = ~(kind["ends"] | kind["hole"])
+    d = np.minimum(_roller_distance(geometry, verts[flank], off), _roller_distance(geometry, verts[flank], -off))
+    assert np.all(np.abs(d - w) < 1e-9)
+    tri = verts[faces]
+    sides = (np.abs(np.hypot(tri[..., 0], tri[..., 1]) - cyl.inner_radius_mm) < 1e-9).all(axis=1) | \
+        (np.abs(np.hypot(tri[..., 0], tri[..., 1]) - cyl.outer_radius_mm) < 1e-9).all(axis=1)
+    flank_facets = flank[faces].all(axis=1) & ~sides  # every vertex off the ends and bore is a flank's
+    assert flank_facets.sum() > len(faces) / 3
+    p = tri[flank_facets].mean(axis=1)
+    off_flank = np.abs(np.minimum(_roller_distance(geometry, p, off), _roller_distance(geometry, p, -off)) - w)
+    assert off_flank.max() <= dev + 1e-6
+    data, _ = cm.part_stl(geometry, tol=TOL, name="Ribbed")
+    assert data.startswith(b"camfab Ribbed units=mm tol=0.01 ribbed cylinder")
+
+
+@pytest.mark.slow  # the STEP's ribbed solid (~6 s)
+def test_rib_step_solid_agrees(rib):
+    pytest.importorskip("cadquery", reason="the STEP solid needs cadquery (the step extra)")
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
+    from OCP.BRepExtrema import BRepExtrema_DistShapeShape
+    from OCP.BRepGProp import BRepGProp
+    from OCP.gp import gp_Pnt
+    from OCP.GProp import GProp_GProps
+
+    from camfab.cad.rib import rib_solid
+
+    geometry, *_ = rib
+    verts, faces, _ = cm.part_mesh(geometry, tol=TOL)
+    solid, loft_dev = rib_solid(geometry, tol=TOL)
+    vol, area = GProp_GProps(), GProp_GProps()
+    BRepGProp.VolumeProperties_s(solid.wrapped, vol, 1e-6, True)
+    BRepGProp.SurfaceProperties_s(solid.wrapped, area, 1e-6, True)
+    tri = verts[faces]
+    volume = float(np.einsum("ij,ij->", tri[:, 0], np.cross(tri[:, 1], tri[:, 2]))) / 6.0
+    assert abs(volume - vol.Mass()) <= TOL * area.Mass()
+    rng = np.random.default_rng(13)
+    sample = np.concatenate([verts[rng.choice(len(verts), 200, replace=False)],
+                             tri[rng.choice(len(tri), 200, replace=False)].mean(axis=1)])
+    shell = solid.Shells()[0].wrapped
+    far = np.array([BRepExtrema_DistShapeShape(shell, BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, p))).Vertex())
+                    .Value() for p in sample])
+    assert far[:200].max() <= TOL and far.max() <= TOL + loft_dev, far.max()
 
 
 def test_export_stl_imports_no_cad_or_mesh_library(tmp_path):
