@@ -21,8 +21,8 @@ IGES and the assembly are outside the goal: they import cadquery/OCP, ~3 s on th
 The child processes run without ``PYTHONDONTWRITEBYTECODE`` (bytecode cached in a temporary
 ``PYTHONPYCACHEPREFIX``, as an installed package has it) and one untimed warm-up run per command fills that cache.
 
-Run:  python3 benchmarks/bench_check.py [--repeat 7] [--baseline | --steep | --process [--export] [--root DIR]
-      [--against DIR]]
+Run:  python3 benchmarks/bench_check.py [--repeat 7] [--baseline | --steep | --process [--export [--only dxf|stl]]
+      [--root DIR] [--against DIR]]
 """
 from __future__ import annotations
 
@@ -201,10 +201,12 @@ def _alternating(repeat: int, root: str | None, against: str, flags: tuple[str, 
     return mine, other
 
 
-def process(repeat: int, root: str | None, export: bool = False, against: str | None = None) -> None:
+def process(repeat: int, root: str | None, export: bool = False, against: str | None = None,
+            only: str | None = None) -> None:
     print("child processes without PYTHONDONTWRITEBYTECODE (bytecode cached as installed), "
           "one untimed warm-up run each")
-    for flags in ([("--dxf",), ("--stl",)] if export else [()]):
+    exports = [(f"--{only}",)] if only else [("--dxf",), ("--stl",)]
+    for flags in (exports if export else [()]):
         goal = EXPORT_TARGET_S if export else PROCESS_TARGET_S
         if against is not None:
             t, old = _alternating(repeat, root, against, flags)
@@ -238,9 +240,11 @@ def main() -> None:
     ap.add_argument("--export", action="store_true", help="with --process: time `export --dxf` and `--stl`")
     ap.add_argument("--against", default=None, metavar="DIR",
                     help="with --process: also time the checkout DIR, alternating with this tree")
+    ap.add_argument("--only", choices=("dxf", "stl"), default=None,
+                    help="with --process --export: time only `export --dxf` (or only `--stl`)")
     a = ap.parse_args()
     if a.process:
-        process(a.repeat, a.root, a.export, a.against)
+        process(a.repeat, a.root, a.export, a.against, a.only)
         return
     if a.steep:
         steep(a.repeat)

@@ -1,4 +1,10 @@
-"""DXF export (ezdxf): millimetre units, named layers, exact arcs.
+"""DXF export: millimetre units, named layers, exact arcs.
+
+Who writes what: :func:`dumps` (the plate DXF of ``camfab export --dxf``) writes its text directly with
+:mod:`camfab.cad.dxfwrite`, without importing ezdxf; :func:`build_document` builds the same drawing as an ezdxf
+document and :func:`write_deterministic` writes it, and those are ezdxf's bytes, which ``dumps`` reproduces byte for
+byte (tests/cad/test_dxf_write.py; docs/decisions.md, "The plate DXF is written without ezdxf").  Other DXF files
+(the drawing sheets, the cylindrical cam's developed DXF) are built with ezdxf.
 
 Flavours
 --------
@@ -19,7 +25,7 @@ face's centre of curvature and the prime circle the circle R_b + R it starts on.
 are recorded as ``$INSUNITS = 4`` (mm) and the tolerance and achieved deviation as custom
 header properties ``CAMFAB_TOL_MM`` / ``CAMFAB_DEVIATION_MM``; the design's name is ``CAMFAB_NAME``, one
 line with DXF's escapes (:func:`camfab.textsafe.dxf_string`).  Output is byte-identical
-for the same input (ezdxf's fixed-metadata mode, no timestamps).
+for the same input (ezdxf's fixed-metadata mode, no timestamps; the CLASSES section sorted).
 """
 from __future__ import annotations
 
@@ -34,7 +40,8 @@ from ..errors import InputError, MissingDependencyError
 from ..geom2d import ArcChain, bulge_centre
 from ..textsafe import dxf_string
 
-__all__ = ["DxfContent", "LAYERS", "FLAVOURS", "dumps", "build_document", "loop_nurbs", "write_deterministic"]
+__all__ = ["DxfContent", "LAYERS", "FLAVOURS", "dumps", "build_document", "loop_nurbs", "r12_pieces",
+           "centre_mark_size", "write_deterministic"]
 
 #: layer name -> ACI colour
 LAYERS = {"PROFILE": 7, "PROFILE_2": 4, "PITCH_CURVE": 2, "PITCH_CURVE_2": 2, "BASE_CIRCLE": 3,
@@ -111,9 +118,19 @@ def _add_loop(msp, loop: ArcChain, layer: str, flavour: str) -> None:
         pts = [(float(x), float(y), 0.0, 0.0, float(b)) for x, y, b in loop.lwpolyline]
         msp.add_lwpolyline(pts, format="xyseb", close=loop.closed, dxfattribs={"layer": layer})
         return
+    for piece in r12_pieces(loop):
+        if len(piece) == 2:
+            msp.add_line(*piece, dxfattribs={"layer": layer})
+        else:
+            msp.add_arc(*piece, dxfattribs={"layer": layer})
+
+
+def r12_pieces(loop: ArcChain):
+    """The R12 flavour's entities of ``loop``, in order: ``(start, end)`` for a LINE, ``(centre, radius,
+    start_angle, end_angle)`` (degrees, counter-clockwise) for an ARC; points as tuples of numpy floats."""
     for p0, p1, b in loop.segments():
         if abs(b) < 1e-15:
-            msp.add_line(tuple(p0), tuple(p1), dxfattribs={"layer": layer})
+            yield tuple(p0), tuple(p1)
             continue
         c = bulge_centre(p0, p1, b)
         r = float(math.hypot(*(p0 - c)))
@@ -121,7 +138,7 @@ def _add_loop(msp, loop: ArcChain, layer: str, flavour: str) -> None:
         a1 = math.degrees(math.atan2(p1[1] - c[1], p1[0] - c[0]))
         if b < 0:  # DXF arcs run counter-clockwise
             a0, a1 = a1, a0
-        msp.add_arc(tuple(c), r, a0, a1, dxfattribs={"layer": layer})
+        yield tuple(c), r, a0, a1
 
 
 def build_document(content: DxfContent, *, flavour: str = "lwpolyline"):
@@ -155,15 +172,25 @@ def build_document(content: DxfContent, *, flavour: str = "lwpolyline"):
                      *content.extra_circles):
         if r:
             msp.add_circle((0.0, 0.0), float(r), dxfattribs={"layer": layer})
-    size = max([float(np.max(np.abs(lp.points))) for lp in content.profiles] + [1.0]) * 0.08
+    size = centre_mark_size(content)
     msp.add_line((-size, 0), (size, 0), dxfattribs={"layer": "CENTRE_MARKS"})
     msp.add_line((0, -size), (0, size), dxfattribs={"layer": "CENTRE_MARKS"})
     return doc
 
 
+def centre_mark_size(content: DxfContent) -> float:
+    """Half the length of the centre mark's lines: 8 % of the profiles' largest coordinate (at least 1 mm)."""
+    return max([float(np.max(np.abs(lp.points))) for lp in content.profiles] + [1.0]) * 0.08
+
+
 def dumps(content: DxfContent, *, flavour: str = "lwpolyline") -> str:
-    """DXF text, byte-identical for the same ``content``."""
-    return write_deterministic(build_document(content, flavour=flavour))
+    """DXF text, byte-identical for the same ``content``: written by :mod:`camfab.cad.dxfwrite`, the same bytes as
+    ``write_deterministic(build_document(content, flavour=flavour))`` without importing ezdxf."""
+    if flavour not in FLAVOURS:
+        raise InputError(f"'{flavour}' is not a valid DXF flavour, must be one of: {', '.join(FLAVOURS)}")
+    from .dxfwrite import write
+
+    return write(content, flavour)
 
 
 def write_deterministic(doc) -> str:
