@@ -4,7 +4,8 @@ DXF: the development of the pitch cylinder (x = R·θ, y = z, :mod:`camfab.desig
 (x from 0 to 2πR): the pitch curve on layer ``PITCH_CURVE``, the groove's +z flank on ``PROFILE`` and its −z
 flank on ``PROFILE_2`` (the disc cams' layers), each an arc chain within the tolerance of the exact curve
 (measured), and the developed outline of the cylinder (its ends z = 0 and z = length, the seam x = 0 and
-x = 2πR) on ``OUTLINE``.
+x = 2πR) on ``OUTLINE``.  The file is written by :func:`camfab.cad.dxfwrite.developed` without importing ezdxf,
+byte-identical to the ezdxf document :func:`developed_document` (tests/cad/test_dxf_write.py).
 
 STEP: the cylinder (outer radius R + depth/2, length along +Z from z = 0) minus the groove, a loft
 (``BRepOffsetAPI_ThruSections``) through sections at the interpolated cam angles (:func:`loft_sections`: as many
@@ -31,11 +32,12 @@ from ..design.cylindrical import CylindricalGeometry, pitch_3d
 from ..discretize import ParametricCurve, arcs
 from ..errors import ExportError
 from ..textsafe import dxf_string, plain
-from .dxf import LAYERS, ezdxf_module, write_deterministic
+from .dxf import LAYERS, ezdxf_module
+from .dxfwrite import developed
 from .step import cadquery, solid_dumps
 
-__all__ = ["developed_curves", "developed_dxf", "grooved_cylinder", "cylinder_solid", "cylinder_step", "cylinder_stl",
-           "solid_mesh", "solid_stl", "loft_sections", "track_loft", "LOFT_SECTIONS"]
+__all__ = ["developed_curves", "developed_dxf", "developed_document", "grooved_cylinder", "cylinder_solid",
+           "cylinder_step", "cylinder_stl", "solid_mesh", "solid_stl", "loft_sections", "track_loft", "LOFT_SECTIONS"]
 
 #: sections of the groove's (and the rib's) loft per turn to begin with: the points the periodic B-spline through
 #: the 3D pitch curve passes through, doubled (at most 4 times) until it lies within the tolerance (the sections of
@@ -65,15 +67,23 @@ def developed_curves(geometry: CylindricalGeometry, tol: float):
 
 
 def developed_dxf(geometry: CylindricalGeometry, *, tol: float, name: str = "cam") -> tuple[str, float]:
-    """DXF text of the developed groove and its measured largest deviation (mm)."""
+    """DXF text of the developed groove and its measured largest deviation (mm): written by
+    :func:`camfab.cad.dxfwrite.developed` without ezdxf, the bytes of :func:`developed_document`."""
+    curves = developed_curves(geometry, tol)
+    dev = max(float(c.max_deviation) for c in curves)
+    cyl = geometry.cylinder
+    return developed(name, tol, dev, curves, 2 * math.pi * cyl.radius_mm, cyl.length_mm), dev
+
+
+def developed_document(name: str, tol: float, dev: float, curves, width: float, length: float):
+    """The developed DXF as an ezdxf document (write it with :func:`~camfab.cad.dxf.write_deterministic`): the
+    pitch curve and flanks ``curves`` (:func:`developed_curves`) and the ``width`` × ``length`` outline."""
     ezdxf = ezdxf_module()
     doc = ezdxf.new("R2010", setup=False)
     doc.header["$INSUNITS"] = 4
     doc.header["$MEASUREMENT"] = 1
     doc.header.custom_vars.append("CAMFAB_NAME", dxf_string(name))
     doc.header.custom_vars.append("CAMFAB_TOL_MM", f"{tol:g}")
-    curves = developed_curves(geometry, tol)
-    dev = max(float(c.max_deviation) for c in curves)
     doc.header.custom_vars.append("CAMFAB_DEVIATION_MM", f"{dev:.3e}")
     for layer, colour in {**LAYERS, "OUTLINE": 8}.items():
         doc.layers.add(layer, color=colour)
@@ -83,11 +93,9 @@ def developed_dxf(geometry: CylindricalGeometry, *, tol: float, name: str = "cam
         end = chain.ends[-1]
         pts.append((float(end[0]), float(end[1]), 0.0, 0.0, 0.0))
         msp.add_lwpolyline(pts, format="xyseb", dxfattribs={"layer": layer})
-    cyl = geometry.cylinder
-    w = 2 * math.pi * cyl.radius_mm
-    msp.add_lwpolyline([(0.0, 0.0), (w, 0.0), (w, cyl.length_mm), (0.0, cyl.length_mm)], close=True,
+    msp.add_lwpolyline([(0.0, 0.0), (width, 0.0), (width, length), (0.0, length)], close=True,
                        dxfattribs={"layer": "OUTLINE"})
-    return write_deterministic(doc), dev
+    return doc
 
 
 def _vec(cq, p):

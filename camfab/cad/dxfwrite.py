@@ -1,5 +1,7 @@
 """The plate DXF's text written directly, byte-identical to ezdxf's.
 
+(And the cylindrical cam's developed DXF, :func:`developed`: the same skeleton, layers and LWPOLYLINEs.)
+
 :func:`camfab.cad.dxf.dumps` writes a :class:`~camfab.cad.dxf.DxfContent` through this module instead of
 building an ezdxf document: importing ezdxf (its whole entity system) cost more than the rest of an
 ``export --dxf`` (docs/decisions.md, "The plate DXF is written without ezdxf").  The file is what
@@ -27,7 +29,7 @@ from ..textsafe import dxf_string
 from . import dxf_skeleton as sk
 from .dxf import DxfContent, centre_mark_size, loop_nurbs, r12_pieces
 
-__all__ = ["write", "EZDXF_VERSION"]
+__all__ = ["write", "developed", "EZDXF_VERSION"]
 
 EZDXF_VERSION = sk.EZDXF_VERSION
 
@@ -166,3 +168,20 @@ def write(content: DxfContent, flavour: str) -> str:
     w = _Writer(r12)
     _entities(content, flavour, w)
     return w.text("" if r12 else _custom_properties(content.name, content.tol_mm, content.deviation_mm))
+
+
+def developed(name: str, tol_mm: float, deviation_mm: float, chains: tuple[ArcChain, ...], width: float,
+              length: float) -> str:
+    """The cylindrical cam's developed DXF (:func:`camfab.cad.cylinder.developed_dxf`): the pitch curve and the
+    flanks (``chains``, each an open LWPOLYLINE through its starts and last end) and the ``width`` × ``length``
+    outline on ``OUTLINE``; the bytes :func:`camfab.cad.cylinder.developed_document` and
+    :func:`~camfab.cad.dxf.write_deterministic` make."""
+    w = _Writer(r12=False)
+    w.add_layer("OUTLINE")
+    for layer, chain in zip(("PITCH_CURVE", "PROFILE", "PROFILE_2"), chains, strict=True):
+        rows = [(p[0], p[1], b) for p, b in zip(chain.starts, chain.bulges, strict=True)]
+        end = chain.ends[-1]
+        w.lwpolyline(layer, [*rows, (end[0], end[1], 0.0)], closed=False)
+    w.lwpolyline("OUTLINE", [(0.0, 0.0, 0.0), (width, 0.0, 0.0), (width, length, 0.0), (0.0, length, 0.0)],
+                 closed=True)
+    return w.text(_custom_properties(name, tol_mm, deviation_mm))

@@ -1,6 +1,6 @@
 """The plate DXF written without ezdxf (camfab.cad.dxfwrite) is ezdxf's file byte for byte: every built-in
-example's plate in every flavour, with and without tool paths, and generated contents with hostile names; and
-``camfab export --dxf`` of a disc or groove cam no longer imports ezdxf."""
+example's plate in every flavour, with and without tool paths, and generated contents with hostile names; the
+cylindrical cam's developed DXF likewise; and ``camfab export --dxf`` no longer imports ezdxf."""
 from __future__ import annotations
 
 import dataclasses
@@ -156,6 +156,7 @@ def test_bad_flavour_refused_before_writing():
 # ---- the command --------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("name", ["ejemplo9rt", "groove_translating", "ejemplo8da_conjugate"])
 def test_export_dxf_imports_no_ezdxf_and_writes_ezdxf_bytes(tmp_path, name):
+    """A disc, a groove and a conjugate pair: the plate DXF of the command is the ezdxf path's bytes."""
     from tests.test_lazy_imports import _run
 
     out = tmp_path / "out"
@@ -164,3 +165,52 @@ def test_export_dxf_imports_no_ezdxf_and_writes_ezdxf_bytes(tmp_path, name):
     assert "ezdxf" not in last["modules"]
     (written,) = out.glob("*.dxf")
     assert written.read_bytes() == _ezdxf_text(_example_content(name, False), "lwpolyline").encode("utf-8")
+
+
+# ---- the cylindrical cam's developed DXF ----------------------------------------------------------------------
+def _developed_ezdxf(name, tol, dev, curves, width, length):
+    from camfab.cad.cylinder import developed_document
+
+    return write_deterministic(developed_document(name, tol, dev, curves, width, length))
+
+
+@pytest.mark.parametrize("tol", [0.01, 0.003])
+def test_cylinder_example_developed_dxf_byte_identical(tol):
+    from camfab.cad.cylinder import developed_curves, developed_dxf
+    from camfab.design.mechanisms import geometry_from_spec
+    from camfab.formats import load_design
+
+    geom = geometry_from_spec(load_design(EXAMPLES / "cylindrical_translating.toml"))
+    text, dev = developed_dxf(geom, tol=tol, name="barrel ^ \n")
+    curves = developed_curves(geom, tol)
+    cyl = geom.cylinder
+    assert text == _developed_ezdxf("barrel ^ \n", tol, dev, curves, 2 * math.pi * cyl.radius_mm, cyl.length_mm)
+
+
+@st.composite
+def _open_chains(draw):
+    chain = draw(_chains())
+    return dataclasses.replace(chain, closed=False)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(curves=st.tuples(_open_chains(), _open_chains(), _open_chains()), name=_name,
+       tol=st.sampled_from([0.01, 1e-4, 2]), dev=st.floats(0, 1, allow_nan=False),
+       width=st.floats(1, 3000, allow_nan=False), length=st.one_of(st.integers(1, 500), st.floats(1, 500)))
+def test_generated_developed_dxf_byte_identical(curves, name, tol, dev, width, length):
+    from camfab.cad.dxfwrite import developed
+
+    with np.errstate(all="ignore"):
+        assert developed(name, tol, dev, curves, width, length) == _developed_ezdxf(name, tol, dev, curves, width,
+                                                                                    length)
+
+
+def test_export_dxf_of_a_cylindrical_cam_imports_no_ezdxf(tmp_path):
+    from tests.test_lazy_imports import _run
+
+    out = tmp_path / "out"
+    last = _run(tmp_path, "export", str(EXAMPLES / "cylindrical_translating.toml"), "--dxf", "--force", "-o", str(out))
+    assert last["code"] in (0, None)
+    assert "ezdxf" not in last["modules"]
+    (written,) = out.glob("*.dxf")
+    assert written.read_bytes().startswith(b"  0\nSECTION\n  2\nHEADER\n") and b"OUTLINE" in written.read_bytes()
