@@ -32,8 +32,8 @@ from ..design.cylindrical import CylindricalGeometry, pitch_3d
 from ..discretize import ParametricCurve, arcs
 from ..errors import ExportError
 from ..textsafe import dxf_string, plain
-from .dxf import LAYERS, ezdxf_module
-from .dxfwrite import developed
+from .dxf import LAYERS, ezdxf_module, write_deterministic
+from .dxfwrite import developed, same_ezdxf
 from .step import cadquery, solid_dumps
 
 __all__ = ["developed_curves", "developed_dxf", "developed_document", "grooved_cylinder", "cylinder_solid",
@@ -68,11 +68,15 @@ def developed_curves(geometry: CylindricalGeometry, tol: float):
 
 def developed_dxf(geometry: CylindricalGeometry, *, tol: float, name: str = "cam") -> tuple[str, float]:
     """DXF text of the developed groove and its measured largest deviation (mm): written by
-    :func:`camfab.cad.dxfwrite.developed` without ezdxf, the bytes of :func:`developed_document`."""
+    :func:`camfab.cad.dxfwrite.developed` without ezdxf, the bytes of :func:`developed_document` (which writes it
+    when the installed ezdxf is not the writer's version, :func:`camfab.cad.dxfwrite.same_ezdxf`)."""
     curves = developed_curves(geometry, tol)
     dev = max(float(c.max_deviation) for c in curves)
     cyl = geometry.cylinder
-    return developed(name, tol, dev, curves, 2 * math.pi * cyl.radius_mm, cyl.length_mm), dev
+    args = (name, tol, dev, curves, 2 * math.pi * cyl.radius_mm, cyl.length_mm)
+    if not same_ezdxf():  # another ezdxf than the writer's: its own bytes, as before
+        return write_deterministic(developed_document(*args)), dev
+    return developed(*args), dev
 
 
 def developed_document(name: str, tol: float, dev: float, curves, width: float, length: float):

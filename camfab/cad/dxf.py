@@ -1,10 +1,12 @@
 """DXF export: millimetre units, named layers, exact arcs.
 
 Who writes what: :func:`dumps` (the plate DXF of ``camfab export --dxf``) writes its text directly with
-:mod:`camfab.cad.dxfwrite`, without importing ezdxf; :func:`build_document` builds the same drawing as an ezdxf
-document and :func:`write_deterministic` writes it, and those are ezdxf's bytes, which ``dumps`` reproduces byte for
-byte (tests/cad/test_dxf_write.py; docs/decisions.md, "The plate DXF is written without ezdxf").  Other DXF files
-(the drawing sheets, the cylindrical cam's developed DXF) are built with ezdxf.
+:mod:`camfab.cad.dxfwrite`, without importing ezdxf; only an extra circle on a layer not camfab's (ezdxf checks the
+name), or any file when the installed ezdxf is not the version the writer reproduces, goes through ezdxf.
+:func:`build_document` builds the same drawing as an ezdxf document and :func:`write_deterministic` writes it:
+ezdxf's bytes, which ``dumps`` reproduces byte for byte (tests/cad/test_dxf_write.py; docs/decisions.md, "The plate
+DXF is written without ezdxf").  The cylindrical cam's developed DXF is written by the same module
+(:mod:`camfab.cad.cylinder`); the drawing sheets are built with ezdxf.
 
 Flavours
 --------
@@ -188,8 +190,10 @@ def dumps(content: DxfContent, *, flavour: str = "lwpolyline") -> str:
     ``write_deterministic(build_document(content, flavour=flavour))`` without importing ezdxf."""
     if flavour not in FLAVOURS:
         raise InputError(f"'{flavour}' is not a valid DXF flavour, must be one of: {', '.join(FLAVOURS)}")
-    from .dxfwrite import write
+    from .dxfwrite import write, writes
 
+    if not writes(content):  # another ezdxf installed, or a layer of the caller's (ezdxf checks its name): ezdxf
+        return write_deterministic(build_document(content, flavour=flavour))
     return write(content, flavour)
 
 
