@@ -74,9 +74,9 @@ def wrap(sense: int, r: float | np.ndarray, u: np.ndarray, z: float | np.ndarray
 def flank_at(geometry: Any, flank: int, t: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The exact flank ``flank`` at the pairs (cam angle t, radius r) (``(p,)`` each): its developed angle u
     (x/r), its 3D point and the 3D point's derivative along t, ``(p,)``, ``(p, 3)``, ``(p, 3)``.  One evaluation
-    of the developed flank (``at_radius``) for all the pairs, its radius an array (every formula of it is
-    elementwise in r for a cylindrical roller, bit for bit the per-radius evaluation's), one per radius for a
-    conical roller (whose section's second derivatives take one radius)."""
+    of the developed flank for all the pairs (``DevelopedContact.on_radii``: the points bit for bit those of
+    each radius's own evaluation) for a cylindrical roller, one per radius for a conical roller (whose section's
+    second derivatives take one radius)."""
     from ..design.cylindrical import RollerShape
 
     t, r = np.asarray(t, dtype=float), np.asarray(r, dtype=float)
@@ -84,9 +84,7 @@ def flank_at(geometry: Any, flank: int, t: np.ndarray, r: np.ndarray) -> tuple[n
     conical = geometry.cylinder.roller is RollerShape.CONICAL
     for at in [np.nonzero(r == v)[0] for v in np.unique(r)] if conical else [np.arange(len(r))] if len(r) else []:
         contact = geometry.at_radius(float(r[at[0]]), flank)
-        if not conical:
-            vars(contact)["r"] = r  # the radius of each pair
-        e = contact.evaluate(t[at])
+        e = contact.evaluate(t[at]) if conical else contact.on_radii(t[at], r[at])
         x[at], d1[at] = e.point, e.point_d1
     sense = geometry.mechanism.sense
     u = x[:, 0] / r

@@ -104,8 +104,22 @@ class DevelopedContact(Contact):
         self.oscillating = mechanism.motion is FollowerMotion.OSCILLATING
 
     def _evaluate(self, phi, rotate: bool, S=None) -> ProfileSample:
+        return self._sample(phi, self.r, S)
+
+    def on_radii(self, phi, radii) -> ProfileSample:
+        """The flank at the cam angles ``phi``, each on its own cylinder ``radii`` (the same length), in one
+        evaluation: what :meth:`evaluate` gives on each radius alone (every formula is elementwise in the radius),
+        for a cylindrical roller, whose section and half width are the same on every radius (a conical roller's
+        would be this contact's radius's, so it is refused).  The points are the same bit for bit; derivatives
+        and directions may differ in the last bits (numpy's vector loops against one-element arrays: ≤ 4e-15
+        relative, tested)."""
+        if self.mechanism.cylinder.roller is not RollerShape.CYLINDRICAL:
+            raise ValueError("on_radii needs a cylindrical roller: a conical roller's section changes with the radius")
+        return self._sample(phi, np.asarray(radii, dtype=float))
+
+    def _sample(self, phi, r, S=None) -> ProfileSample:
         x, s = self._S(phi, S)
-        mech, r, sg = self.mechanism, self.r, self.sense
+        mech, sg = self.mechanism, self.sense
         C, T, A = _path(mech, r, x, s)
         e, e1, e2, z, z1, z2, v = _arm(mech, s)
         f = envelope(mech.section(r), sg, xy(r * x, z + self.shift), xy(r + 0 * z1, z1), xy(0 * z2, z2), e, e1, e2)

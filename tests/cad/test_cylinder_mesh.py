@@ -212,6 +212,41 @@ def test_flank_at_array_radius_is_the_per_radius_evaluation(geometry):
                                                     e.point[:, 1])[0])
 
 
+def test_on_radii_is_each_radius_own_evaluation_bit_for_bit(geometry):
+    """DevelopedContact.on_radii (one evaluation, a radius per cam angle) gives the points of the per-radius
+    contact's evaluate bit for bit and every other field of the sample to 1e-14 relative (numpy's vector loops
+    against one-element arrays); a conical roller (its section changes with r) is refused."""
+    import dataclasses
+
+    from camfab.design.assemble import geometry_from_spec
+    from camfab.design.spec import design_from_dict
+
+    rng = np.random.default_rng(11)
+    t, r = rng.uniform(0, 7, 40), rng.uniform(35, 45, 40)
+    for flank in (1, -1):
+        many = geometry.at_radius(40.0, flank).on_radii(t, r)
+        for k in range(40):
+            one = geometry.at_radius(float(r[k]), flank).evaluate(t[k:k + 1])
+            for f in dataclasses.fields(one):
+                a, b = getattr(one, f.name), getattr(many, f.name)
+                if a is None:
+                    assert b is None, f.name
+                    continue
+                a, b = np.asarray(a)[0], np.asarray(b)[k]
+                if f.name in ("phi", "point"):
+                    assert a.tobytes() == b.tobytes(), (f.name, k)
+                else:
+                    np.testing.assert_allclose(b, a, rtol=1e-14, atol=0, err_msg=f"{f.name} {k}")
+    conical = geometry_from_spec(design_from_dict({
+        "name": "Cone", "cam": {"kind": "cylindrical"},
+        "cylinder": {"radius_mm": 40.0, "length_mm": 90.0, "groove_depth_mm": 10.0, "roller": "conical"},
+        "follower": {"type": "roller", "motion": "translating", "roller_radius_mm": 6.0},
+        "motion": [{"law": "cycloidal", "lift": 10.0, "angle_deg": 180.0},
+                   {"law": "cycloidal", "lift": -10.0, "angle_deg": 180.0}]}))
+    with pytest.raises(ValueError, match="cylindrical roller"):
+        conical.at_radius(40.0, 1).on_radii(t, r)
+
+
 def test_zipper_walks_both_edges_once():
     ua = np.sort(np.random.default_rng(1).uniform(0.3, 0.3 + 2 * math.pi, 37))
     ub = 2 * math.pi * np.arange(16) / 16
