@@ -1,8 +1,8 @@
 """The same bytes whatever the machine's thread count (docs/decisions.md, "One BLAS thread in the fitter"):
 every artifact kind of ``camfab run``, in separate processes with BLAS/OpenMP on one and on two threads and
-different hash seeds, is byte-identical (a plate cam's kinds and a cylindrical cam's: its developed DXF, STEP, IGES,
-the STL meshed from the exact surfaces, the rotary program).  Before the fitter pinned BLAS to one thread, Ejemplo11RO's STL had
-5 576 triangles on one thread and 5 560 on two."""
+different hash seeds, is byte-identical (a plate cam's kinds and a cylindrical cam's: its developed DXF, STEP,
+IGES, the STL meshed from the exact surfaces, the rotary program).  Before the fitter pinned BLAS to one thread,
+Ejemplo11RO's STL had 5 576 triangles on one thread and 5 560 on two."""
 from __future__ import annotations
 
 import hashlib

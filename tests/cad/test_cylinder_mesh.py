@@ -4,11 +4,7 @@ mesh's facets within it of them, the STEP solid's volume and surface, no CAD or 
 ``camfab export --stl``, and bad input refused."""
 from __future__ import annotations
 
-import json
 import math
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -266,35 +262,41 @@ def test_refused_beyond_the_triangle_cap_and_for_a_bad_bore(geometry):
         cm.part_mesh(geometry, tol=0.0)
 
 
-@pytest.mark.slow  # the STEP's solid (~6 s) and 500 distances to its surface
-def test_the_step_solid_agrees(made, geometry):
-    """OCC's adaptive volume of the STEP's solid within tol·area of the mesh's; a few hundred mesh vertices and
-    facet points within tol (plus the loft's own deviation) of the solid's surface."""
-    pytest.importorskip("cadquery", reason="the STEP solid needs cadquery (the step extra)")
+def _against_solid(solid, verts: np.ndarray, faces: np.ndarray, n: int, seed: int) -> np.ndarray:
+    """The mesh against an OCC solid: the solid's adaptive volume within tol·area of the mesh's (asserted), and the
+    distances to the solid's surface of n random mesh vertices, then n random facet centroids."""
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
     from OCP.BRepExtrema import BRepExtrema_DistShapeShape
     from OCP.BRepGProp import BRepGProp
     from OCP.gp import gp_Pnt
     from OCP.GProp import GProp_GProps
 
-    from camfab.cad.cylinder import cylinder_solid
-
-    bore, verts, faces, dev = made
-    if bore:
-        pytest.skip("one solid is enough (the bore's cylinder is checked exactly above)")
-    solid, loft_dev = cylinder_solid(geometry, tol=TOL)
     vol, area = GProp_GProps(), GProp_GProps()
     BRepGProp.VolumeProperties_s(solid.wrapped, vol, 1e-6, True)
     BRepGProp.SurfaceProperties_s(solid.wrapped, area, 1e-6, True)
     tri = verts[faces]
     volume = float(np.einsum("ij,ij->", tri[:, 0], np.cross(tri[:, 1], tri[:, 2]))) / 6.0
     assert abs(volume - vol.Mass()) <= TOL * area.Mass()
-    rng = np.random.default_rng(11)
-    sample = np.concatenate([verts[rng.choice(len(verts), 250, replace=False)],
-                             tri[rng.choice(len(tri), 250, replace=False)].mean(axis=1)])
+    rng = np.random.default_rng(seed)
+    sample = np.concatenate([verts[rng.choice(len(verts), n, replace=False)],
+                             tri[rng.choice(len(tri), n, replace=False)].mean(axis=1)])
     shell = solid.Shells()[0].wrapped  # the surface: a point inside the solid is not 0 from it
-    far = np.array([BRepExtrema_DistShapeShape(shell, BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, p))).Vertex())
-                    .Value() for p in sample])
+    return np.array([BRepExtrema_DistShapeShape(shell, BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, p))).Vertex())
+                     .Value() for p in sample])
+
+
+@pytest.mark.slow  # the STEP's solid (~6 s) and 500 distances to its surface
+def test_the_step_solid_agrees(made, geometry):
+    """OCC's adaptive volume of the STEP's solid within tol·area of the mesh's; a few hundred mesh vertices and
+    facet points within tol (plus the loft's own deviation) of the solid's surface."""
+    pytest.importorskip("cadquery", reason="the STEP solid needs cadquery (the step extra)")
+    from camfab.cad.cylinder import cylinder_solid
+
+    bore, verts, faces, dev = made
+    if bore:
+        pytest.skip("one solid is enough (the bore's cylinder is checked exactly above)")
+    solid, loft_dev = cylinder_solid(geometry, tol=TOL)
+    far = _against_solid(solid, verts, faces, 250, 11)
     assert far[:250].max() <= TOL, far[:250].max()  # the vertices: exact points; the loft within its deviation
     assert far.max() <= TOL + loft_dev, far.max()
 
@@ -341,48 +343,21 @@ def test_rib_mesh_is_closed_and_on_the_exact_part(rib):
 @pytest.mark.slow  # the STEP's ribbed solid (~6 s)
 def test_rib_step_solid_agrees(rib):
     pytest.importorskip("cadquery", reason="the STEP solid needs cadquery (the step extra)")
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeVertex
-    from OCP.BRepExtrema import BRepExtrema_DistShapeShape
-    from OCP.BRepGProp import BRepGProp
-    from OCP.gp import gp_Pnt
-    from OCP.GProp import GProp_GProps
-
     from camfab.cad.rib import rib_solid
 
     geometry, *_ = rib
     verts, faces, _ = cm.part_mesh(geometry, tol=TOL)
     solid, loft_dev = rib_solid(geometry, tol=TOL)
-    vol, area = GProp_GProps(), GProp_GProps()
-    BRepGProp.VolumeProperties_s(solid.wrapped, vol, 1e-6, True)
-    BRepGProp.SurfaceProperties_s(solid.wrapped, area, 1e-6, True)
-    tri = verts[faces]
-    volume = float(np.einsum("ij,ij->", tri[:, 0], np.cross(tri[:, 1], tri[:, 2]))) / 6.0
-    assert abs(volume - vol.Mass()) <= TOL * area.Mass()
-    rng = np.random.default_rng(13)
-    sample = np.concatenate([verts[rng.choice(len(verts), 200, replace=False)],
-                             tri[rng.choice(len(tri), 200, replace=False)].mean(axis=1)])
-    shell = solid.Shells()[0].wrapped
-    far = np.array([BRepExtrema_DistShapeShape(shell, BRepBuilderAPI_MakeVertex(gp_Pnt(*map(float, p))).Vertex())
-                    .Value() for p in sample])
+    far = _against_solid(solid, verts, faces, 200, 13)
     assert far[:200].max() <= TOL and far.max() <= TOL + loft_dev, far.max()
 
 
 def test_export_stl_imports_no_cad_or_mesh_library(tmp_path):
     """``camfab export <cylindrical example> --stl`` writes the STL without cadquery, OCP or trimesh."""
-    code = """
-import json, runpy, sys
-sys.argv = ["camfab", *sys.argv[1:]]
-try:
-    runpy.run_module("camfab", run_name="__main__", alter_sys=True)
-except SystemExit as e:
-    code = e.code
-print(json.dumps({"code": code, "modules": sorted(sys.modules)}), file=sys.stderr)
-"""
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    r = subprocess.run([sys.executable, "-c", code, "export", str(EXAMPLE), "--stl", "-o", str(tmp_path), "--force"],
-                       cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
-    last = json.loads(r.stderr.strip().splitlines()[-1])
-    assert last["code"] in (0, None), r.stderr
+    from tests.test_lazy_imports import _run
+
+    last = _run(tmp_path, "export", str(EXAMPLE), "--stl", "-o", str(tmp_path), "--force")
+    assert last["code"] in (0, None), last
     heavy = sorted(m for m in last["modules"] if m.split(".")[0] in ("cadquery", "OCP", "trimesh", "scipy"))
     assert not heavy, heavy
     data = (tmp_path / "BarrelCam.stl").read_bytes()
