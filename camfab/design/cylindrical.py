@@ -47,7 +47,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ..errors import Problem
+from ..errors import InputError, Problem
 from ..geom2d import cross, dot
 from .cylinder_spec import CYLINDER_KEYS, CylinderSpec, Feature, RollerShape, cylinder_section
 from .kinds import CamKind, FollowerMotion, FollowerType
@@ -114,7 +114,7 @@ class DevelopedContact(Contact):
         and directions may differ in the last bits (numpy's vector loops against one-element arrays: ≤ 4e-15
         relative, tested)."""
         if self.mechanism.cylinder.roller is not RollerShape.CYLINDRICAL:
-            raise ValueError("on_radii needs a cylindrical roller: a conical roller's section changes with the radius")
+            raise InputError("on_radii needs a cylindrical roller: a conical roller's section changes with the radius")
         return self._sample(phi, np.asarray(radii, dtype=float))
 
     def _sample(self, phi, r, S=None) -> ProfileSample:

@@ -12,7 +12,7 @@ import pytest
 
 from camfab.cad import cylinder_mesh as cm
 from camfab.cad.stl import FACET, is_closed_surface
-from camfab.errors import ExportError
+from camfab.errors import ExportError, InputError
 from camfab.pipeline import load
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -239,7 +239,7 @@ def test_on_radii_is_each_radius_own_evaluation_bit_for_bit(geometry):
         "follower": {"type": "roller", "motion": "translating", "roller_radius_mm": 6.0},
         "motion": [{"law": "cycloidal", "lift": 10.0, "angle_deg": 180.0},
                    {"law": "cycloidal", "lift": -10.0, "angle_deg": 180.0}]}))
-    with pytest.raises(ValueError, match="cylindrical roller"):
+    with pytest.raises(InputError, match="cylindrical roller"):
         conical.at_radius(40.0, 1).on_radii(t, r)
 
 
