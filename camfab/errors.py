@@ -15,9 +15,9 @@ fails on a ``raise`` of a builtin exception anywhere in the package.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any
 
+from .records import dataclass
 from .textsafe import excerpt
 
 __all__ = [

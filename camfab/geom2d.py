@@ -17,11 +17,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass, replace
 
 import numpy as np
 
 from .errors import GeometryError
+from .records import dataclass, replace
 
 __all__ = [
     "TWO_PI",

@@ -15,7 +15,6 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from functools import cached_property, lru_cache
 from typing import NamedTuple
 
@@ -23,6 +22,7 @@ import numpy as np
 
 from .errors import InputError
 from .quadrature import Integral, integral, integrate
+from .records import dataclass
 
 __all__ = ["Grid", "Optimum", "Range", "dense_grid", "resolution", "unresolved", "clear_caches", "search",
            "extremum", "extrema", "positive_ranges", "root", "integrate", "integral", "Integral"]

@@ -48,7 +48,6 @@ import threading
 import time
 from collections.abc import Callable, Generator, Iterable, Sequence
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -59,6 +58,7 @@ from .formats import load_design
 from .formats.knot_files import relocated
 from .io import atomic_write, hold_sigint, inside, leftover_name, output_folder, safe_stem, swap_dir, write_all
 from .pipeline import Cam, Output, Request, RunResult, build_files, shop_file_names
+from .records import dataclass, replace
 from .report.overview import cam_summary, index_html
 from .results import Verdict
 from .textsafe import bounded, plain

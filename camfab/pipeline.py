@@ -20,7 +20,6 @@ import logging
 import math
 import time
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, field
 from enum import StrEnum
 from pathlib import Path
 from typing import Any
@@ -37,6 +36,7 @@ from .errors import GeometryError, InputError, MissingDependencyError, Problem, 
 from .formats import EXAMPLES_DIR, load_design, resolve_design_path
 from .io import atomic_write, inside, output_folder, safe_stem, write_all
 from .limits import MAX_POSES, MAX_SIZE_OVER_TOL
+from .records import dataclass, field
 from .results import CheckReport, IssueCode, Severity, Verdict
 
 __all__ = ["Output", "SHOP_OUTPUTS", "Request", "RunResult", "Cam", "EXPORTERS", "gcode_job", "run", "build_files",

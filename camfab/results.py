@@ -9,11 +9,12 @@ JSON keys say ``_deg`` either way).
 from __future__ import annotations
 
 from collections.abc import Iterable, Iterator
-from dataclasses import dataclass
 from enum import StrEnum
 from typing import Any, Protocol
 
 import numpy as np
+
+from .records import dataclass
 
 __all__ = [
     "Severity",

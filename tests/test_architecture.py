@@ -16,10 +16,11 @@ PACKAGE = ROOT / "camfab"
 #: what each part of the package may import from camfab (module-name prefixes); a module not listed here
 #: fails the test, so a new package must take its place in the layers
 BASE = ("camfab.version", "camfab.errors", "camfab.units", "camfab.tolerances", "camfab.results", "camfab.numeric",
-        "camfab.geom2d", "camfab.textsafe", "camfab.limits", "camfab.threads", "camfab.brent", "camfab.sets")
+        "camfab.geom2d", "camfab.textsafe", "camfab.limits", "camfab.threads", "camfab.brent", "camfab.sets",
+        "camfab.records")
 LAYERS: dict[str, tuple[str, ...]] = {
     "camfab.version": (),
-    "camfab.errors": ("camfab.textsafe",),  # messages quote values through textsafe.excerpt
+    "camfab.errors": ("camfab.textsafe", "camfab.records"),  # messages quote values through textsafe.excerpt
     "camfab.units": (),
     "camfab.tolerances": (),
     "camfab.limits": ("camfab.errors", "camfab.textsafe"),
@@ -27,12 +28,13 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "camfab.textsafe": (),
     "camfab.threads": (),
     "camfab.assets": ("camfab.errors",),
-    "camfab.results": ("camfab.errors",),
-    "camfab.numeric": ("camfab.errors", "camfab.quadrature"),
+    "camfab.results": ("camfab.errors", "camfab.records"),
+    "camfab.numeric": ("camfab.errors", "camfab.quadrature", "camfab.records"),
     "camfab.quadrature": (),
     "camfab.brent": ("camfab.errors", "camfab.textsafe"),  # InputError / InternalError, as numeric
     "camfab.sets": (),
-    "camfab.geom2d": ("camfab.errors", "camfab.tolerances"),
+    "camfab.records": (),
+    "camfab.geom2d": ("camfab.errors", "camfab.tolerances", "camfab.records"),
     "camfab.design": BASE + ("camfab.design",),
     "camfab.discretize": BASE + ("camfab.discretize",),
     "camfab.offset": BASE + ("camfab.design", "camfab.discretize", "camfab.offset"),

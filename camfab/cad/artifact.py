@@ -6,8 +6,9 @@ on first use: ``camfab check`` and the other commands that write no CAD file nev
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
+
+from ..records import dataclass
 
 if TYPE_CHECKING:
     from ..discretize import ArcDiscretisation

@@ -18,7 +18,6 @@ import math
 import re
 import tempfile
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -27,6 +26,7 @@ import numpy as np
 from ..design.mechanisms import ConstantDiameterCam, ConstantWidthCam
 from ..errors import Problem, SpecError
 from ..geom2d import ArcChain
+from ..records import dataclass
 from .export import plate_of
 from .step import cadquery as _cq
 from .step import plate_solid

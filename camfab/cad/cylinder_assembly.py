@@ -21,13 +21,13 @@ from __future__ import annotations
 
 import math
 import tempfile
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, cast
 
 import numpy as np
 
 from ..design.cylindrical import Feature, RollerShape, pitch_3d
+from ..records import dataclass, field
 from .assembly import canonical_order, to_assembly
 from .step import cadquery, canonical_reals
 from .stepheader import design_meta, header_dumps

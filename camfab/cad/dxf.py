@@ -34,12 +34,12 @@ from __future__ import annotations
 import io
 import math
 import re
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import InputError, MissingDependencyError
 from ..geom2d import ArcChain, bulge_centre
+from ..records import dataclass, field
 from ..textsafe import dxf_string
 
 __all__ = ["DxfContent", "LAYERS", "FLAVOURS", "dumps", "build_document", "loop_nurbs", "r12_pieces",

@@ -24,12 +24,12 @@ import contextlib
 import io
 import math
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from ..errors import ExportError, MissingDependencyError
 from ..io import atomic_stream
+from ..records import dataclass
 from ..textsafe import excerpt, plain
 
 __all__ = ["sheet_pdf", "sheet_figure", "paper_size", "read_sheet", "SetEntry", "write_drawing_set",

@@ -11,12 +11,12 @@ on the +Y axis (the follower direction at cam angle 0).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import GeometryError, InternalError
 from ..geom2d import ArcChain
+from ..records import dataclass
 
 __all__ = ["PlateSpec", "keyway_size", "bore_loop", "circle_loop", "plate_volume"]
 

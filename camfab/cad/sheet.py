@@ -9,7 +9,6 @@ from __future__ import annotations
 import functools
 import math
 import tomllib
-from dataclasses import dataclass
 from typing import Any, cast
 
 import numpy as np
@@ -17,6 +16,7 @@ import numpy as np
 from ..assets import read_template
 from ..errors import ExportError, InputError
 from ..geom2d import ArcChain
+from ..records import dataclass
 from ..textsafe import dxf_mtext, dxf_string, dxf_text
 from .dxf import ezdxf_module
 

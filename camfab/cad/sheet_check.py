@@ -8,10 +8,10 @@ every entity and DIMENSION block, grouped into title block, lift table, notes, c
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
+from ..records import dataclass
 from .sheet import NOTE_PITCH, SheetLayout, text_width
 
 __all__ = ["SheetItems", "sheet_items", "layout_problems", "Occupancy", "dimension_parts", "REFERENCE_LAYERS"]

@@ -15,10 +15,10 @@ from __future__ import annotations
 
 import os
 import re
-from dataclasses import dataclass
 from datetime import UTC, datetime
 
 from ..errors import InputError
+from ..records import dataclass
 from ..textsafe import step_string
 from ..version import __version__
 

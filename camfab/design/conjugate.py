@@ -40,7 +40,6 @@ centres).  It is computed by root finding on that margin and enforced with a
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
 import numpy as np
@@ -48,6 +47,7 @@ import numpy as np
 from ..brent import brentq
 from ..errors import ApiError, Problem
 from ..numeric import extremum
+from ..records import dataclass, replace
 from ..sets import sorted_unique
 from .faces import OscillatingFlat, OscillatingFlatContact, TranslatingFlat, TranslatingFlatContact
 from .kinds import CamKind, FollowerMotion, FollowerType

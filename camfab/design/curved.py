@@ -30,12 +30,12 @@ tend to the flat face's (tested against :mod:`camfab.design.faces`).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 
 from ..errors import Problem
+from ..records import dataclass
 from .kinds import FollowerMotion, FollowerType
 from .mechanism import Mechanism, finite_fields, lift_range, require_positive, require_rotation
 from .profile import DEG, Contact, MotionLike

@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 from enum import StrEnum
 from typing import Any
 
+from ..records import dataclass
 from .kinds import CamKind
 
 __all__ = ["CYLINDER_KEYS", "Feature", "RollerShape", "CylinderSpec", "cylinder_section"]

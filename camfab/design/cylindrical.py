@@ -42,13 +42,13 @@ leaves only the slip of the axial part, ``ω·(|C_r′| − |C_R′|·r/R)``.  I
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 
 from ..errors import InputError, Problem
 from ..geom2d import cross, dot
+from ..records import dataclass
 from .cylinder_spec import CYLINDER_KEYS, CylinderSpec, Feature, RollerShape, cylinder_section
 from .kinds import CamKind, FollowerMotion, FollowerType
 from .mechanism import Mechanism, finite_fields, lift_range, require_positive, require_rotation

@@ -13,9 +13,9 @@ from __future__ import annotations
 import datetime
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Any
 
+from ..records import dataclass
 from .validator import Validator
 
 __all__ = ["DrawingSpec", "drawing_section", "HOLE_FIT", "KEYWAY_WIDTH_FITS", "GENERAL_TOLERANCE",

@@ -42,13 +42,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 
 from .. import numeric
 from ..errors import InputError
+from ..records import dataclass
 from ..results import (
     DynamicsReport,
     DynamicsSummary,

@@ -10,11 +10,11 @@ from 0 to the period inclusive, a sample on a junction counted on both sides.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..records import dataclass
 from .segment import Segment
 
 if TYPE_CHECKING:

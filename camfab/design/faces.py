@@ -17,12 +17,12 @@ profile ``P = p·n + s·J·n`` with ``s = p′/(σ + β′)`` and radius of curv
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 
 from ..errors import Problem
+from ..records import dataclass
 from .kinds import ContactKind, FollowerMotion, FollowerType
 from .mechanism import Mechanism, finite_fields, lift_range, require_positive, require_rotation
 from .profile import CHUNK, DEG, Contact, MotionLike, ProfileSample, block, rot_into

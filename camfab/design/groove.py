@@ -36,12 +36,12 @@ cylindrical cam's groove can reuse :func:`flank_contacts` on its developed pitch
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
 import numpy as np
 
 from ..errors import Problem
+from ..records import dataclass, replace
 from .kinds import CamKind, FollowerMotion
 from .mechanism import Mechanism, finite_fields, require_non_negative, require_positive
 from .profile import CamGeometry, Contact, MotionLike, ProfileSample

@@ -12,10 +12,11 @@ from the period or from the attributes a contact happens to have.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from enum import StrEnum
 
 import numpy as np
+
+from ..records import dataclass
 
 __all__ = [
     "CamKind",

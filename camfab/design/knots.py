@@ -67,7 +67,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -75,6 +74,7 @@ import numpy as np
 
 from ..errors import Problem, SpecError
 from ..limits import MAX_KNOTS, MAX_LIFT_MM
+from ..records import dataclass, field
 from ..results import Finding, IssueCode, Severity
 from ..tolerances import ANGLE_SUM_TOL_DEG
 from ..units import DEG, rpm_to_rad_s

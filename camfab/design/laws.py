@@ -52,12 +52,12 @@ middle.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from ..brent import brentq
+from ..records import dataclass, field
 
 __all__ = [
     "horner",

@@ -19,7 +19,8 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass
+
+from ..records import dataclass
 
 __all__ = ["Material", "MATERIALS", "DEFAULT_CAM_MATERIAL", "DEFAULT_FOLLOWER_MATERIAL", "known_materials",
            "match_material", "material_from_table"]

@@ -25,12 +25,12 @@ mechanism).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
 from typing import Any, ClassVar
 
 import numpy as np
 
 from ..errors import Problem, SpecError
+from ..records import dataclass, fields
 from .kinds import CamKind, FollowerMotion, FollowerType, Rotation
 from .profile import CamGeometry, Contact, MotionLike
 

@@ -19,13 +19,13 @@ import dataclasses
 import math
 import re
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from .. import numeric
 from ..errors import InputError, Problem, SpecError
+from ..records import dataclass, field
 from .assemble import is_form_closed, loads_from_spec
 from .checks import DEFAULT_PRESSURE_LIMIT_DEG
 from .dynamics import ContactDynamics, pair_of

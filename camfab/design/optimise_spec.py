@@ -19,10 +19,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
 from enum import StrEnum
 from typing import Any
 
+from ..records import dataclass
 from .validator import Validator
 
 __all__ = ["OptimiseSpec", "VariableSpec", "Method", "OBJECTIVE_NAMES", "CONSTRAINT_NAMES", "optimise_section"]

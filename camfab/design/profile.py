@@ -55,7 +55,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any, ClassVar, Protocol
 
 import numpy as np
@@ -63,6 +62,7 @@ import numpy as np
 from ..errors import ApiError, InputError, SpecError
 from ..geom2d import cross, dot
 from ..numeric import extrema, integrate
+from ..records import dataclass
 from ..sets import sorted_unique
 from .kinds import Axis, ContactKind
 

@@ -18,11 +18,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import InputError
+from ..records import dataclass, field
 from ..sets import sorted_unique
 from ..tolerances import CONTINUITY_REL_TOL
 from .evaluation import Grouped, by_segment

@@ -22,12 +22,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import Problem, SpecError
 from ..limits import MAX_LIFT_MM, MAX_SEGMENTS
+from ..records import dataclass
 from ..tolerances import ANGLE_SUM_TOL_DEG
 from .extrema import segment_candidates
 from .laws import GENERIC, HALF_PERIOD, LAWS, get_law, law_names

@@ -29,12 +29,11 @@ the follower's direction of increasing lift to the roller's normal at the contac
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from ..errors import GeometryError
 from ..geom2d import J, cross, dot
+from ..records import dataclass
 
 __all__ = ["RollerSection", "Envelope", "envelope"]
 

@@ -13,12 +13,12 @@ The roller centre C follows the pitch curve; the profile is its parallel curve a
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 
 from ..errors import Problem
+from ..records import dataclass
 from .kinds import FollowerMotion, FollowerType
 from .mechanism import Mechanism, finite_fields, lift_range, require_non_negative, require_positive, require_rotation
 from .profile import CHUNK, DEG, Contact, MotionLike, ProfileSample, block, rot_into

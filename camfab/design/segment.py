@@ -10,11 +10,11 @@ faster path reproduces operation for operation.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import InputError
+from ..records import dataclass, field
 from .laws import LAWS, Law, Polynomial, derivative_rows, horner
 
 __all__ = ["Segment", "hermite_coefficients", "solve_generic"]

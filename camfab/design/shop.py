@@ -10,11 +10,11 @@ inputs.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 from enum import StrEnum
 from typing import Any
 
 from ..limits import MAX_DEPTH_LEVELS
+from ..records import dataclass
 from ..tolerances import DEFAULT_EXPORT_TOL_MM, MAX_EXPORT_TOL_MM, MIN_EXPORT_TOL_MM
 from .validator import Validator
 

@@ -15,10 +15,10 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
 from typing import Any
 
 from ..errors import InputError, Problem, SpecError
+from ..records import dataclass
 from .checks import DEFAULT_PRESSURE_LIMIT_DEG
 from .kinds import FollowerMotion
 from .mechanisms import OscillatingFlat, OscillatingRoller, TranslatingFlat, TranslatingRoller, mechanism_from_spec

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Any
 
+from ..records import dataclass
 from .validator import Validator
 
 __all__ = ["SizingSpec", "sizing_section", "SIZER_NAMES"]

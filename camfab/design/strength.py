@@ -42,13 +42,13 @@ steels), unlimited below σ_Hlim.  An estimate: lubrication, sliding and surface
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from .. import numeric
 from ..errors import InputError
+from ..records import dataclass
 from ..results import Finding, IssueCode, Severity
 from .dynamics import ContactDynamics, DynamicsSample, GrooveDynamics, PairDynamics
 from .kinds import ContactKind

@@ -19,9 +19,9 @@ contact force) or a ``[strength]`` table.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
 from typing import Any
 
+from ..records import dataclass, field
 from .materials import (
     DEFAULT_CAM_MATERIAL,
     DEFAULT_FOLLOWER_MATERIAL,

@@ -13,12 +13,12 @@ uses an SHM rise over ``rise_deg``, a dwell, an SHM return over ``rise_deg`` and
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 
 from ..errors import Problem
+from ..records import dataclass
 from .conjugate import FormClosed
 from .faces import TranslatingFlatContact
 from .kinds import CamKind, FollowerType

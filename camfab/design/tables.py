@@ -7,12 +7,12 @@ sheet and the CAM-DAS workbook print and a shop checks a cam against.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from ..errors import Problem, SpecError
+from ..records import dataclass
 from .kinds import ContactKind
 
 __all__ = ["LiftTable", "lift_table", "sample_params", "intervals"]

@@ -43,12 +43,12 @@ geometric ladder of speeds and refined by root finding.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from .. import numeric
 from ..errors import InputError
+from ..records import dataclass
 from ..results import Extreme, Finding, IssueCode, JumpSpeed, Maximum, Severity
 from ..units import RPM
 from .dynamics import ContactDynamics, Loads

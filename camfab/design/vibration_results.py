@@ -7,9 +7,9 @@ or mm of travel for a translating cam; the JSON keys say ``_deg`` either way).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
+from ..records import dataclass
 from ..results import Extreme, Finding, JumpSpeed, Maximum
 
 __all__ = ["Harmonic", "VibrationSummary", "VibrationReport"]

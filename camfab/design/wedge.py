@@ -7,13 +7,13 @@ reads the cam left to right, x₀ = 0) and χ = −1 when it slides right (x₀ 
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 
 from ..errors import Problem
 from ..geom2d import J, cross
+from ..records import dataclass
 from .kinds import CamKind, Direction
 from .mechanism import Mechanism, finite_fields, require_non_negative
 from .profile import Contact, MotionLike, ProfileSample, inverse, pressure_angle, xy

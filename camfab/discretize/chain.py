@@ -3,11 +3,11 @@ polylines, bulge rows, G-code style arcs and arc chains, and the merging of co-c
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from ..geom2d import TWO_PI, J, cross, dot, rotate, unit
+from ..records import dataclass
 from .entities import LINE_SWEEP_RAD, MAX_ARC_SWEEP_RAD, arc_from, entity_distance, entity_point
 from .grid import grid_nearest
 

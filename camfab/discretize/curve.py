@@ -11,12 +11,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..errors import CamfabError
 from ..geom2d import TWO_PI, cross
+from ..records import dataclass, field
 
 __all__ = [
     "CurveError",

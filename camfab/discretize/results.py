@@ -2,11 +2,10 @@
 and the arc chain :class:`ArcDiscretisation` (an :class:`~camfab.geom2d.ArcChain` with its fit data)."""
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from ..geom2d import ArcChain, J, rotate
+from ..records import dataclass
 from .chain import Chain
 
 __all__ = ["Deviation", "Discretisation", "ArcDiscretisation"]

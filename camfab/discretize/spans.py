@@ -8,11 +8,11 @@ tangent.  Each span is clamped to the curve's point and tangent at both ends.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..geom2d import cross, dot, rotate, unit
+from ..records import dataclass, field
 from .curve import ParametricCurve, piece_index, points_at
 from .entities import MAX_TURNING_RAD, arc_from
 from .spanmodel import cumtrapz, span_model

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -20,6 +19,7 @@ from ..discretize.fit import REFIT_SHARE
 from ..errors import ApiError
 from ..geom2d import ArcChain
 from ..offset.cutter import ToolCentrePath, offset_curve, offset_loop, profile_curve, tool_centre_path
+from ..records import dataclass, replace
 from ..tolerances import arc_radius_limit
 from .distance import CurveDistance
 from .model import Job, Program, machining_of

@@ -37,7 +37,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field, replace
 from typing import Literal
 
 import numpy as np
@@ -45,6 +44,7 @@ import numpy as np
 from camfab.errors import InputError
 from camfab.gcode.parse import Move
 from camfab.geom2d import TWO_PI, arc_sweep
+from camfab.records import dataclass, field, replace
 from camfab.results import Finding, IssueCode
 
 __all__ = ["CompensatedPath", "simulate_compensation", "move_lengths"]

@@ -8,12 +8,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
 from camfab.errors import GeometryError
 from camfab.geom2d import TWO_PI, ArcChain, J, arc_sweep
+from camfab.records import dataclass
 
 __all__ = [
     "CLOSE_TOL_MM",

@@ -26,12 +26,12 @@ import bisect
 import math
 import re
 import tomllib
-from dataclasses import dataclass
 from functools import cache
 from importlib import resources
 from typing import Any
 
 from camfab.errors import Problem, SpecError
+from camfab.records import dataclass
 
 __all__ = ["TOOL_MATERIALS", "CuttingData", "cutting_data", "known_materials", "match_material", "table"]
 

@@ -8,13 +8,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
 from typing import Any
 
 from camfab.design.shop import MachiningSpec
 from camfab.errors import Problem, SpecError
 from camfab.gcode.cutting import cutting_data
 from camfab.limits import MAX_DEPTH_LEVELS
+from camfab.records import dataclass, field, replace
 from camfab.tolerances import MAX_EXPORT_TOL_MM, MIN_EXPORT_TOL_MM
 
 __all__ = ["Rapid", "Feed", "Arc", "Comment", "ToolChange", "Spindle", "Coolant", "CutterComp", "Item", "Job",

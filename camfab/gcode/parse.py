@@ -21,12 +21,12 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
 from camfab.errors import CamfabError, InputError
 from camfab.geom2d import arc_sweep
+from camfab.records import dataclass
 
 __all__ = ["GcodeError", "Move", "Backplot", "Samples", "parse", "backplot", "points_along", "sample"]
 

@@ -12,9 +12,9 @@ unknown word) is a :class:`RotaryReadError` naming the line.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 
 from ..errors import CamfabError
+from ..records import dataclass
 from .posts.base import MM_PER_INCH
 
 __all__ = ["RotaryMove", "RotaryReadError", "read_rotary"]

@@ -36,6 +36,7 @@ from typing import Any
 
 import numpy as np
 
+from ..records import dataclass
 from ..results import Finding, IssueCode
 from .model import Job
 from .rotary_finish import cutter_penetration, finishing_direction, flank_path, pitch_distance, require_groove
@@ -53,7 +54,7 @@ _PROBES = 4096
 _RADII = np.linspace(0.0, 1.0, 6)
 
 
-@dataclasses.dataclass(frozen=True)
+@dataclass(frozen=True)
 class RotaryVerifyReport(VerifyReport):
     """:class:`VerifyReport` with the ``rotary`` summary (added to the JSON; no key renamed)."""
 
@@ -63,7 +64,7 @@ class RotaryVerifyReport(VerifyReport):
         return super().to_dict() | {"rotary": self.rotary}
 
 
-@dataclasses.dataclass(frozen=True)
+@dataclass(frozen=True)
 class Samples:
     """Points of the cutting moves: X, A (deg), Z, the index of their move, on the tip's developed cylinder."""
 

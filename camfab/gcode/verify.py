@@ -69,7 +69,6 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -91,6 +90,7 @@ from camfab.gcode.model import Job
 from camfab.gcode.parse import Backplot, GcodeError, Move, Samples, parse, points_along, sample
 from camfab.gcode.post import POSTS, get_post
 from camfab.gcode.posts.base import Post
+from camfab.records import dataclass, field, replace
 from camfab.results import Finding, IssueCode, Severity
 
 __all__ = ["MAX_SAMPLES_PER_MOVE", "VerifyReport", "declared_post", "default_step", "verify", "verify_program"]

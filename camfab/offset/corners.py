@@ -24,7 +24,6 @@ sides (minus the cut-back stretches), and an added stretch for each arc or face 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -32,6 +31,7 @@ from ..design.kinds import ContactKind
 from ..discretize import ParametricCurve
 from ..errors import GeometryError
 from ..geom2d import J, cross, dot, rotate, unit
+from ..records import dataclass
 
 __all__ = ["ProfileCorner", "profile_corners", "cornered_curve", "corner_note", "CORNER_GAP_MM"]
 

@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -32,6 +31,7 @@ from ..discretize import (
 from ..discretize.tolerance import within
 from ..errors import GeometryError, InternalError
 from ..geom2d import ArcChain
+from ..records import dataclass
 from ..tolerances import DEFAULT_EXPORT_TOL_MM
 from .corners import corner_note, cornered_curve, profile_corners
 from .outline import translating_outline

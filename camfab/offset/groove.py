@@ -10,11 +10,11 @@ The shapely guard buffers the inner flank's polygon outward and the outer flank'
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 from ..discretize import ArcDiscretisation, ParametricCurve, arcs, validate_tol
 from ..errors import GeometryError
 from ..numeric import positive_ranges
+from ..records import dataclass
 from .cutter import ToolCentrePath, concave_limit, offset_curve, pitch_curve, profile_curve, shapely_guard
 
 __all__ = ["GroovePaths", "groove_tool_paths", "flank_cutter_problem"]

@@ -23,12 +23,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 
 from ..discretize import ParametricCurve
 from ..errors import ApiError, GeometryError
+from ..records import dataclass
 from .corners import cornered_curve, profile_corners
 
 __all__ = ["Piece", "line_piece", "arc_piece", "chain_curve", "translating_outline"]

@@ -6,12 +6,12 @@ the report (sampling grids, angle ranges, the CAM-DAS conclusions rows).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from ..design.kinds import FollowerType
+from ..records import dataclass
 from ..results import CURVATURE_CODES, JUMP_CODES, IssueCode, Severity, Verdict
 
 __all__ = ["Axis", "axis_of", "sample_grid", "finding_spans", "fmt", "fmt_at", "range_text",

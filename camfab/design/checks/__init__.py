@@ -26,10 +26,10 @@ from __future__ import annotations
 import dataclasses
 import itertools
 from collections.abc import Callable
-from dataclasses import dataclass
 from enum import StrEnum
 from typing import Any
 
+from ...records import dataclass
 from ...results import CheckReport
 from ..profile import CamGeometry
 from .common import CUSP_TOL_MM, DEFAULT_PRESSURE_LIMIT_DEG, ContactSample, Limits, RuleResult

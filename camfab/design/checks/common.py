@@ -9,13 +9,13 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from ... import numeric
 from ...errors import GeometryError
+from ...records import dataclass, field
 from ...results import Finding
 from ..kinds import ContactKind
 from ..profile import Contact, ProfileSample
