@@ -17,7 +17,7 @@ PACKAGE = ROOT / "camfab"
 #: fails the test, so a new package must take its place in the layers
 BASE = ("camfab.version", "camfab.errors", "camfab.units", "camfab.tolerances", "camfab.results", "camfab.numeric",
         "camfab.geom2d", "camfab.textsafe", "camfab.limits", "camfab.threads", "camfab.brent", "camfab.sets",
-        "camfab.records")
+        "camfab.words", "camfab.records")
 LAYERS: dict[str, tuple[str, ...]] = {
     "camfab.version": (),
     "camfab.errors": ("camfab.textsafe", "camfab.records"),  # messages quote values through textsafe.excerpt
@@ -33,6 +33,7 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "camfab.quadrature": (),
     "camfab.brent": ("camfab.errors", "camfab.textsafe"),  # InputError / InternalError, as numeric
     "camfab.sets": (),
+    "camfab.words": (),
     "camfab.records": (),
     "camfab.geom2d": ("camfab.errors", "camfab.tolerances", "camfab.records"),
     "camfab.design": BASE + ("camfab.design",),

@@ -17,10 +17,10 @@ The names match the work materials of the cutting-data table (``camfab/gcode/cut
 """
 from __future__ import annotations
 
-import re
 from collections.abc import Mapping
 
 from ..records import dataclass
+from ..words import earliest_word
 
 __all__ = ["Material", "MATERIALS", "DEFAULT_CAM_MATERIAL", "DEFAULT_FOLLOWER_MATERIAL", "known_materials",
            "match_material", "material_from_table"]
@@ -116,13 +116,9 @@ def match_material(text: str, extra: Mapping[str, Material] | None = None) -> Ma
     for name, mat in table.items():
         if text.strip().lower() == name.lower():
             return mat
-    best: tuple[int, Material] | None = None
-    for mat in table.values():
-        for word in (mat.name, *mat.aliases):
-            m = re.search(rf"(?<![\w.-]){re.escape(word)}(?![\w.-])", text, re.IGNORECASE)
-            if m and (best is None or m.start() < best[0]):
-                best = (m.start(), mat)
-    return None if best is None else best[1]
+    named = [(mat, word) for mat in table.values() for word in (mat.name, *mat.aliases)]
+    i = earliest_word(text, [word for _, word in named])
+    return None if i is None else named[i][0]
 
 
 def material_from_table(name: str, values: Mapping[str, float]) -> Material:

@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import bisect
 import math
-import re
 import tomllib
 from functools import cache
 from importlib import resources
@@ -32,6 +31,7 @@ from typing import Any
 
 from camfab.errors import Problem, SpecError
 from camfab.records import dataclass
+from camfab.words import earliest_word
 
 __all__ = ["TOOL_MATERIALS", "CuttingData", "cutting_data", "known_materials", "match_material", "table"]
 
@@ -58,13 +58,9 @@ def match_material(text: str) -> str | None:
     >>> match_material("42CrMo4, induction hardened"), match_material("EN AW-6082 T6"), match_material("brass")
     ('42CrMo4', 'AlMgSi1', None)
     """
-    best: tuple[int, str] | None = None
-    for name, row in table()["materials"].items():
-        for word in (name, *row.get("aliases", ())):
-            m = re.search(rf"(?<![\w.-]){re.escape(word)}(?![\w.-])", text, re.IGNORECASE)
-            if m and (best is None or m.start() < best[0]):
-                best = (m.start(), name)
-    return None if best is None else best[1]
+    named = [(name, word) for name, row in table()["materials"].items() for word in (name, *row.get("aliases", ()))]
+    i = earliest_word(text, [word for _, word in named])
+    return None if i is None else named[i][0]
 
 
 @dataclass(frozen=True)
