@@ -78,6 +78,7 @@ from ..records import dataclass, field
 from ..results import Finding, IssueCode, Severity
 from ..tolerances import ANGLE_SUM_TOL_DEG
 from ..units import DEG, rpm_to_rad_s
+from .extrema import polynomial_roots
 from .program import MotionProgram, Segment, hermite_coefficients
 
 __all__ = [
@@ -276,9 +277,8 @@ class KnotTable:
         for nu in orders:
             col = np.abs(vals[:, nu])
             floor = 1e-12 * float(col.max())
-            for i, seg in enumerate(segs):
+            for i, (seg, (lo, hi, _, _)) in enumerate(zip(segs, _extremes_all(segs, nu), strict=True)):
                 ref = max(col[i], col[i + 1])
-                lo, hi, _, _ = _extremes(seg, nu)
                 peak = max(abs(lo), abs(hi))
                 if ref > floor and peak > ratio * ref:
                     out.append((i, nu, self._warning(i, seg, nu, peak, ref)))
@@ -301,13 +301,27 @@ class KnotTable:
 
 def _extremes(seg: Segment, nu: int) -> tuple[float, float, float, float]:
     """Exact (min, max, u_min, u_max) of S⁽ⁿᵘ⁾ (per radian) over one polynomial segment."""
-    assert seg.coeffs is not None  # a knot table's segments are Hermite polynomials (KnotTable.segments)
-    p = np.polynomial.Polynomial(seg.coeffs).deriv(nu)
-    r = p.deriv().roots() if p.degree() > 0 else np.array([])
-    r = r.real[(np.abs(r.imag) <= 1e-12) & (r.real > 0.0) & (r.real < 1.0)]
-    u = np.concatenate([[0.0, 1.0], r])
-    vals = p(u) / seg.span**nu
-    return float(vals.min()), float(vals.max()), float(u[vals.argmin()]), float(u[vals.argmax()])
+    return _extremes_all([seg], nu)[0]
+
+
+def _extremes_all(segs: Sequence[Segment], nu: int) -> list[tuple[float, float, float, float]]:
+    """:func:`_extremes` of each segment, the roots of all found together (:func:`extrema.polynomial_roots`:
+    bit for bit numpy's ``Polynomial(coeffs).deriv(nu).deriv().roots()``, whose domain map is the identity)."""
+    poly = np.polynomial.polynomial
+    ders = []
+    for seg in segs:
+        assert seg.coeffs is not None  # a knot table's segments are Hermite polynomials (KnotTable.segments)
+        ders.append(poly.polyder(seg.coeffs, nu))
+    moving = [i for i, d in enumerate(ders) if len(d) > 1]
+    roots = dict(zip(moving, polynomial_roots([poly.polyder(ders[i]) for i in moving]), strict=True))
+    out = []
+    for i, (seg, d) in enumerate(zip(segs, ders, strict=True)):
+        r = roots.get(i, np.array([]))
+        r = r.real[(np.abs(r.imag) <= 1e-12) & (r.real > 0.0) & (r.real < 1.0)]
+        u = np.concatenate([[0.0, 1.0], r])
+        vals = poly.polyval(u, d) / seg.span**nu
+        out.append((float(vals.min()), float(vals.max()), float(u[vals.argmin()]), float(u[vals.argmax()])))
+    return out
 
 
 # ---------------------------------------------------------------------------

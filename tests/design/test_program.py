@@ -730,3 +730,51 @@ def test_valid_program_from_build_program_in_radians():
     inputs = [SegmentInput(r[0], float(r[1]), r[2] * DEG) for r in EJ11RO]
     p = build_program(inputs)
     assert screen(p) == screen(prog(EJ11RO))
+
+
+# ---------------------------------------------------------------------------
+# the polynomial segments' extremum candidates, their roots found all together
+def _random_coefficients(rng: np.random.Generator, count: int) -> list[np.ndarray]:
+    """Coefficient arrays of degree 0–8 over many scales, some with trailing zeros, some all zero."""
+    out = []
+    for _ in range(count):
+        n = int(rng.integers(1, 10))
+        c = rng.normal(size=n) * 10.0 ** rng.integers(-8, 8, size=n)
+        if rng.random() < 0.2:
+            c = np.concatenate([c, np.zeros(int(rng.integers(1, 3)))])
+        if rng.random() < 0.05:
+            c = np.zeros(n)
+        out.append(c)
+    return out
+
+
+def test_polynomial_roots_are_numpys_polyroots_bit_for_bit():
+    """One eigenvalue call per degree gives each polynomial the roots numpy's polyroots gives it alone."""
+    from camfab.design.extrema import polynomial_roots
+    coeffs = _random_coefficients(np.random.default_rng(20261127), 3000)
+    for c, got in zip(coeffs, polynomial_roots(coeffs), strict=True):
+        t = np.trim_zeros(c, "b")
+        ref = np.polynomial.polynomial.polyroots(t) if len(t) else np.array([])
+        assert got.shape == ref.shape
+        assert got.astype(complex).tobytes() == ref.astype(complex).tobytes(), (c, got, ref)
+
+
+def test_knot_extremes_together_are_each_segments_own():
+    """KnotTable's batched extremes (quintic and 7th-degree segments) equal numpy's Polynomial path segment by
+    segment, bit for bit."""
+    from types import SimpleNamespace
+
+    from camfab.design.knots import _extremes_all
+    rng = np.random.default_rng(7)
+    scale = np.array([5.0, 20.0, 80.0, 300.0])
+    segs = [SimpleNamespace(coeffs=hermite_coefficients(rng.normal(size=m) * scale[:m], rng.normal(size=m) * scale[:m],
+                                                        span), span=span)
+            for span, m in zip(rng.uniform(0.01, 2.0, size=300), rng.integers(3, 5, size=300), strict=True)]
+    for nu in range(4):
+        for seg, got in zip(segs, _extremes_all(segs, nu), strict=True):
+            p = np.polynomial.Polynomial(seg.coeffs).deriv(nu)
+            r = p.deriv().roots() if p.degree() > 0 else np.array([])
+            r = r.real[(np.abs(r.imag) <= 1e-12) & (r.real > 0.0) & (r.real < 1.0)]
+            u = np.concatenate([[0.0, 1.0], r])
+            vals = p(u) / seg.span**nu
+            assert got == (float(vals.min()), float(vals.max()), float(u[vals.argmin()]), float(u[vals.argmax()]))
