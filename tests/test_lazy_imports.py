@@ -132,3 +132,20 @@ def test_cli_runs_blas_on_one_thread_unless_the_user_says(tmp_path):
     assert user["env"] == {"OPENBLAS_NUM_THREADS": None, "OMP_NUM_THREADS": "2"}
     if (os.cpu_count() or 1) >= 2:  # OpenBLAS caps the count at the cores
         assert set(user["blas_threads"]) == {2}
+
+
+def test_check_of_a_toml_design_imports_no_workbook_module(tmp_path):
+    """The workbook side of camfab.formats (and the lift table's module it writes) loads on first use only; its
+    names are still importable from the package (docs/decisions.md, "Start-up: records' methods without compiled
+    source")."""
+    code, mods = _modules_after(tmp_path, "check", "valve_exhaust_ej1")
+    assert code in (0, 1), code
+    workbook = ("camfab.formats.xlsx_design", "camfab.formats.camdas_workbook", "camfab.formats.xlsx_blocks",
+                "camfab.design.tables")
+    assert not [m for m in workbook if m in mods]
+    probe = ("import camfab.formats as f, camfab.formats.xlsx_design as x; "
+             "print(f.design_to_xlsx is x.design_to_xlsx, f.load_design_xlsx is x.load_design_xlsx, "
+             "f.design_rows is x.design_rows, hasattr(f, 'no_such_name'))")
+    r = subprocess.run([sys.executable, "-c", probe], env=dict(os.environ, PYTHONPATH=str(ROOT)), capture_output=True,
+                       text=True, timeout=60, check=True)
+    assert r.stdout.split() == ["True", "True", "True", "False"]

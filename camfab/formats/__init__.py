@@ -25,7 +25,8 @@ Examples
 """
 from __future__ import annotations
 
-from .camdas_workbook import camdas_workbook
+from typing import TYPE_CHECKING, Any
+
 from .design_files import EXAMPLES_DIR, load_design, resolve_design_path
 from .knot_files import (
     load_motion_table,
@@ -36,11 +37,26 @@ from .knot_files import (
     resolve_knot_file,
 )
 from .toml_design import design_from_data, load_design_toml
-from .xlsx_design import design_rows, design_to_xlsx, load_design_xlsx
+
+if TYPE_CHECKING:
+    from .xlsx_design import design_rows, design_to_xlsx, load_design_xlsx
+
+#: the workbook side, imported on first use (a TOML design's ``check`` does not need it).  The CAM-DAS results
+#: workbook is ``camdas_workbook.camdas_workbook``: a lazy re-export of a function named like its module would be
+#: replaced by the module whenever another import loads it first.
+_LAZY = {"design_rows": "xlsx_design", "design_to_xlsx": "xlsx_design", "load_design_xlsx": "xlsx_design"}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = [
     "EXAMPLES_DIR",
-    "camdas_workbook",
     "design_from_data",
     "design_rows",
     "design_to_xlsx",

@@ -6,7 +6,6 @@ from pathlib import Path
 from ..design.spec import DesignSpec
 from ..errors import Problem, SpecError
 from .toml_design import load_design_toml
-from .xlsx_design import load_design_xlsx
 
 __all__ = ["EXAMPLES_DIR", "load_design", "resolve_design_path"]
 
@@ -26,8 +25,11 @@ def load_design(path: str | Path, *, allow_outside_files: bool = False) -> Desig
         On unreadable or invalid files; every problem found is listed.
     """
     p = Path(path)
-    load = load_design_xlsx if p.suffix.lower() == ".xlsx" else load_design_toml
-    return load(p, allow_outside_files=allow_outside_files)
+    if p.suffix.lower() == ".xlsx":
+        from .xlsx_design import load_design_xlsx  # the workbook reader only for a workbook
+
+        return load_design_xlsx(p, allow_outside_files=allow_outside_files)
+    return load_design_toml(p, allow_outside_files=allow_outside_files)
 
 
 def resolve_design_path(name: str | Path) -> Path:
