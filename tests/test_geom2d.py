@@ -6,6 +6,8 @@ import math
 import numpy as np
 import pytest
 from ezdxf.math import bulge_center, bulge_to_arc
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from camfab.errors import GeometryError
 from camfab.geom2d import (
@@ -110,3 +112,20 @@ def test_arc_chain_checks_its_shapes():
         ArcChain(np.zeros((2, 2)), np.zeros((2, 2)), np.zeros((1, 2)), np.zeros(2), np.zeros(2))
     with pytest.raises(GeometryError, match="3 bulges for 2 vertices"):
         ArcChain.from_bulges(np.zeros((2, 2)), np.zeros(3))
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.integers(0, 4), max_size=3), st.sampled_from([np.float64, np.complex128, np.int64, np.bool_]),
+       st.sampled_from([np.float64, np.complex128]), st.booleans())
+def test_pair_is_np_stack_last_axis(shape, da, db, strided):
+    """geom2d.pair gives np.stack([a, b], axis=-1)'s array: shape, dtype, bytes and memory order."""
+    from camfab.geom2d import pair
+    rng = np.random.default_rng(len(shape))
+    a = (rng.normal(size=(*shape, 2)) * 3)[..., 0].astype(da)
+    b = rng.normal(size=shape).astype(db)
+    if strided and shape:
+        a, b = a[::-1], b[::-1]
+    ref = np.stack([a, b], axis=-1)
+    got = pair(a, b)
+    assert got.shape == ref.shape and got.dtype == ref.dtype and got.strides == ref.strides
+    assert got.tobytes() == ref.tobytes()

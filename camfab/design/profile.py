@@ -60,7 +60,7 @@ from typing import Any, ClassVar, Protocol
 import numpy as np
 
 from ..errors import ApiError, InputError, SpecError
-from ..geom2d import cross, dot
+from ..geom2d import cross, dot, pair
 from ..numeric import extrema, integrate
 from ..records import dataclass
 from ..sets import sorted_unique
@@ -163,7 +163,7 @@ class Extremes:
 def xy(x, y) -> np.ndarray:
     """(n, 2) array of the broadcast coordinates x, y."""
     x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
-    return np.stack([x, y], axis=1)
+    return pair(x, y) if x.ndim == 1 else np.stack([x, y], axis=1)
 
 
 def pressure_angle(v: np.ndarray, n: np.ndarray, sigma: int) -> np.ndarray:

@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import GeometryError
-from ..geom2d import J, cross, dot
+from ..geom2d import J, cross, dot, pair
 from ..records import dataclass
 
 __all__ = ["RollerSection", "Envelope", "envelope"]
@@ -55,7 +55,7 @@ class RollerSection:
         r, c, h = self.r, self.c, self.h
         ct = np.cos(t)
         beta = np.arctan(c * ct) + np.arcsin((e + h * ct) / (r * np.sqrt(1.0 + (c * ct) ** 2)))
-        return np.stack([r * beta, (c * r * np.cos(beta) + h) * np.sin(t)], axis=-1)
+        return pair(r * beta, (c * r * np.cos(beta) + h) * np.sin(t))
 
     def d_t(self, t, e):
         """∂σ/∂t (complex step)."""
@@ -85,9 +85,9 @@ class RollerSection:
         g = q / k**3
         qt = -h * st / r
         zero = 0.0 * q
-        return (np.stack([r * qt / k, h * ct], axis=-1), np.stack([1.0 / k, zero], axis=-1),
-                np.stack([-h * ct / k + r * qt * qt * g, -h * st], axis=-1), np.stack([qt * g, zero], axis=-1),
-                np.stack([g / r, zero], axis=-1))
+        return (pair(r * qt / k, h * ct), pair(1.0 / k, zero),
+                pair(-h * ct / k + r * qt * qt * g, -h * st), pair(qt * g, zero),
+                pair(g / r, zero))
 
 
 @dataclass(frozen=True, slots=True)
@@ -144,4 +144,4 @@ def envelope(sec: RollerSection, sense: int, B, Bp, Bpp, e, e1, e2) -> Envelope:
     with np.errstate(divide="ignore", invalid="ignore"):
         k = sense * psi1 / lam
     point = B + sec.sigma(t, e)
-    return Envelope(t, point, d1, normal, tangent, k, np.stack([np.cos(t), np.sin(t)], axis=-1))
+    return Envelope(t, point, d1, normal, tangent, k, pair(np.cos(t), np.sin(t)))
