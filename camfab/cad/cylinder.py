@@ -28,7 +28,7 @@ import math
 
 import numpy as np
 
-from ..design.cylindrical import CylindricalGeometry, pitch_3d
+from ..design.cylindrical import CylindricalGeometry, pitch_3d, wrap
 from ..discretize import ParametricCurve, arcs
 from ..errors import ExportError
 from ..textsafe import dxf_string, plain
@@ -108,8 +108,7 @@ def _vec(cq, p):
 
 def _wrap(geometry: CylindricalGeometry, r: float, xz: np.ndarray) -> np.ndarray:
     """Developed points (x, z) of the cylinder r → cam-frame 3D points (polar angle 90° + σ·x/r)."""
-    a = 0.5 * math.pi + geometry.mechanism.sense * xz[:, 0] / r
-    return np.stack([r * np.cos(a), r * np.sin(a), xz[:, 1]], axis=1)
+    return wrap(geometry.mechanism.sense, r, xz[:, 0] / r, xz[:, 1])
 
 
 def _crossings(geometry: CylindricalGeometry, r: float, contact, grid: tuple, planes: tuple) -> np.ndarray:

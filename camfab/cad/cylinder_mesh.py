@@ -37,11 +37,12 @@ from typing import Any
 
 import numpy as np
 
+from ..design.cylindrical import wrap
 from ..errors import ExportError
 from ..textsafe import plain
 
 __all__ = ["MAX_TRIANGLES", "part_mesh", "part_triangles", "part_stl", "zipper", "track_angles",
-           "radial_rows", "circle_steps", "wrap", "flank_rows", "cylinder_depth"]
+           "radial_rows", "circle_steps", "flank_rows", "cylinder_depth"]
 
 #: the most triangles a grooved cylinder's mesh may have (50 bytes each in the STL: 100 MB)
 MAX_TRIANGLES = 2_000_000
@@ -62,13 +63,6 @@ _PROBES = np.array([[0.5, 0.5, 0, 0], [0.5, 0, 0, 0.5], [0, 0, 0.5, 0.5], [0.5, 
 def _refuse(what: str, tol: float) -> ExportError:
     return ExportError(f"the cylinder's STL: {what} with the {tol:g} mm tolerance. Give a larger "
                        "[manufacturing] tolerance_mm")
-
-
-def wrap(sense: int, r: float | np.ndarray, u: np.ndarray, z: float | np.ndarray) -> np.ndarray:
-    """Points ``(..., 3)`` of the cylinder(s) r at developed angles u (polar angle 90° + σ·u) and heights z."""
-    a = 0.5 * math.pi + sense * u
-    r = np.asarray(r, dtype=float)
-    return np.stack(np.broadcast_arrays(r * np.cos(a), r * np.sin(a), z), axis=-1)
 
 
 def flank_at(geometry: Any, flank: int, t: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

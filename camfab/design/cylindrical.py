@@ -57,7 +57,7 @@ from .roller_section import RollerSection, envelope
 
 __all__ = ["RollerShape", "CylinderSpec", "cylinder_section", "DevelopedContact", "CylindricalGeometry",
            "CylindricalTranslating", "CylindricalOscillating", "CYLINDER_KEYS", "slip_ratio", "pitch_3d",
-           "FAMILIES", "cylinder_report", "radius_summary", "Feature"]
+           "FAMILIES", "cylinder_report", "radius_summary", "Feature", "wrap"]
 
 # ---------------------------------------------------------------------------
 def _arm(mech: Any, S) -> tuple[np.ndarray, ...]:
@@ -173,8 +173,15 @@ def pitch_3d(geometry: CylindricalGeometry, phi, r: float | None = None) -> np.n
     (cam axis Z, (n, 3) mm) at cam angles ``phi``: developed (x, z) wrapped to the polar angle 90° + σ·x/r."""
     r = geometry.cylinder.radius_mm if r is None else r
     C, _ = geometry.at_radius(r).pitch(phi)
-    a = 0.5 * math.pi + geometry.mechanism.sense * C[:, 0] / r
-    return np.stack([r * np.cos(a), r * np.sin(a), C[:, 1]], axis=1)
+    return wrap(geometry.mechanism.sense, r, C[:, 0] / r, C[:, 1])
+
+
+def wrap(sense: int, r: float | np.ndarray, u: np.ndarray, z: float | np.ndarray) -> np.ndarray:
+    """Points ``(..., 3)`` in the cam frame of the cylinder(s) r at developed angles u (x/r; polar angle
+    90° + σ·u, σ the cam's ``sense``) and heights z, broadcast together."""
+    a = 0.5 * math.pi + sense * u
+    r = np.asarray(r, dtype=float)
+    return np.stack(np.broadcast_arrays(r * np.cos(a), r * np.sin(a), z), axis=-1)
 
 
 def slip_ratio(geometry: CylindricalGeometry, n: int = 4001) -> float:

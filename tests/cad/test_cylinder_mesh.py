@@ -12,6 +12,7 @@ import pytest
 
 from camfab.cad import cylinder_mesh as cm
 from camfab.cad.stl import FACET, is_closed_surface
+from camfab.design.cylindrical import wrap
 from camfab.errors import ExportError, InputError
 from camfab.pipeline import load
 
@@ -159,7 +160,7 @@ def test_exact_surfaces_lie_within_tol_of_the_mesh(made, geometry):
     s = rng.uniform(0, 1, (401, 1))
     pts.append((1 - s) * sec[:, 0, 0] + s * sec[:, 1, 0])
     u, z = rng.uniform(0, 2 * math.pi, 4000), rng.uniform(0, cyl.length_mm, 4000)
-    outer = cm.wrap(sense, cyl.outer_radius_mm, u, z)
+    outer = wrap(sense, cyl.outer_radius_mm, u, z)
     w = geometry.mechanism.half_width(cyl.radius_mm)
     pts.append(outer[_roller_distance(geometry, outer) > w])
     points = np.concatenate(pts)
@@ -204,7 +205,7 @@ def test_flank_at_array_radius_is_the_per_radius_evaluation(geometry):
     for k in range(50):
         e = geometry.at_radius(float(r[k]), -1).evaluate(t[k:k + 1])
         assert u[k] == e.point[0, 0] / r[k]
-        np.testing.assert_array_equal(p[k], cm.wrap(geometry.mechanism.sense, float(r[k]), u[k:k + 1],
+        np.testing.assert_array_equal(p[k], wrap(geometry.mechanism.sense, float(r[k]), u[k:k + 1],
                                                     e.point[:, 1])[0])
 
 
