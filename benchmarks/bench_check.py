@@ -201,6 +201,55 @@ def _alternating(repeat: int, root: str | None, against: str, flags: tuple[str, 
     return mine, other
 
 
+def _instructions(root: str | None, name: str, cache: str) -> int:
+    """Instructions (valgrind's callgrind, ``Collected``) of one ``python -m camfab check NAME`` from ``root``:
+    the same count on a busy machine as on an idle one."""
+    import os
+    import re
+    import subprocess
+
+    env = dict(os.environ, PYTHONPATH=root or str(HERE.parent), PYTHONPYCACHEPREFIX=cache)
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    cmd = [sys.executable, "-m", "camfab", "check", name]
+    subprocess.run(cmd, env=env, cwd=cache, capture_output=True, check=False)  # bytecode cached first
+    r = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null", *cmd], env=env, cwd=cache,
+                       capture_output=True, text=True, check=False)
+    m = re.search(r"Collected : (\d+)", r.stderr)
+    if m is None:
+        raise SystemExit(f"valgrind gave no count for {name}: {r.stderr[-500:]}")
+    return int(m.group(1))
+
+
+def instructions(root: str | None, against: str | None) -> None:
+    """Each example's check counted in instructions (``--process --instructions``), two at a time."""
+    import shutil
+    import tempfile
+    from concurrent.futures import ThreadPoolExecutor
+
+    if shutil.which("valgrind") is None:
+        raise SystemExit("--instructions needs valgrind (apt-get install valgrind)")
+    trees = [root] + ([against] if against is not None else [])
+    caches = [tempfile.mkdtemp(prefix="camfab-pyc-") for _ in trees]
+    examples = [name for name, _ in _api()[0]]
+    try:
+        with ThreadPoolExecutor(2) as pool:
+            counts = {(k, name): pool.submit(_instructions, tree, name, caches[k])
+                      for name in examples for k, tree in enumerate(trees)}
+            got = {key: f.result() for key, f in counts.items()}
+    finally:
+        for c in caches:
+            shutil.rmtree(c, ignore_errors=True)
+    print("python -m camfab check EXAMPLE, instructions (valgrind callgrind)"
+          + (f", this tree against {against}" if against is not None else ""))
+    for name in examples:
+        mine = got[(0, name)]
+        if against is None:
+            print(f"  {name:28}{mine / 1e6:9.1f} M")
+        else:
+            old = got[(1, name)]
+            print(f"  {name:28}{old / 1e6:9.1f} M -> {mine / 1e6:7.1f} M  ({(mine - old) / old:+.1%})")
+
+
 def process(repeat: int, root: str | None, export: bool = False, against: str | None = None,
             only: str | None = None) -> None:
     print("child processes without PYTHONDONTWRITEBYTECODE (bytecode cached as installed), "
@@ -242,7 +291,12 @@ def main() -> None:
                     help="with --process: also time the checkout DIR, alternating with this tree")
     ap.add_argument("--only", choices=("dxf", "stl"), default=None,
                     help="with --process --export: time only `export --dxf` (or only `--stl`)")
+    ap.add_argument("--instructions", action="store_true",
+                    help="with --process: count each check's instructions with valgrind instead of timing it")
     a = ap.parse_args()
+    if a.process and a.instructions:
+        instructions(a.root, a.against)
+        return
     if a.process:
         process(a.repeat, a.root, a.export, a.against, a.only)
         return
