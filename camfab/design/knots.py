@@ -79,6 +79,7 @@ from ..results import Finding, IssueCode, Severity
 from ..tolerances import ANGLE_SUM_TOL_DEG
 from ..units import DEG, rpm_to_rad_s
 from .extrema import polynomial_roots
+from .laws import derivative_rows, horner
 from .program import MotionProgram, Segment, hermite_coefficients
 
 __all__ = [
@@ -305,21 +306,22 @@ def _extremes(seg: Segment, nu: int) -> tuple[float, float, float, float]:
 
 
 def _extremes_all(segs: Sequence[Segment], nu: int) -> list[tuple[float, float, float, float]]:
-    """:func:`_extremes` of each segment, the roots of all found together (:func:`extrema.polynomial_roots`:
-    bit for bit numpy's ``Polynomial(coeffs).deriv(nu).deriv().roots()``, whose domain map is the identity)."""
-    poly = np.polynomial.polynomial
-    ders = []
+    """:func:`_extremes` of each segment, the roots of all found together: bit for bit numpy's
+    ``Polynomial(coeffs).deriv(nu)`` path (``derivative_rows`` is polyder's ``j·cⱼ``, ``horner`` polyval's rule,
+    :func:`extrema.polynomial_roots` polyroots; the domain map is the identity), without importing
+    ``numpy.polynomial`` (~5 ms of a check)."""
+    rows = []
     for seg in segs:
         assert seg.coeffs is not None  # a knot table's segments are Hermite polynomials (KnotTable.segments)
-        ders.append(poly.polyder(seg.coeffs, nu))
-    moving = [i for i, d in enumerate(ders) if len(d) > 1]
-    roots = dict(zip(moving, polynomial_roots([poly.polyder(ders[i]) for i in moving]), strict=True))
+        rows.append(derivative_rows(seg.coeffs, nu + 2)[nu:])
+    moving = [i for i, (d, _) in enumerate(rows) if len(d) > 1]
+    roots = dict(zip(moving, polynomial_roots([np.asarray(rows[i][1]) for i in moving]), strict=True))
     out = []
-    for i, (seg, d) in enumerate(zip(segs, ders, strict=True)):
+    for i, (seg, (d, _)) in enumerate(zip(segs, rows, strict=True)):
         r = roots.get(i, np.array([]))
         r = r.real[(np.abs(r.imag) <= 1e-12) & (r.real > 0.0) & (r.real < 1.0)]
         u = np.concatenate([[0.0, 1.0], r])
-        vals = poly.polyval(u, d) / seg.span**nu
+        vals = horner(np.asarray(d), u) / seg.span**nu
         out.append((float(vals.min()), float(vals.max()), float(u[vals.argmin()]), float(u[vals.argmax()])))
     return out
 
