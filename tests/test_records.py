@@ -158,3 +158,21 @@ def test_classes_that_want_more_go_to_the_standard_library():
     for cls in (Plain, Ordered, Own):
         assert cls.__eq__.__module__ != "camfab.records"
     assert repr(Own(1)) == "own" and Ordered(1) < Ordered(2) and Plain(1) == Plain(1)
+
+
+def test_camfab_modules_take_dataclass_from_records():
+    """A new module's records get the same start-up saving: no camfab module but records uses the standard
+    library's decorator directly."""
+    from pathlib import Path
+
+    root = Path(camfab.__file__).parent
+    direct = []
+    for path in sorted(root.rglob("*.py")):
+        if path.name == "records.py":
+            continue
+        for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+            names = line.split("from dataclasses import", 1)[1] if line.lstrip().startswith("from dataclasses import") \
+                else ""
+            if "dataclass" in [x.strip() for x in names.split(",")] or "@dataclasses.dataclass" in line:
+                direct.append(f"{path.relative_to(root.parent)}:{n}")
+    assert not direct, f"use `from camfab.records import dataclass` (docs/decisions.md): {direct}"
