@@ -137,6 +137,17 @@ PROCESS_TARGET_S = 0.35
 EXPORT_TARGET_S = 1.0
 
 
+def _child_env(root: str | None, cache: str) -> dict[str, str]:
+    """The environment of a timed child: camfab from ``root`` (default this checkout), bytecode cached in
+    ``cache`` as in an installed package (a checkout run with PYTHONDONTWRITEBYTECODE would compile every module
+    on every start)."""
+    import os
+
+    env = dict(os.environ, PYTHONPATH=root or str(HERE.parent), PYTHONPYCACHEPREFIX=cache)
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    return env
+
+
 def process_timings(repeat: int, root: str | None, export: tuple[str, ...] = (), cache: str | None = None,
                     warm: bool = True) -> dict[str, tuple[float, float]]:
     """{example: (best CPU s, best wall s)} of ``python -m camfab check EXAMPLE`` as a whole process, or of
@@ -153,8 +164,7 @@ def process_timings(repeat: int, root: str | None, export: tuple[str, ...] = (),
     # `cache`, not in a checkout, whose ./camfab `python -m` would import first.
     own = cache is None
     cache = cache or tempfile.mkdtemp(prefix="camfab-pyc-")
-    env = dict(os.environ, PYTHONPATH=root or str(HERE.parent), PYTHONPYCACHEPREFIX=cache)
-    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    env = _child_env(root, cache)
     examples = [name for name, _ in _api()[0]]
     out = {}
     for name in examples:
@@ -204,12 +214,10 @@ def _alternating(repeat: int, root: str | None, against: str, flags: tuple[str, 
 def _instructions(root: str | None, name: str, cache: str) -> int:
     """Instructions (valgrind's callgrind, ``Collected``) of one ``python -m camfab check NAME`` from ``root``:
     the same count on a busy machine as on an idle one."""
-    import os
     import re
     import subprocess
 
-    env = dict(os.environ, PYTHONPATH=root or str(HERE.parent), PYTHONPYCACHEPREFIX=cache)
-    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    env = _child_env(root, cache)
     cmd = [sys.executable, "-m", "camfab", "check", name]
     subprocess.run(cmd, env=env, cwd=cache, capture_output=True, check=False)  # bytecode cached first
     r = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null", *cmd], env=env, cwd=cache,

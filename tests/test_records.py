@@ -113,10 +113,7 @@ class _Nothing:
 def test_field_options_slots_inheritance_and_no_fields(cls):
     """repr=False, compare=False, hash=False, eq=False, slots and a subclass, against the standard library."""
     eq = cls is not _Identity
-    twin = dataclasses.make_dataclass(
-        cls.__name__, [(f.name, f.type, dataclasses.field(repr=f.repr, compare=f.compare, hash=f.hash))
-                       for f in dataclasses.fields(cls)], frozen=True, eq=eq)
-    twin.__qualname__ = cls.__qualname__
+    twin = _twin(cls)
     n = len(dataclasses.fields(cls))
     for values in itertools.islice(itertools.product(POOL[:4], repeat=n), 60):
         a, ta = _instance(cls, values), _instance(twin, values)
