@@ -20,6 +20,8 @@ that both see the same load, and prints both.  ``--process --export`` times ``py
 IGES and the assembly are outside the goal: they import cadquery/OCP, ~3 s on their own; README "Benchmarks").
 The child processes run without ``PYTHONDONTWRITEBYTECODE`` (bytecode cached in a temporary
 ``PYTHONPYCACHEPREFIX``, as an installed package has it) and one untimed warm-up run per command fills that cache.
+Each timing ends with the floor of this Python: ``-c pass`` (the interpreter and ``site``, whose ``.pth`` files run
+in every process) and ``-c "import numpy"``, and what is left of the slowest example above numpy's import.
 
 Run:  python3 benchmarks/bench_check.py [--repeat 7] [--baseline | --steep | --process [--export [--only dxf|stl]]
       [--root DIR] [--against DIR]]
@@ -258,6 +260,28 @@ def instructions(root: str | None, against: str | None) -> None:
             print(f"  {name:28}{old / 1e6:9.1f} M -> {mine / 1e6:7.1f} M  ({(mine - old) / old:+.1%})")
 
 
+def _floor(repeat: int) -> tuple[float, float]:
+    """Best CPU seconds of this Python doing nothing (``-c pass``: the interpreter and ``site``, whose ``.pth``
+    files run for every process) and of ``-c "import numpy"``: the part of a check that is not camfab's."""
+    import resource
+    import subprocess
+
+    best = [math.inf, math.inf]
+    for _ in range(repeat + 1):
+        for i, code in enumerate(("pass", "import numpy")):
+            before = resource.getrusage(resource.RUSAGE_CHILDREN)
+            subprocess.run([sys.executable, "-c", code], check=True)
+            after = resource.getrusage(resource.RUSAGE_CHILDREN)
+            best[i] = min(best[i], after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
+    return best[0], best[1]
+
+
+def _print_floor(repeat: int, slowest: float) -> None:
+    bare, numpy_ = _floor(repeat)
+    print(f"floor (this Python, best of {repeat}): `-c pass` {bare:.3f} s, `-c 'import numpy'` {numpy_:.3f} s CPU; "
+          f"camfab's own part of the slowest: {slowest - numpy_:.3f} s")
+
+
 def process(repeat: int, root: str | None, export: bool = False, against: str | None = None,
             only: str | None = None) -> None:
     print("child processes without PYTHONDONTWRITEBYTECODE (bytecode cached as installed), "
@@ -275,6 +299,7 @@ def process(repeat: int, root: str | None, export: bool = False, against: str | 
             worst = max(c for c, _ in t.values())
             print(f"slowest {max(c for c, _ in old.values()):.3f} -> {worst:.3f} s CPU: "
                   f"{'MET' if worst <= goal else 'MISSED'}")
+            _print_floor(repeat, worst)
             continue
         t = process_timings(repeat, root, flags)
         what = f"export EXAMPLE {' '.join(flags)}" if export else "check EXAMPLE"
@@ -283,6 +308,7 @@ def process(repeat: int, root: str | None, export: bool = False, against: str | 
             print(f"  {name:28}{cpu:7.3f} s CPU {wall:7.3f} s wall" + ("" if cpu <= goal else "  MISSED"))
         worst = max(c for c, _ in t.values())
         print(f"slowest {worst:.3f} s CPU: {'MET' if worst <= goal else 'MISSED'}")
+        _print_floor(repeat, worst)
 
 
 def main() -> None:
