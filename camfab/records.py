@@ -113,7 +113,7 @@ def _frozen_setters(cls: type, fields: list[dataclasses.Field[Any]], globals: di
 
 
 #: the template ``__init__``'s parameter count grows by doubling from this (a record with more fields gets a larger one)
-_TEMPLATE_MIN = 16
+_TEMPLATE_MIN = 32
 _templates: dict[int, types.CodeType] = {}
 
 
