@@ -262,15 +262,18 @@ def instructions(root: str | None, against: str | None) -> None:
 
 def _floor(repeat: int) -> tuple[float, float]:
     """Best CPU seconds of this Python doing nothing (``-c pass``: the interpreter and ``site``, whose ``.pth``
-    files run for every process) and of ``-c "import numpy"``: the part of a check that is not camfab's."""
+    files run for every process) and of ``-c "import numpy"``: the part of a check that is not camfab's.  BLAS on
+    one thread, as ``python -m camfab`` sets it by default (OpenBLAS's start-up threads cost ~0.1 s of CPU)."""
+    import os
     import resource
     import subprocess
 
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
     best = [math.inf, math.inf]
     for _ in range(repeat + 1):
         for i, code in enumerate(("pass", "import numpy")):
             before = resource.getrusage(resource.RUSAGE_CHILDREN)
-            subprocess.run([sys.executable, "-c", code], check=True)
+            subprocess.run([sys.executable, "-c", code], check=True, env=env)
             after = resource.getrusage(resource.RUSAGE_CHILDREN)
             best[i] = min(best[i], after.ru_utime - before.ru_utime + after.ru_stime - before.ru_stime)
     return best[0], best[1]
