@@ -1,6 +1,7 @@
-"""``camfab.records.dataclass``: the representation, equality and hash it gives a frozen record are those the
-standard library's ``dataclass`` generates, for every record class in camfab (docs/decisions.md, "Records'
-methods without compiled source")."""
+"""``camfab.records.dataclass``: the representation, equality, hash, frozen setters and ``__init__`` it gives a
+frozen record behave as those the standard library's ``dataclass`` generates, for every record class in camfab
+(docs/decisions.md, "Start-up: records' methods without compiled source" and "Start-up: the frozen records'
+setters and ``__init__`` without compiled source")."""
 from __future__ import annotations
 
 import dataclasses
