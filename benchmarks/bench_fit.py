@@ -18,7 +18,11 @@ both fits' arc counts and deviations (and whether the arcs are the same bit for 
 lists per fit the arcs, the measured deviation and the CPU time; with ``--root`` both trees' fits side by side
 (arcs before/after, whether they are the same bit for bit) and the totals.
 
+``--stages`` times the issue cam's fit by stage (CPU around each: the Hermite stand-in, cutting the spans, the
+spans' arc-count search, laying the arcs, the certification; the rest), what a faster fitter has to cut.
+
 Run:  PYTHONPATH=. python3 benchmarks/bench_fit.py [--repeat 20] [--root /work/main --rounds 3] [--examples]
+      [--stages]
 """
 from __future__ import annotations
 
@@ -192,6 +196,44 @@ def compare_examples(root: Path | None) -> None:
           f"{all(r['dev'] <= r['tol'] for r in new)}")
 
 
+def stages(repeat: int) -> None:
+    """CPU per stage of the issue cam's 1 µm fit, averaged over ``repeat`` fits after a warm-up (timers wrapped
+    around the stages' functions where the fit calls them)."""
+    from collections import Counter
+
+    import camfab.discretize.arcspline as spline
+    import camfab.discretize.fit as fit
+
+    spent: Counter = Counter()
+
+    def timed(module, name: str, label: str) -> None:
+        inner = getattr(module, name)
+
+        def run(*a, **k):
+            t = time.process_time()
+            try:
+                return inner(*a, **k)
+            finally:
+                spent[label] += time.process_time() - t
+        setattr(module, name, run)
+
+    for module, name, label in ((fit, "fit_surrogate", "Hermite stand-in"), (spline, "cut_spans", "cutting spans"),
+                                (spline, "_fit_spans", "arc-count search"), (spline, "_span_chains", "laying arcs"),
+                                (spline, "certified_deviation", "certification")):
+        timed(module, name, label)
+    curve = issue_cam_curve()
+    arcs(curve, tol=1e-3)
+    spent.clear()
+    t = time.process_time()
+    for _ in range(repeat):
+        arcs(curve, tol=1e-3)
+    total = (time.process_time() - t) / repeat * 1e3
+    print(f"issue-15 roller cam, 1 µm: {total:.1f} ms CPU per fit (mean of {repeat})")
+    for label, cpu in spent.items():
+        print(f"  {label:18}{cpu / repeat * 1e3:7.1f} ms")
+    print(f"  {'the rest':18}{total - sum(spent.values()) / repeat * 1e3:7.1f} ms")
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=20, help="fits timed, the best kept (constant width: a quarter, "
@@ -202,11 +244,15 @@ def main(argv=None) -> None:
                     "width, 2 1000 segments)")
     ap.add_argument("--examples", action="store_true", help="every example profile at 1e-3 and 1e-4 mm: arcs, "
                     "deviation, CPU per fit (with --root: both trees)")
+    ap.add_argument("--stages", action="store_true", help="the issue cam's fit timed by stage")
     ap.add_argument("--case", type=int, help=argparse.SUPPRESS)
     ap.add_argument("--examples-json", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.examples_json:
         print(json.dumps(example_fits()))
+        return
+    if args.stages:
+        stages(args.repeat)
         return
     if args.examples:
         compare_examples(args.root.resolve() if args.root is not None else None)

@@ -120,7 +120,11 @@ class _Nothing:
     pass
 
 
-@pytest.mark.parametrize("cls", [_Options, _Identity, _Slotted, _Derived, _Nothing])
+#: the fixtures above (field options, eq=False, slots, a subclass, no fields)
+FIXTURES = [_Options, _Identity, _Slotted, _Derived, _Nothing]
+
+
+@pytest.mark.parametrize("cls", FIXTURES)
 def test_field_options_slots_inheritance_and_no_fields(cls):
     """repr=False, compare=False, hash=False, eq=False, slots and a subclass, against the standard library."""
     eq = cls is not _Identity
@@ -198,7 +202,7 @@ def _outcome(obj: object, name: str, delete: bool) -> tuple[str, str] | None:
     return None
 
 
-@pytest.mark.parametrize("cls", RECORDS + [_Options, _Identity, _Slotted, _Derived, _Nothing],
+@pytest.mark.parametrize("cls", RECORDS + FIXTURES,
                          ids=lambda c: f"{c.__module__}.{c.__qualname__}")
 def test_frozen_setters_equal_the_standard_librarys(cls):
     """Assigning or deleting a field or another name, on the class and on a plain subclass: the same outcome and
@@ -291,7 +295,7 @@ def _same_init(cls: type, twin: type) -> None:
         assert _construct(cls, *args, **kwargs) == _construct(twin, *args, **kwargs), (args, kwargs)
 
 
-@pytest.mark.parametrize("cls", RECORDS + [_Options, _Identity, _Slotted, _Derived, _Nothing],
+@pytest.mark.parametrize("cls", RECORDS + FIXTURES,
                          ids=lambda c: f"{c.__module__}.{c.__qualname__}")
 def test_init_equals_the_standard_librarys(cls):
     if cls.__init__.__code__.co_filename != "<string>":
@@ -357,6 +361,8 @@ def test_init_special_cases_go_to_the_standard_library():
 
     for cls in (Factory, Post, Init, Keywords, Self, Prefixed):
         assert not _closure_made(cls)
+    for cls in (Factory, Post, Keywords, Self, Prefixed):  # (an InitVar is no field: a twin cannot have it)
+        _same_init(cls, _twin(cls))
     assert Factory(1).b == [] and Factory(1).b is not Factory(1).b and Post(2).a == 4 and Init(2, 3).a == 6
     assert Keywords(a=1).a == 1 and Self(5).self == 5 and Prefixed(3).__records_0__ == 3
     with pytest.raises(TypeError, match="non-default argument 'b' follows default argument"):

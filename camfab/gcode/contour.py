@@ -220,8 +220,7 @@ def as_contour(entities) -> tuple[Segment, ...]:
 def _signed_area(segs: Sequence[Segment]) -> float:
     """The exact signed area of a closed contour (> 0 counter-clockwise), by Green's theorem: every entity's chord
     ``(a × b)/2``, and an arc's circular segment between chord and arc ``r²(θ - sin θ)/2`` (``θ`` its signed
-    sweep; a full circle's ``πr²``).  (It used to be the area of a polygon through 64 points per turn of every
-    arc: the same sign for any contour, at a numpy polyline per arc.)"""
+    sweep; a full circle's ``πr²``; docs/decisions.md, "Contours: exact signed area")."""
     total = 0.0
     for s in segs:
         (ax, ay), (bx, by) = s.start, s.end
