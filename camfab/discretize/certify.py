@@ -5,20 +5,31 @@
 points) is fixed whatever the curve.  The fit's own acceptance test only needs to know that the true maximum
 is within ``tol``, and a bound on the distance between samples tells how many points guarantee that.
 
-Derivation.  Let ``g(s)`` be the distance from the curve point at arc length ``s`` to the chain.  Near the
-chain (within ``tol``, far below every radius) the nearest point of a G1 chain lies inside an entity or on a
-joint where both neighbours' formulas agree, so ``g = min_j g_j`` with ``g_j`` the distance to entity ``j``'s
-line or full circle.  For a circle of centre ``c`` and radius ``r``, with ``ρ = |P - c|`` and ``u = (P - c)/ρ``:
-``g_j'' = ±(κ·(n·u) + (1 - (t·u)²)/ρ)``, so ``g_j'' ≤ K = max|κ_curve| + max_j 1/(r_j - tol)`` (a line: ``K =
-max|κ_curve|``).  Every ``g_j`` is then K-semiconcave, and so is their minimum, hence on a sample interval
-of arc length ``h``::
+Derivation.  Let ``f(s)`` be the *signed* distance from the curve point at arc length ``s`` to the chain, so
+that ``g = |f|`` is the distance.  A G1 chain of lines and arcs is a C¹ curve whose curvature is piecewise
+constant, at most ``1/r_min``; closer to it than ``r_min`` (and nearer an inner point of it than an open chain's
+ends, which the fit puts on the curve) its signed distance function ``d`` is C¹ with a gradient of length 1 and a
+Hessian of norm at most ``1/(r_min - |d|)`` (the level line at distance ``d`` from an arc of curvature ``k``
+is a concentric arc of curvature ``k/(1 - k·d)``; from a line, a line).  So ``f(s) = d(P(s))`` has
+``f'' = Hess d[P′, P′] + ∇d·P″`` and ``|f''| ≤ K = max|κ_curve| + 1/(r_min - tol)`` (a chain of lines: ``K =
+max|κ_curve|``) wherever ``|f| ≤ tol``; ``d`` is 1-Lipschitz, so between samples ``h`` apart of at most
+``tol`` it stays within ``tol + h/2``, and the bound there is ``1/(r_min - tol - h/2)``, within the stand-in's
+safety factor below of the one used (``h`` is a fraction of a millimetre, ``r_min`` tens of them).  The bound
+is two-sided: ``f`` minus its linear interpolation vanishes at both samples and has a second derivative in
+``[-K, K]``, so it lies within ``K·(s - a)(b - s)/2`` of zero, hence on a sample interval of arc length ``h``::
 
-    g(s) ≤ (linear interpolation of the two samples) + K·(s - a)(b - s)/2 ≤ max(samples) + K·h²/8.
+    g(s) ≤ |linear interpolation of the two samples of f| + K·(s - a)(b - s)/2 ≤ max(samples) + K·h²/8.
+
+(A one-sided bound ``f'' ≤ K`` — semiconcavity — would bound ``f`` from below only.)  A sample's distance may be an
+upper bound rather than the exact one (the fit's measurement takes it to a window of entities): the bound then
+holds for the distance to the union of those entities, itself a G1 chain, and the true distance is smaller.
 
 The sampled maximum ``D`` the measurement reports is at least the largest sample (its refinement only adds),
 so the true curve-to-chain maximum is at most ``D + K·h²/8`` with ``h ≤ max|P′|·period / samples`` (at least
 ``samples·(hi - lo)/period`` points fall on every smooth piece).  The other direction (chain to curve) does not
-depend on ``samples``: each of its distances is taken to an exact curve point (an upper bound).  Hence
+depend on ``samples``: each of its distances is taken to an exact curve point (an upper bound), and its
+maximum is the first one's to second order (within the tube the chain is a graph ``P + f·n`` over the curve, and
+a curve point's distance to it is ``|f|`` less a term in ``f′²``).  Hence
 :func:`certified_deviation` measures with the fewest samples whose gap ``K·h²/8`` is
 :data:`CERTIFY_SHARE` of ``tol``, and accepts that measurement when ``D + gap ≤ tol`` (less the writers'
 room); otherwise it measures as before (the default sample count), so a fit is never accepted on weaker
@@ -40,7 +51,7 @@ from .results import Deviation
 from .surrogate import HermiteSurrogate
 from .tolerance import WRITE_ROOM_MM, within
 
-__all__ = ["CERTIFY_SHARE", "DEFAULT_SAMPLES", "semiconcavity", "sample_gap", "samples_for", "certified_deviation"]
+__all__ = ["CERTIFY_SHARE", "DEFAULT_SAMPLES", "curvature_bound", "sample_gap", "samples_for", "certified_deviation"]
 
 #: the share of ``tol`` the gap between curve samples may cost (the fit aims at 97 % of tol less the stand-in's
 #: error; the measured deviation of the examples lands at 80–97 %)
@@ -70,8 +81,8 @@ def _curve_bounds(sur: HermiteSurrogate) -> tuple[float, float]:
     return _SAFETY * float(k_max), _SAFETY * float(v_max)
 
 
-def semiconcavity(sur: HermiteSurrogate, chain: Chain, tol: float) -> tuple[float, float]:
-    """``(K, max |P′|)``: the bound of ``g''`` (module notes) and the curve's largest speed; ``K`` is inf when
+def curvature_bound(sur: HermiteSurrogate, chain: Chain, tol: float) -> tuple[float, float]:
+    """``(K, max |P′|)``: the bound of ``|f''|`` (module notes) and the curve's largest speed; ``K`` is inf when
     an arc's radius is not above ``tol``."""
     kc, vmax = _curve_bounds(sur)
     r = 1.0 / np.abs(chain.curvature[chain.curvature != 0.0])
@@ -101,12 +112,12 @@ def certified_deviation(chain: Chain, curve: ParametricCurve, sur: HermiteSurrog
     ``tol`` (module notes) when they are fewer than the default and the certificate holds, else as measured
     with the default samples.  ``expected`` (the fit's model error, mm) narrows the gap allowed to half the
     room it leaves when that is less than :data:`CERTIFY_SHARE` of ``tol``."""
-    K, vmax = semiconcavity(sur, chain, tol)
+    K, vmax = curvature_bound(sur, chain, tol)
     gap = min(CERTIFY_SHARE * tol, 0.5 * (tol - WRITE_ROOM_MM - expected))
     n = samples_for(K, vmax, curve.period, gap)
     if n is not None and n < DEFAULT_SAMPLES:
         g = sample_gap(K, vmax, curve.period, n)
-        dev = measure_fit(chain, curve, sur, n, g)
+        dev = measure_fit(chain, curve, sur, n, g, bound=(K, vmax))
         if within(dev.max + g, tol):
             return dev
     return measure_deviation(chain, curve)

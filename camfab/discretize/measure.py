@@ -166,18 +166,31 @@ class _CurveProjector:
         return np.where(better, new, dist), np.where(better, tt, t)
 
 
-def _zoom_max(f: Callable[[np.ndarray], np.ndarray], lo: np.ndarray, hi: np.ndarray,
-              levels: int = 2, m: int = 33) -> np.ndarray:
-    """Maximum of ``f`` on each ``[lo, hi]`` by nested sample grids (one batched call of ``f`` per level)."""
+def _zoom_max(f: Callable[[np.ndarray, np.ndarray], np.ndarray], lo: np.ndarray, hi: np.ndarray,
+              levels: int = 2, m: int = 33, per_step: float | None = None) -> np.ndarray:
+    """Maximum of ``f`` on each ``[lo, hi]`` by nested sample grids (one batched call of ``f`` per level);
+    ``f(points, rows)`` takes the brackets (rows of ``lo``) its points belong to.
+
+    ``per_step``: when given, the maximum of ``f`` between two samples ``Δ`` apart exceeds the larger of them by
+    at most ``per_step·Δ²`` (the certificate's bound, :mod:`camfab.discretize.certify`), and a bracket whose
+    samples plus that bound stay below the largest value found so far is not zoomed into further.  The overall
+    maximum and the bracket holding it are then the same bit for bit: such a bracket holds no value reaching
+    the largest, so neither does any sample a further level would take (a 1e-9 relative margin covers the
+    rounding of the bound and of the distances); the entry of a bracket left out is its last level's maximum."""
     best = np.full(lo.size, -np.inf)
     grid = np.linspace(0.0, 1.0, m)
     rows = np.arange(lo.size)
-    for _ in range(levels):
+    for level in range(levels):
         u = lo[:, None] + (hi - lo)[:, None] * grid
-        v = f(u)
+        v = f(u, rows)
         j = v.argmax(axis=1)
-        best = np.maximum(best, v[rows, j])
-        lo, hi = u[rows, np.maximum(j - 1, 0)], u[rows, np.minimum(j + 1, m - 1)]
+        here = np.arange(rows.size)
+        best[rows] = np.maximum(best[rows], v[here, j])
+        lo, hi = u[here, np.maximum(j - 1, 0)], u[here, np.minimum(j + 1, m - 1)]
+        if per_step is not None and level + 1 < levels:
+            step = u[:, 1] - u[:, 0]
+            keep = (best[rows] + per_step * step * step) * (1.0 + 1e-9) >= best.max()
+            rows, lo, hi = rows[keep], lo[keep], hi[keep]
     return best
 
 
@@ -198,7 +211,7 @@ def _curve_to_chain(chain: Chain, curve: ParametricCurve, sur: HermiteSurrogate,
         hi_t = ts[top + 1]
     else:
         lo_t, hi_t = ts[np.maximum(top - 1, 0)], ts[np.minimum(top + 1, n_t)]
-    best_a = _zoom_max(g_a, lo_t, hi_t) if top.size else np.zeros(0)
+    best_a = _zoom_max(lambda t, _: g_a(t), lo_t, hi_t) if top.size else np.zeros(0)
     i_a = int(np.argmax(d_a))
     worst_a, at_a = float(d_a[i_a]), float(ts[i_a])
     if best_a.size and best_a.max() > worst_a:
@@ -244,7 +257,7 @@ def _refine_along_entities(chain: Chain, u: np.ndarray, d_b: np.ndarray, t_b: np
         u_lo = u[ent, np.maximum(ui - 1, 0)]
         u_hi = u[ent, np.minimum(ui + 1, per_entity - 1)]
 
-        def g_b(uu):
+        def g_b(uu, _):
             pts = entity_point(chain.start[ent, None], chain.tangent[ent, None], chain.curvature[ent, None], uu)
             return dist(pts.reshape(-1, 2)).reshape(uu.shape)
 
@@ -332,13 +345,13 @@ def _near_entities(chain: Chain, q: np.ndarray, ent: np.ndarray, reach: int = 1)
 
 
 def _fit_curve_to_chain(chain: Chain, curve: ParametricCurve, samples: int, gap: float,
-                        foot: np.ndarray) -> tuple[float, float]:
+                        foot: np.ndarray, bound: tuple[float, float] | None = None) -> tuple[float, float]:
     """Largest distance from the exact curve to the chain and its parameter, from one call of the curve at the
     nodes :func:`measure_deviation` takes for ``samples``.  A sample's distance is taken to the entity whose
     start's foot ``foot`` (curve parameters, one per entity) comes last before it and to that entity's two
     neighbours: an upper bound, exact for a chain that follows its curve (any sample left too far only makes the
     certificate fail, and the default measurement runs).  Every local maximum within ``gap`` of the largest is
-    refined by nested grids of exact points (by the semiconcavity bound of :mod:`camfab.discretize.certify`
+    refined by nested grids of exact points (by the bound of :mod:`camfab.discretize.certify`
     only those can hold the true maximum)."""
     ts, _ = sample_nodes(curve, max(int(samples), 8 * chain.n), 8)
     n_t = ts.size - 1
@@ -361,8 +374,10 @@ def _fit_curve_to_chain(chain: Chain, curve: ParametricCurve, samples: int, gap:
         hi_t = ts[top + 1]
     else:
         lo_t, hi_t = ts[np.maximum(top - 1, 0)], ts[np.minimum(top + 1, n_t)]
-    best_a = _zoom_max(lambda t: _near_entities(chain, points_at(curve, t), ent[top][:, None], 2), lo_t, hi_t,
-                       m=_FIT_ZOOM)
+    near = ent[top]
+    # (with a bound: a bracket's samples Δt apart miss at most K·(max|P′|·Δt)²/8, certify's gap)
+    best_a = _zoom_max(lambda t, rows: _near_entities(chain, points_at(curve, t), near[rows, None], 2), lo_t, hi_t,
+                       m=_FIT_ZOOM, per_step=None if bound is None else bound[0] * bound[1] ** 2 / 8.0)
     if best_a.max() > worst_a:
         worst_a = float(best_a.max())
         at_a = float(np.mod(0.5 * (lo_t + hi_t)[best_a.argmax()], curve.period))
@@ -385,7 +400,7 @@ def _fit_chain_to_curve(chain: Chain, sur: HermiteSurrogate, per_entity: int, re
 
 
 def measure_fit(chain: Chain, curve: ParametricCurve, sur: HermiteSurrogate, samples: int, gap: float, *,
-                per_entity: int = 17, refine_top: int = 8) -> Deviation:
+                per_entity: int = 17, refine_top: int = 8, bound: tuple[float, float] | None = None) -> Deviation:
     """The fit's own two-way measurement of ``chain`` on its stand-in ``sur`` (a :func:`fit_surrogate` result,
     error at most ``tol/200``), for :func:`~camfab.discretize.certify.certified_deviation`.
 
@@ -393,11 +408,13 @@ def measure_fit(chain: Chain, curve: ParametricCurve, sur: HermiteSurrogate, sam
     curve), refining every sampled local maximum within ``gap`` (the certificate's ``K·h²/8``) of the largest
     instead of a fixed number; chain to curve by projection on ``sur`` instead of a stand-in built from new
     exact samples and derivatives, without polishing (:func:`_fit_chain_to_curve`).  About six calls of the exact
-    curve instead of ~25."""
+    curve instead of ~25.  ``bound``: the certificate's ``(K, max |P′|)`` that gave ``gap``, when known; the
+    refinement then zooms only into the brackets that can hold the largest distance (:func:`_zoom_max`: the same
+    result)."""
     if chain.n == 0:
         raise GeometryError("no entities to measure: give at least one line or arc")
     worst_b, at_b, foot = _fit_chain_to_curve(chain, sur, per_entity, refine_top)
-    worst_a, at_a = _fit_curve_to_chain(chain, curve, samples, gap, foot)
+    worst_a, at_a = _fit_curve_to_chain(chain, curve, samples, gap, foot, bound)
     at = at_a if worst_a >= worst_b else at_b
     return Deviation(max=max(worst_a, worst_b), curve_to_entities=worst_a,
                      entities_to_curve=worst_b, at_param=at, at_point=points_at(curve, np.array([at]))[0])

@@ -6,7 +6,7 @@ chain.  An exporter asks a narrower question — is this chain (a pitch loop off
 flattened STL outline, chords of large arcs) within ``tol`` of the curve, and by how much — which the fit's own
 certificate answers (:mod:`camfab.discretize.certify`, derivation there): the curve's stand-in within ``tol/200``
 (:func:`~camfab.discretize.surrogate.fit_surrogate`), the curve sampled just densely enough that the
-semiconcavity gap ``K·h²/8`` is 5 % of ``tol``, and the measurement accepted only when ``measured + gap ≤ tol``.
+certificate's gap ``K·h²/8`` is 5 % of ``tol``, and the measurement accepted only when ``measured + gap ≤ tol``.
 A chain measured closer than ``tol`` whose gap leaves no room (a flattened outline at 95 % of ``tol``) is
 measured once more with the gap half the room left (:data:`MIN_GAP_SHARE` of ``tol`` at least: a bounded number
 of samples).  When no certificate holds (a chain farther than ``tol``, an arc tighter than ``tol``) the full
@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..geom2d import cross, dot
-from .certify import CERTIFY_SHARE, DEFAULT_SAMPLES, sample_gap, samples_for, semiconcavity
+from .certify import CERTIFY_SHARE, DEFAULT_SAMPLES, curvature_bound, sample_gap, samples_for
 from .curve import ParametricCurve
 from .measure import as_chain, measure_deviation, measure_fit
 from .results import Deviation
@@ -70,14 +70,14 @@ def measure_within(entities, curve: ParametricCurve, tol: float) -> Deviation:
     sur, err = fit_surrogate(curve, tol)
     if not err <= tol / SURROGATE_FRACTION:
         return measure_deviation(chain, curve)
-    K, vmax = semiconcavity(sur, chain, tol)
+    K, vmax = curvature_bound(sur, chain, tol)
     gap = CERTIFY_SHARE * tol
     while gap >= MIN_GAP_SHARE * tol:
         n = samples_for(K, vmax, curve.period, gap)
         if n is None or n >= DEFAULT_SAMPLES:
             break
         g = sample_gap(K, vmax, curve.period, n)
-        dev = measure_fit(chain, curve, sur, n, g)
+        dev = measure_fit(chain, curve, sur, n, g, bound=(K, vmax))
         if within(dev.max + g, tol):
             return dev
         if gap < CERTIFY_SHARE * tol:  # the second certificate failed too

@@ -9,7 +9,7 @@ import pytest
 from camfab.design.assemble import geometry_from_spec
 from camfab.design.spec import design_from_dict
 from camfab.discretize import ParametricCurve, arcs, measure_deviation, points_at
-from camfab.discretize.certify import CERTIFY_SHARE, certified_deviation, sample_gap, samples_for, semiconcavity
+from camfab.discretize.certify import CERTIFY_SHARE, certified_deviation, curvature_bound, sample_gap, samples_for
 from camfab.discretize.measure import measure_fit
 from camfab.discretize.surrogate import HermiteSurrogate, fit_surrogate
 from camfab.formats import load_design
@@ -51,7 +51,7 @@ def _to_arcs(res, pts):
 def test_sampled_maximum_plus_gap_bounds_the_dense_maximum(name):
     curve = CURVES[name]()
     res = arcs(curve, tol=TOL)
-    K, vmax = semiconcavity(fit_surrogate(curve, TOL)[0], res.chain(), TOL)
+    K, vmax = curvature_bound(fit_surrogate(curve, TOL)[0], res.chain(), TOL)
     dense_t = np.unique(np.concatenate([np.linspace(0.0, curve.period, 10**6), curve.breakpoints]))
     dense = _to_arcs(res, points_at(curve, dense_t)).max()
     gaps = []
@@ -69,7 +69,7 @@ def test_certified_fit_matches_a_dense_independent_check():
     curve = issue15_curve()
     res = arcs(curve, tol=TOL)
     sur = fit_surrogate(curve, TOL)[0]
-    K, vmax = semiconcavity(sur, res.chain(), TOL)
+    K, vmax = curvature_bound(sur, res.chain(), TOL)
     n = samples_for(K, vmax, curve.period, CERTIFY_SHARE * TOL)
     assert n is not None and n < 20000  # fewer samples than the default measurement
     independent = check_arcs(res, Dense(curve, 10**6))
@@ -102,7 +102,7 @@ def test_fit_measurement_agrees_with_the_general_one(factor):
     chain = arcs(base, tol=TOL).chain()
     curve = _scaled(base, factor)
     sur = fit_surrogate(curve, TOL)[0]
-    K, vmax = semiconcavity(sur, chain, TOL)
+    K, vmax = curvature_bound(sur, chain, TOL)
     n = samples_for(K, vmax, curve.period, CERTIFY_SHARE * TOL)
     gap = sample_gap(K, vmax, curve.period, n)
     fit = measure_fit(chain, curve, sur, n, gap)
@@ -122,10 +122,55 @@ def test_fit_measurement_bounds_a_dense_check_off_the_curve():
     res = arcs(base, tol=TOL)
     curve = _scaled(base, 1.0 + 2e-5)
     sur = fit_surrogate(curve, TOL)[0]
-    K, vmax = semiconcavity(sur, res.chain(), TOL)
+    K, vmax = curvature_bound(sur, res.chain(), TOL)
     n = samples_for(K, vmax, curve.period, CERTIFY_SHARE * TOL)
     gap = sample_gap(K, vmax, curve.period, n)
     fit = measure_fit(res.chain(), curve, sur, n, gap)
     independent = check_arcs(res, Dense(curve, 10**6))
     assert independent <= fit.max + gap
     assert fit.max == pytest.approx(independent, rel=1e-5)
+
+
+def test_refinement_skips_brackets_the_bound_rules_out():
+    """:func:`~camfab.discretize.measure._zoom_max` with the certificate's bound zooms into fewer brackets and
+    finds the same largest value in the same bracket, bit for bit; a bracket left out keeps a value within the
+    bound below its full refinement (a function with ``|f''| ≤ K``: a sum of cosines)."""
+    from camfab.discretize.measure import _zoom_max
+
+    rng = np.random.default_rng(7)
+    amp, freq, phase = rng.uniform(0.1, 1.0, 6), rng.uniform(1.0, 20.0, 6), rng.uniform(0, 2 * np.pi, 6)
+    K = float((amp * freq ** 2).sum())  # |f''| ≤ Σ a·ω²
+    calls = {"full": 0, "pruned": 0}
+
+    def f(kind):
+        def run(u, rows):
+            calls[kind] += u.size
+            return (amp * np.cos(freq * u[..., None] + phase)).sum(axis=-1)
+        return run
+
+    centres = np.sort(rng.uniform(0.0, 10.0, 60))
+    lo, hi = centres - 0.02, centres + 0.02
+    full = _zoom_max(f("full"), lo, hi, m=17)
+    pruned = _zoom_max(f("pruned"), lo, hi, m=17, per_step=K / 8.0)
+    assert pruned.max() == full.max() and pruned.argmax() == full.argmax()
+    assert np.all(pruned <= full)
+    step = (hi - lo) / 16
+    assert np.all(full <= pruned + K / 8.0 * step ** 2 + 1e-12)
+    assert calls["pruned"] < 0.7 * calls["full"]  # not vacuous: most brackets stop after the first level
+
+
+@pytest.mark.parametrize("factor", [1.0, 1.0 + 2e-5])
+def test_fit_measurement_with_its_bound_is_the_same(factor):
+    """The fit's measurement given the certificate's ``(K, max|P′|)`` (it then zooms only into the brackets that
+    can hold the largest distance) reports exactly what it reports without: on the fit and on a chain 1–2.5 tol
+    off its curve."""
+    base = issue15_curve()
+    chain = arcs(base, tol=TOL).chain()
+    curve = _scaled(base, factor)
+    sur = fit_surrogate(curve, TOL)[0]
+    K, vmax = curvature_bound(sur, chain, TOL)
+    n = samples_for(K, vmax, curve.period, CERTIFY_SHARE * TOL)
+    gap = sample_gap(K, vmax, curve.period, n)
+    plain, bounded = measure_fit(chain, curve, sur, n, gap), measure_fit(chain, curve, sur, n, gap, bound=(K, vmax))
+    assert (bounded.max, bounded.curve_to_entities, bounded.entities_to_curve, bounded.at_param) == \
+        (plain.max, plain.curve_to_entities, plain.entities_to_curve, plain.at_param)
