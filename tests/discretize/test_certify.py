@@ -93,18 +93,24 @@ def _scaled(curve, factor):
                            lambda t: factor * curve.derivative(t), curve.closed)
 
 
-@pytest.mark.parametrize("factor", [1.0, 1.0 + 2e-5])
-def test_fit_measurement_agrees_with_the_general_one(factor):
-    """The fit's own measurement (one exact call at the certified samples, the chain projected on the fit's
-    stand-in, each sample against its own entity and neighbours) against ``measure_deviation`` (its own stand-in,
-    grid search over every entity, polished feet): the same maximum, on the fit and on a chain 1–2.5 tol off."""
+def _fit_measurement_case(factor: float):
+    """The issue cam's fit against its curve scaled by ``factor`` (1: the fit's own curve; ``1 + 2e-5``: 1–2.5 tol
+    off): ``(chain, curve, stand-in, (K, max|P′|), samples, gap)`` as the certificate takes them."""
     base = issue15_curve()
     chain = arcs(base, tol=TOL).chain()
     curve = _scaled(base, factor)
     sur = fit_surrogate(curve, TOL)[0]
     K, vmax = curvature_bound(sur, chain, TOL)
     n = samples_for(K, vmax, curve.period, CERTIFY_SHARE * TOL)
-    gap = sample_gap(K, vmax, curve.period, n)
+    return chain, curve, sur, (K, vmax), n, sample_gap(K, vmax, curve.period, n)
+
+
+@pytest.mark.parametrize("factor", [1.0, 1.0 + 2e-5])
+def test_fit_measurement_agrees_with_the_general_one(factor):
+    """The fit's own measurement (one exact call at the certified samples, the chain projected on the fit's
+    stand-in, each sample against its own entity and neighbours) against ``measure_deviation`` (its own stand-in,
+    grid search over every entity, polished feet): the same maximum, on the fit and on a chain 1–2.5 tol off."""
+    chain, curve, sur, (K, vmax), n, gap = _fit_measurement_case(factor)
     fit = measure_fit(chain, curve, sur, n, gap)
     general = measure_deviation(chain, curve)
     assert fit.max == pytest.approx(general.max, rel=1e-6)
@@ -164,13 +170,7 @@ def test_fit_measurement_with_its_bound_is_the_same(factor):
     """The fit's measurement given the certificate's ``(K, max|P′|)`` (it then zooms only into the brackets that
     can hold the largest distance) reports exactly what it reports without: on the fit and on a chain 1–2.5 tol
     off its curve."""
-    base = issue15_curve()
-    chain = arcs(base, tol=TOL).chain()
-    curve = _scaled(base, factor)
-    sur = fit_surrogate(curve, TOL)[0]
-    K, vmax = curvature_bound(sur, chain, TOL)
-    n = samples_for(K, vmax, curve.period, CERTIFY_SHARE * TOL)
-    gap = sample_gap(K, vmax, curve.period, n)
+    chain, curve, sur, (K, vmax), n, gap = _fit_measurement_case(factor)
     plain, bounded = measure_fit(chain, curve, sur, n, gap), measure_fit(chain, curve, sur, n, gap, bound=(K, vmax))
     assert (bounded.max, bounded.curve_to_entities, bounded.entities_to_curve, bounded.at_param) == \
         (plain.max, plain.curve_to_entities, plain.entities_to_curve, plain.at_param)
