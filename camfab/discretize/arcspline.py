@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from ..geom2d import cross, dot, rotate
+from ..geom2d import TWO_PI, cross, dot, rotate
 from .certify import certified_deviation
 from .chain import Chain, merge_cocircular
 from .congruent import CongruentSpans
@@ -208,20 +208,43 @@ def _tanlen(kk, ll):
     return ll / 2 if abs(x) < 1e-12 else math.tan(x) / kk
 
 
+def _sinc_factors(k: np.ndarray, u: np.ndarray) -> tuple[list, list]:
+    """The two ``np.sinc`` factors :func:`~camfab.discretize.entities.entity_point` takes for entities of curvature
+    ``k`` and length ``u``, all in two calls (as floats: the arcs of a span are laid one after another)."""
+    ku = k * u
+    return np.sinc(ku / math.pi).tolist(), np.sinc(ku / TWO_PI).tolist()
+
+
+def _end_of(sx: float, sy: float, tx: float, ty: float, k: float, u: float, f1: float, f2: float) -> tuple:
+    """:func:`~camfab.discretize.entities.entity_point` at ``u`` of the entity from ``(sx, sy)`` along ``(tx, ty)``
+    (curvature ``k``) on floats, operation for operation (``f1``, ``f2``: its :func:`_sinc_factors`; a float's
+    ``** 2`` is the C library's ``pow``, as a numpy scalar's): the same point bit for bit, without a dozen small
+    arrays per arc."""
+    x = u * f1
+    y = 0.5 * k * u * u * f2 ** 2
+    return sx + x * tx + y * -ty, sy + x * ty + y * tx
+
+
 def _lay_backward(p1, t1, k, ell, j: int):
     """Arcs ``j + 2 … m - 1`` laid backward from ``p1`` (tangent ``t1``): their starts and start tangents,
     and the point and tangent angle where the closing biarc must end."""
     b_starts: list[np.ndarray] = []
     b_tans: list[np.ndarray] = []
     end_p, end_ang = p1, math.atan2(t1[1], t1[0])
-    for i in range(ell.size - 1, j + 1, -1):
+    idx = np.arange(ell.size - 1, j + 1, -1)
+    if not idx.size:
+        return b_starts, b_tans, end_p, end_ang
+    kb, lb = (-k[idx]).tolist(), ell[idx].tolist()
+    f1, f2 = _sinc_factors(-k[idx], ell[idx])
+    px, py = float(end_p[0]), float(end_p[1])
+    for n, i in enumerate(idx.tolist()):
         ang_s = end_ang - k[i] * ell[i]
-        tb = np.array([math.cos(end_ang), math.sin(end_ang)])
-        sp = entity_point(end_p, -tb, -k[i], ell[i])
-        b_starts.insert(0, sp)
+        c, sn = math.cos(end_ang), math.sin(end_ang)
+        px, py = _end_of(px, py, -c, -sn, kb[n], lb[n], f1[n], f2[n])  # (along -tb: curvature -k)
+        b_starts.insert(0, np.array([px, py]))
         b_tans.insert(0, np.array([math.cos(ang_s), math.sin(ang_s)]))
-        end_p, end_ang = sp, ang_s
-    return b_starts, b_tans, end_p, end_ang
+        end_ang = ang_s
+    return b_starts, b_tans, b_starts[0], end_ang
 
 
 def _cut_long_arcs(S, TT, K, L):
@@ -255,12 +278,16 @@ def _span_chain(p0, t0, p1, t1, knots, k, fixed=(None, None)):
     starts, tans, ks, ls = [p0], [t0], [], []
     base = math.atan2(t0[1], t0[0])
     ang = base + np.concatenate([[0.0], np.cumsum(k * ell)])
+    f1, f2 = _sinc_factors(k[:j], ell[:j])
+    kf, lf = k[:j].tolist(), ell[:j].tolist()
+    px, py, tx, ty = float(p0[0]), float(p0[1]), float(t0[0]), float(t0[1])
     for i in range(j):
-        e = entity_point(starts[-1], tans[-1], k[i], ell[i])
+        px, py = _end_of(px, py, tx, ty, kf[i], lf[i], f1[i], f2[i])
+        tx, ty = math.cos(ang[i + 1]), math.sin(ang[i + 1])
         ks.append(k[i])
         ls.append(ell[i])
-        starts.append(e)
-        tans.append(np.array([math.cos(ang[i + 1]), math.sin(ang[i + 1])]))
+        starts.append(np.array([px, py]))
+        tans.append(np.array([tx, ty]))
     b_starts, b_tans, end_p, end_ang = _lay_backward(p1, t1, k, ell, j)
     d1, d2 = _tanlen(k[j], ell[j]), _tanlen(k[j + 1], ell[j + 1])
     ratio = d1 / d2 if d1 > 0 and d2 > 0 else 1.0

@@ -37,12 +37,9 @@ def _column_max(a: np.ndarray) -> np.ndarray:
     return np.array([a[:, 0].max(), a[:, 1].max()])
 
 
-def _candidates(sites: np.ndarray, q: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray] | None:
-    """Every (query row, site index) pair whose site lies in the 3×3 cells around the query's cell, grouped by
-    query row in increasing order, or None when the grid would need more cells than int64 keys can number.
-
-    Keys number the cells column by column, so a query's 3×3 cells are three runs of consecutive keys (one
-    ``searchsorted`` pair each)."""
+def _site_cells(sites: np.ndarray, cell: float) -> tuple | None:
+    """The sites bucketed in cells of side ``cell``: ``(origin, nx, ny, order, sorted keys)``, or None when the grid
+    would need more cells than int64 keys can number."""
     origin = _column_min(sites)
     cs = np.floor((sites - origin) / cell)
     nx, ny = _column_max(cs) + 1
@@ -51,7 +48,27 @@ def _candidates(sites: np.ndarray, q: np.ndarray, cell: float) -> tuple[np.ndarr
     ny_i = int(ny)
     keys = cs[:, 0].astype(np.int64) * ny_i + cs[:, 1].astype(np.int64)
     order = np.argsort(keys, kind="stable")
-    skeys = keys[order]
+    return origin, nx, ny, order, keys[order]
+
+
+def _candidates(sites: np.ndarray, q: np.ndarray, cell: float, cells: dict | None = None
+                ) -> tuple[np.ndarray, np.ndarray] | None:
+    """Every (query row, site index) pair whose site lies in the 3×3 cells around the query's cell, grouped by
+    query row in increasing order, or None when the grid would need more cells than int64 keys can number.
+
+    Keys number the cells column by column, so a query's 3×3 cells are three runs of consecutive keys (one
+    ``searchsorted`` pair each).  ``cells``: the sites' buckets by cell side, kept for the next queries of the
+    same sites (a caller's dictionary)."""
+    if cells is None:
+        grid = _site_cells(sites, cell)
+    else:
+        if cell not in cells:
+            cells[cell] = _site_cells(sites, cell)
+        grid = cells[cell]
+    if grid is None:
+        return None
+    origin, nx, ny, order, skeys = grid
+    ny_i = int(ny)
     qc = np.floor((q - origin) / cell)
     qc = np.clip(qc, -2.0, np.array([nx, ny]) + 1.0).astype(np.int64)  # far queries: no site near, no overflow
     col = qc[:, 0, None] + np.arange(-1, 2)  # (N, 3) the three columns
@@ -83,8 +100,8 @@ def _row_minima(rows: np.ndarray, site: np.ndarray, d: np.ndarray, n: int) -> tu
 
 
 def grid_nearest(q: np.ndarray, sites: np.ndarray, cell: float,
-                 distance: Callable[[np.ndarray, np.ndarray], np.ndarray], reach: float = 0.0
-                 ) -> tuple[np.ndarray, np.ndarray]:
+                 distance: Callable[[np.ndarray, np.ndarray], np.ndarray], reach: float = 0.0,
+                 cells: dict | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The smallest ``distance(q_rows, site_indices)`` over every site, for each query point, exactly.
 
     Parameters
@@ -98,6 +115,9 @@ def grid_nearest(q: np.ndarray, sites: np.ndarray, cell: float,
         The finest cells' side (about the spacing of the sites).
     distance : callable
         ``distance(points (K, 2), site indices (K,)) -> (K,)`` distances.
+    cells : dict, optional
+        A dictionary kept by the caller for queries of the same ``sites``: their buckets per cell side are made
+        once and reused (the same answers).
 
     Returns
     -------
@@ -117,7 +137,7 @@ def grid_nearest(q: np.ndarray, sites: np.ndarray, cell: float,
     for _ in range(_LEVELS):
         if not todo.size or cell >= extent:
             break
-        pairs = _candidates(sites, q[todo], cell)
+        pairs = _candidates(sites, q[todo], cell, cells)
         if pairs is None:
             break
         rows, site = pairs

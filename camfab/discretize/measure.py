@@ -96,6 +96,7 @@ class _CurveProjector:
         self._width = sur.x[1:] - sur.x[:-1]
         self._site_x = np.ascontiguousarray(self.sites[:, 0])
         self._site_y = np.ascontiguousarray(self.sites[:, 1])
+        self._cells: dict = {}  # the sites' grid buckets, made once for every query (grid_nearest)
 
     def nearest(self, x: np.ndarray) -> np.ndarray:
         """Index of the curve sample nearest to each ``x`` ``(N, 2)``."""
@@ -104,7 +105,7 @@ class _CurveProjector:
         def dist(p: np.ndarray, j: np.ndarray) -> np.ndarray:
             return np.hypot(p[:, 0] - sx[j], p[:, 1] - sy[j])
 
-        return grid_nearest(x, self.sites, self.cell, dist)[1]
+        return grid_nearest(x, self.sites, self.cell, dist, cells=self._cells)[1]
 
     def project(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Distance from each ``x`` ``(N, 2)`` to the curve, the foot parameter and its smooth piece.

@@ -185,3 +185,29 @@ def test_translating_outline_keeps_corners(tol):
         assert jumps[hit][0] > 1e-3      # and stays a corner
         at_corner |= hit
     assert jumps[~at_corner].max() < 1e-7
+
+
+def test_arcs_laid_on_floats_are_entity_points_bit_for_bit():
+    """The span's arcs are laid one after another on floats (``arcspline._end_of`` with the sinc factors of all
+    arcs taken at once): every end point is ``entities.entity_point``'s, bit for bit, forward and backward (along
+    the reversed tangent with the curvature negated), for curvatures from a line to a tight arc and lengths from
+    a micrometre to a half turn."""
+    from camfab.discretize.arcspline import _end_of, _sinc_factors
+    from camfab.discretize.entities import entity_point
+
+    rng = np.random.default_rng(11)
+    n = 4000
+    k = rng.choice([-1.0, 1.0], n) * 10.0 ** rng.uniform(-9, 1, n)
+    k[:50] = 0.0
+    u = np.minimum(10.0 ** rng.uniform(-3, 2, n), math.pi / np.maximum(np.abs(k), 1e-300))
+    start = rng.normal(scale=60.0, size=(n, 2))
+    ang = rng.uniform(-math.pi, math.pi, n)
+    for sign in (1.0, -1.0):
+        tan = sign * np.stack([np.cos(ang), np.sin(ang)], axis=1)
+        kk = sign * k
+        f1, f2 = _sinc_factors(kk, u)
+        for i in range(n):
+            ref = entity_point(start[i], tan[i], kk[i], u[i])
+            got = _end_of(float(start[i, 0]), float(start[i, 1]), float(tan[i, 0]), float(tan[i, 1]), float(kk[i]),
+                          float(u[i]), f1[i], f2[i])
+            assert got == (ref[0], ref[1]), (i, sign)

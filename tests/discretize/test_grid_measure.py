@@ -60,11 +60,18 @@ def test_grid_nearest_is_the_brute_force_nearest():
         (np.zeros((3, 2)), rng.normal(size=(20, 2))),  # all sites at one point
         (np.array([[1.0, 2.0]]), rng.normal(size=(5, 2))),
     ]:
+        cells: dict = {}  # the sites' buckets kept across queries: the same answers, made once per cell side
         for cell in (1e-3, 0.05, 1.0, 1e4):
             d, j = grid_nearest(q, sites, cell, _euclid(sites))
             bd, _ = _brute(q, sites, _euclid(sites))
             np.testing.assert_array_equal(d, bd)
             np.testing.assert_array_equal(_euclid(sites)(q, j), bd)
+            for half in (q[::2], q[1::2], q):
+                dc, jc = grid_nearest(half, sites, cell, _euclid(sites), cells=cells)
+                ref = grid_nearest(half, sites, cell, _euclid(sites))
+                np.testing.assert_array_equal(dc, ref[0])
+                np.testing.assert_array_equal(jc, ref[1])
+        assert cells and all(v is None or v[3].size == sites.shape[0] for v in cells.values())
 
 
 def test_chain_distance_is_exact_against_every_entity():
