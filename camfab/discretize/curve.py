@@ -23,6 +23,7 @@ __all__ = [
     "ParametricCurve",
     "points_at",
     "derivatives_at",
+    "points_and_derivatives_at",
     "piece_index",
     "check_closed",
     "discontinuities",
@@ -56,6 +57,11 @@ class ParametricCurve:
     closed : bool, optional
         True (default) for a closed curve: ``P(period)`` equals ``P(0)`` and
         parameters outside ``[0, period]`` wrap around.
+    point_and_derivative : callable, optional
+        ``point_and_derivative(t)`` returns ``(point(t), derivative(t))`` from one evaluation, for a curve whose
+        two share their work (a cam profile: one motion evaluation instead of two).  Its values must be those of
+        ``point`` and ``derivative`` exactly; used only together with ``derivative``
+        (:func:`points_and_derivatives_at`).
 
     Raises
     ------
@@ -68,6 +74,7 @@ class ParametricCurve:
     period: float = TWO_PI
     derivative: Callable[[np.ndarray], np.ndarray] | None = None
     closed: bool = True
+    point_and_derivative: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] | None = None
 
     def __post_init__(self) -> None:
         period = float(self.period)
@@ -92,6 +99,23 @@ class ParametricCurve:
         return self.breakpoints[:-1], self.breakpoints[1:]
 
 
+def _inside(curve: ParametricCurve, flat: np.ndarray) -> np.ndarray:
+    """Parameters outside ``[0, period]`` wrapped around (closed curve) or clamped to the ends (open)."""
+    outside = (flat < 0.0) | (flat > curve.period)
+    if outside.any():
+        inside = np.mod(flat, curve.period) if curve.closed else np.clip(flat, 0.0, curve.period)
+        flat = np.where(outside, inside, flat)
+    return flat
+
+
+def _checked(values, n: int, what: str, fix: str) -> np.ndarray:
+    """A user function's ``(n, 2)`` result as floats (a :class:`CurveError` for any other shape)."""
+    v = np.asarray(values, dtype=float)
+    if v.shape != (n, 2):
+        raise CurveError(f"curve.{what} must return an (n, 2) array, got shape {v.shape}; return {fix}")
+    return v
+
+
 def points_at(curve: ParametricCurve, t) -> np.ndarray:
     """``P(t)`` (mm) for any array shape of ``t``: ``t.shape + (2,)``.
 
@@ -104,16 +128,51 @@ def points_at(curve: ParametricCurve, t) -> np.ndarray:
         If ``curve.point`` does not return an ``(n, 2)`` array.
     """
     t = np.asarray(t, dtype=float)
-    flat = t.ravel()
-    outside = (flat < 0.0) | (flat > curve.period)
-    if outside.any():
-        inside = np.mod(flat, curve.period) if curve.closed else np.clip(flat, 0.0, curve.period)
-        flat = np.where(outside, inside, flat)
-    p = np.asarray(curve.point(flat), dtype=float)
-    if p.shape != (flat.size, 2):
-        raise CurveError(f"curve.point must return an (n, 2) array, got shape {p.shape}; "
-                         "return np.column_stack([x, y])")
-    return p.reshape(t.shape + (2,))
+    flat = _inside(curve, t.ravel())
+    return _checked(curve.point(flat), flat.size, "point", "np.column_stack([x, y])").reshape(t.shape + (2,))
+
+
+def _near_ends(t, lo, hi):
+    """Where :func:`derivatives_at` extrapolates: the parameters within ``2δ`` of their piece's ends, and the two
+    inner parameters ``t1``, ``t2`` it extrapolates from."""
+    width = hi - lo
+    # δ = 1e-7 of the piece, but at least a few ulps of the parameter (a piece 1e-9° wide would
+    # otherwise put t1 and t2 on the same float) and at most an eighth of the piece
+    ulps = 8 * np.spacing(np.maximum(np.abs(lo), np.abs(hi)))
+    delta = np.minimum(np.maximum(1e-7 * width, ulps), width / 8)
+    near_lo = t - lo < 2 * delta
+    near_hi = (hi - t < 2 * delta) & ~near_lo
+    near = near_lo | near_hi
+    base = np.where(near_lo, lo, hi)[near]
+    side = np.where(near_lo, 1.0, -1.0)[near]
+    return near, base + side * 2 * delta[near], base + side * 4 * delta[near]
+
+
+def _one_sided(t, near, t1, t2, vals) -> np.ndarray:
+    """The derivatives at ``t`` from ``vals`` (the curve's derivative at ``t``, ``t1``, ``t2`` in a row): those
+    near a piece end extrapolated linearly from ``t1``, ``t2`` inside it."""
+    out = vals[:t.size]
+    if near.any():
+        d1, d2 = vals[t.size:t.size + t1.size], vals[t.size + t1.size:]
+        step = t2 - t1
+        frac = np.where(step != 0, (t[near] - t1) / np.where(step != 0, step, 1.0), 0.0)[:, None]
+        out[near] = d1 + frac * (d2 - d1)
+    return out
+
+
+def points_and_derivatives_at(curve: ParametricCurve, x, t, lo, hi) -> tuple[np.ndarray, np.ndarray]:
+    """``(points_at(curve, x), derivatives_at(curve, t, lo, hi))`` (``x`` and ``t`` 1-D), from one evaluation when
+    the curve has ``point_and_derivative`` (the same values: its contract), else from the two."""
+    if curve.point_and_derivative is None or curve.derivative is None:
+        return points_at(curve, x), derivatives_at(curve, t, lo, hi)
+    x = _inside(curve, np.asarray(x, dtype=float).ravel())
+    t, lo, hi = (np.asarray(v, dtype=float).ravel() for v in np.broadcast_arrays(t, lo, hi))
+    near, t1, t2 = _near_ends(t, lo, hi)
+    p, d = curve.point_and_derivative(np.concatenate([x, t, t1, t2]))
+    n = x.size + t.size + t1.size + t2.size
+    p = _checked(p, n, "point_and_derivative", "(points, derivatives), each np.column_stack([x, y])")
+    d = _checked(d, n, "point_and_derivative", "(points, derivatives), each np.column_stack([x, y])")
+    return p[:x.size], _one_sided(t, near, t1, t2, d[x.size:])
 
 
 def derivatives_at(curve: ParametricCurve, t, lo, hi) -> np.ndarray:
@@ -130,32 +189,10 @@ def derivatives_at(curve: ParametricCurve, t, lo, hi) -> np.ndarray:
     t, lo, hi = t.ravel(), lo.ravel(), hi.ravel()
     width = hi - lo
     if curve.derivative is not None:
-        def der(x):
-            d = np.asarray(curve.derivative(x), dtype=float)
-            if d.shape != (x.size, 2):
-                raise CurveError(f"curve.derivative must return an (n, 2) array, got shape {d.shape}; "
-                                 "return np.column_stack([dx, dy])")
-            return d
-
-        # δ = 1e-7 of the piece, but at least a few ulps of the parameter (a piece 1e-9° wide would
-        # otherwise put t1 and t2 on the same float) and at most an eighth of the piece
-        ulps = 8 * np.spacing(np.maximum(np.abs(lo), np.abs(hi)))
-        delta = np.minimum(np.maximum(1e-7 * width, ulps), width / 8)
-        near_lo = t - lo < 2 * delta
-        near_hi = (hi - t < 2 * delta) & ~near_lo
-        near = near_lo | near_hi
-        base = np.where(near_lo, lo, hi)[near]
-        side = np.where(near_lo, 1.0, -1.0)[near]
-        t1 = base + side * 2 * delta[near]
-        t2 = base + side * 4 * delta[near]
-        vals = der(np.concatenate([t, t1, t2]))  # one call: user functions may be costly
-        out = vals[:t.size]
-        if near.any():
-            d1, d2 = vals[t.size:t.size + t1.size], vals[t.size + t1.size:]
-            step = t2 - t1
-            frac = np.where(step != 0, (t[near] - t1) / np.where(step != 0, step, 1.0), 0.0)[:, None]
-            out[near] = d1 + frac * (d2 - d1)
-        return out.reshape(shape + (2,))
+        near, t1, t2 = _near_ends(t, lo, hi)
+        vals = _checked(curve.derivative(np.concatenate([t, t1, t2])), t.size + t1.size + t2.size, "derivative",
+                        "np.column_stack([dx, dy])")  # one call: user functions may be costly
+        return _one_sided(t, near, t1, t2, vals).reshape(shape + (2,))
     h = np.minimum(1e-6 * curve.period, width / 8.0)
     fwd = t - h < lo
     bwd = (t + h > hi) & ~fwd

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .curve import ParametricCurve, derivatives_at, points_at
+from .curve import ParametricCurve, points_and_derivatives_at, points_at
 
 __all__ = ["HermiteSurrogate", "sample_nodes", "fit_surrogate", "SURROGATE_FRACTION", "SURROGATE_MAX_NODES"]
 
@@ -39,14 +39,14 @@ class HermiteSurrogate:
             counts = np.diff(np.searchsorted(x, curve.breakpoints))
         piece = np.repeat(np.arange(lo.size), counts)
         a, b = x[:-1], x[1:]
-        p = points_at(curve, x)
+        # one derivative per node and smooth piece: an interval's end is the next one's start (same piece) except
+        # at each piece's end, whose one-sided derivative comes from that piece (points and derivatives from one
+        # evaluation when the curve offers it)
+        ends = np.cumsum(counts) - 1  # the last interval of every piece (each piece has one at least)
+        p, d = points_and_derivatives_at(curve, x, np.concatenate([a, b[ends]]), np.concatenate([lo[piece], lo]),
+                                         np.concatenate([hi[piece], hi]))
         if curve.closed:
             p[-1] = p[0]
-        # one derivative per node and smooth piece: an interval's end is the next one's start (same piece) except
-        # at each piece's end, whose one-sided derivative comes from that piece
-        ends = np.cumsum(counts) - 1  # the last interval of every piece (each piece has one at least)
-        d = derivatives_at(curve, np.concatenate([a, b[ends]]), np.concatenate([lo[piece], lo]),
-                           np.concatenate([hi[piece], hi]))
         d0 = d[:a.size]
         d1 = np.empty_like(d0)
         d1[:-1] = d0[1:]

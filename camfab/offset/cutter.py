@@ -72,8 +72,13 @@ def profile_curve(contact) -> ParametricCurve:
         log.info("profile: the follower's velocity jumps at %s; the profile is the one the follower makes there",
                  corner_note(contact, corners))
         return cornered_curve(contact, corners)
+    def both(t):
+        s = contact.evaluate_fields(t, ("point", "point_d1"))
+        return s["point"], s["point_d1"]
+
     return ParametricCurve(lambda t: contact.evaluate_fields(t, ("point",))["point"], contact.breakpoints,
-                           contact.period, lambda t: contact.evaluate_fields(t, ("point_d1",))["point_d1"])
+                           contact.period, lambda t: contact.evaluate_fields(t, ("point_d1",))["point_d1"],
+                           point_and_derivative=both)
 
 
 def pitch_curve(contact) -> ParametricCurve | None:
@@ -108,7 +113,11 @@ def offset_curve(contact, distance: float) -> ParametricCurve:
         s = contact.evaluate_fields(t, ("point_d1", "curvature"))
         return s["point_d1"] * (1.0 + distance * s["curvature"])[:, None]
 
-    return ParametricCurve(point, contact.breakpoints, contact.period, deriv)
+    def both(t):
+        s = contact.evaluate_fields(t, ("point", "normal", "point_d1", "curvature"))
+        return s["point"] + distance * s["normal"], s["point_d1"] * (1.0 + distance * s["curvature"])[:, None]
+
+    return ParametricCurve(point, contact.breakpoints, contact.period, deriv, point_and_derivative=both)
 
 
 def concave_limit(contact) -> tuple[float, list[tuple[float, float]]]:

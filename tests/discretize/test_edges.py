@@ -130,3 +130,45 @@ def test_measurement_of_a_sharp_piece_is_neither_over_nor_under(base, tol):
     brute = brute_deviation(chain, curve)
     assert measured.max <= tol and brute <= tol * 1.001
     assert measured.max == pytest.approx(brute, rel=0.02, abs=tol * 1e-3)
+
+
+def test_points_and_derivatives_from_one_evaluation_are_the_two_calls():
+    """``points_and_derivatives_at`` with a curve's ``point_and_derivative`` (one evaluation): the points and the
+    one-sided derivatives of the two separate calls bit for bit, at breakpoints, next to them and on a piece a few
+    ulps wide; a curve without it takes the two calls; a wrong shape is named."""
+    from camfab.discretize.curve import CurveError, points_and_derivatives_at
+
+    calls = []
+
+    def point(t):
+        return 30.0 * np.stack([np.cos(t), np.sin(2 * t)], axis=-1)
+
+    def deriv(t):
+        return 30.0 * np.stack([-np.sin(t), 2 * np.cos(2 * t)], axis=-1)
+
+    def both(t):
+        calls.append(t.size)
+        return point(t), deriv(t)
+
+    a = math.pi / 2
+    bp = [1.0, a, a + math.radians(1e-9), 4.0]
+    plain = ParametricCurve(point, bp, derivative=deriv)
+    one = ParametricCurve(point, bp, derivative=deriv, point_and_derivative=both)
+    x = np.concatenate([plain.breakpoints, np.linspace(0.0, 2 * math.pi, 97), [7.0, -0.5]])  # (two to wrap)
+    lo_p, hi_p = plain.pieces
+    inner = np.linspace(0.1, 6.2, 50)
+    k = np.searchsorted(plain.breakpoints, inner, side="right") - 1
+    # every piece's start and end (one-sided from inside it) and points inside the pieces
+    t = np.concatenate([lo_p, hi_p, inner])
+    lo, hi = np.concatenate([lo_p, lo_p, lo_p[k]]), np.concatenate([hi_p, hi_p, hi_p[k]])
+    ref = points_at(plain, x), derivatives_at(plain, t, lo, hi)
+    got = points_and_derivatives_at(one, x, t, lo, hi)
+    assert calls and len(calls) == 1
+    np.testing.assert_array_equal(got[0], ref[0])
+    np.testing.assert_array_equal(got[1], ref[1])
+    fallback = points_and_derivatives_at(plain, x, t, lo, hi)
+    np.testing.assert_array_equal(fallback[0], ref[0])
+    np.testing.assert_array_equal(fallback[1], ref[1])
+    wrong = ParametricCurve(point, bp, derivative=deriv, point_and_derivative=lambda t: (point(t)[:, 0], deriv(t)))
+    with pytest.raises(CurveError, match="point_and_derivative must return an"):
+        points_and_derivatives_at(wrong, x, t, lo, hi)
