@@ -18,11 +18,16 @@ both fits' arc counts and deviations (and whether the arcs are the same bit for 
 lists per fit the arcs, the measured deviation and the CPU time; with ``--root`` both trees' fits side by side
 (arcs before/after, whether they are the same bit for bit) and the totals.
 
+``--floor`` times what any fit verified by measurement, as this one is, must spend on the issue cam whatever its
+search: the Hermite stand-in's exact evaluations (points and derivatives at its nodes, points at its midpoints), the
+certificate's exact curve samples (one evaluation at the count the certificate asks for) and their distances to the
+fitted chain (each sample against its own entity and the two beside it, as the fit's measurement takes them).
+
 ``--stages`` times the issue cam's fit by stage (CPU around each: the Hermite stand-in, cutting the spans, the
 spans' arc-count search, laying the arcs, the certification; the rest), what a faster fitter has to cut.
 
 Run:  PYTHONPATH=. python3 benchmarks/bench_fit.py [--repeat 20] [--root /work/main --rounds 3] [--examples]
-      [--stages]
+      [--stages] [--floor]
 """
 from __future__ import annotations
 
@@ -234,6 +239,50 @@ def stages(repeat: int) -> None:
     print(f"  {'the rest':18}{total - sum(spent.values()) / repeat * 1e3:7.1f} ms")
 
 
+def floor(repeat: int) -> None:
+    """CPU of the verification's unavoidable parts on the issue cam (module notes, ``--floor``), mean of ``repeat``."""
+    import numpy as np
+
+    from camfab.discretize.certify import CERTIFY_SHARE, curvature_bound, samples_for
+    from camfab.discretize.curve import points_at
+    from camfab.discretize.measure import _near_entities
+    from camfab.discretize.surrogate import HermiteSurrogate, fit_surrogate, sample_nodes
+
+    curve = issue_cam_curve()
+    fit = arcs(curve, tol=1e-3)
+    chain = fit.chain()
+    sur, _ = fit_surrogate(curve, 1e-3)
+    K, vmax = curvature_bound(sur, chain, 1e-3)
+    n = samples_for(K, vmax, curve.period, CERTIFY_SHARE * 1e-3)
+    assert n is not None
+    t, _ = sample_nodes(curve, max(n, 8 * chain.n), 8)
+    t = t[:-1]
+    pts = points_at(curve, t)
+    # each sample's entity: the chain's entities by their start's nearest sample (the fit's measurement takes them
+    # from its projected feet; any assignment costs the same)
+    start = np.searchsorted(t, np.linspace(0.0, curve.period, chain.n, endpoint=False))
+    owner = np.clip(np.searchsorted(start, np.arange(t.size), side="right") - 1, 0, chain.n - 1)
+
+    def mean(f) -> float:
+        f()
+        t0 = time.process_time()
+        for _ in range(repeat):
+            f()
+        return (time.process_time() - t0) / repeat * 1e3
+
+    parts = [(f"stand-in, {sur.x.size} nodes (points, derivatives, midpoints)",
+              mean(lambda: HermiteSurrogate(curve, x=sur.x).interval_errors())),
+             (f"certificate's {t.size} exact samples", mean(lambda: points_at(curve, t))),
+             ("their distances to the chain (3 entities each)", mean(lambda: _near_entities(chain, pts, owner)))]
+    total = mean(lambda: arcs(curve, tol=1e-3))
+    print(f"issue-15 roller cam, 1 µm: {total:.1f} ms CPU per fit (mean of {repeat}); what its verification "
+          "cannot skip:")
+    for label, ms in parts:
+        print(f"  {label:52}{ms:7.2f} ms")
+    label = "floor of this fitter's verification"
+    print(f"  {label:52}{sum(ms for _, ms in parts):7.2f} ms")
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=20, help="fits timed, the best kept (constant width: a quarter, "
@@ -245,6 +294,7 @@ def main(argv=None) -> None:
     ap.add_argument("--examples", action="store_true", help="every example profile at 1e-3 and 1e-4 mm: arcs, "
                     "deviation, CPU per fit (with --root: both trees)")
     ap.add_argument("--stages", action="store_true", help="the issue cam's fit timed by stage")
+    ap.add_argument("--floor", action="store_true", help="what the issue cam's verification cannot skip, timed")
     ap.add_argument("--case", type=int, help=argparse.SUPPRESS)
     ap.add_argument("--examples-json", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
@@ -253,6 +303,9 @@ def main(argv=None) -> None:
         return
     if args.stages:
         stages(args.repeat)
+        return
+    if args.floor:
+        floor(args.repeat)
         return
     if args.examples:
         compare_examples(args.root.resolve() if args.root is not None else None)

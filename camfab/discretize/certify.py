@@ -5,18 +5,18 @@
 points) is fixed whatever the curve.  The fit's own acceptance test only needs to know that the true maximum
 is within ``tol``, and a bound on the distance between samples tells how many points guarantee that.
 
-Derivation.  Let ``f(s)`` be the *signed* distance from the curve point at arc length ``s`` to the chain, so
-that ``g = |f|`` is the distance.  A G1 chain of lines and arcs is a C¹ curve whose curvature is piecewise
-constant, at most ``1/r_min``; closer to it than ``r_min`` (and nearer an inner point of it than an open chain's
-ends, which the fit puts on the curve) its signed distance function ``d`` is C¹ with a gradient of length 1 and a
-Hessian of norm at most ``1/(r_min - |d|)`` (the level line at distance ``d`` from an arc of curvature ``k``
-is a concentric arc of curvature ``k/(1 - k·d)``; from a line, a line).  So ``f(s) = d(P(s))`` has
-``f'' = Hess d[P′, P′] + ∇d·P″`` and ``|f''| ≤ K = max|κ_curve| + 1/(r_min - tol)`` (a chain of lines: ``K =
-max|κ_curve|``) wherever ``|f| ≤ tol``; ``d`` is 1-Lipschitz, so between samples ``h`` apart of at most
-``tol`` it stays within ``tol + h/2``, and the bound there is ``1/(r_min - tol - h/2)``, within the stand-in's
-safety factor below of the one used (``h`` is a fraction of a millimetre, ``r_min`` tens of them).  The bound
-is two-sided: ``f`` minus its linear interpolation vanishes at both samples and has a second derivative in
-``[-K, K]``, so it lies within ``K·(s - a)(b - s)/2`` of zero, hence on a sample interval of arc length ``h``::
+Derivation. Let ``f(s)`` be the *signed* distance from the curve point at arc length ``s`` to the chain, so that
+``g = |f|`` is the distance. A G1 chain of lines and arcs is a C¹ curve whose curvature is piecewise constant, at
+most ``1/r_min``; within its reach (``r_min`` at most, less where distant parts of the chain come close; and nearer
+an inner point of it than an open chain's ends, which the fit puts on the curve) its signed distance function ``d``
+is C¹ with a gradient of length 1 and a Hessian of norm at most ``1/(r_min - |d|)`` (the level line at distance
+``d`` from an arc of curvature ``k`` is a concentric arc of curvature ``k/(1 - k·d)``; from a line, a line). So
+``f(s) = d(P(s))`` has ``f'' = Hess d[P′, P′] + ∇d·P″`` and ``|f''| ≤ K = max|κ_curve| + 1/(r_min - tol)`` (a chain
+of lines: ``K = max|κ_curve|``) wherever ``|f| ≤ tol``; ``d`` is 1-Lipschitz, so between samples ``h`` apart of at
+most ``tol`` it stays within ``tol + h/2``, and the bound there is ``1/(r_min - tol - h/2)``, within the stand-in's
+safety factor below of the one used (``h`` is a fraction of a millimetre, ``r_min`` tens of them). The bound is
+two-sided: ``f`` minus its linear interpolation vanishes at both samples and has a second derivative in ``[-K,
+K]``, so it lies within ``K·(s - a)(b - s)/2`` of zero, hence on a sample interval of arc length ``h``::
 
     g(s) ≤ |linear interpolation of the two samples of f| + K·(s - a)(b - s)/2 ≤ max(samples) + K·h²/8.
 
