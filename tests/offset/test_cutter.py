@@ -119,3 +119,21 @@ def test_bad_tool_radius(contact):
         tool_centre_path(contact, -1.0)
     with pytest.raises(ValueError, match="tol"):
         tool_centre_path(contact, 3.0, tol=1.0)
+
+
+@pytest.mark.parametrize("path", sorted(EXAMPLES.glob("*.toml")), ids=lambda p: p.stem)
+def test_point_and_derivative_from_one_evaluation_are_the_curves_own(path):
+    """A profile's and its offsets' ``point_and_derivative`` (one evaluation of the motion for both, which the
+    discretisation's stand-ins use) equal their ``point`` and ``derivative`` bit for bit: the curve's contract
+    (``ParametricCurve``), at random angles, breakpoints and both ends of the period."""
+    for contact in geometry_from_spec(load_design(path)).profiles:
+        if not contact.closed:  # a translating cam's plate outline (no combined evaluation)
+            continue
+        curves = [profile_curve(contact), offset_curve(contact, 3.0), offset_curve(contact, -0.5)]
+        for curve in curves:
+            if curve.point_and_derivative is None:  # a profile with corners (only under --force)
+                continue
+            t = np.concatenate([np.random.default_rng(5).uniform(0.0, curve.period, 2001), curve.breakpoints])
+            p, d = curve.point_and_derivative(t)
+            np.testing.assert_array_equal(p, curve.point(t))
+            np.testing.assert_array_equal(d, curve.derivative(t))
