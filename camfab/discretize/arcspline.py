@@ -234,13 +234,14 @@ def _lay_backward(p1, t1, k, ell, j: int):
     idx = np.arange(ell.size - 1, j + 1, -1)
     if not idx.size:
         return b_starts, b_tans, end_p, end_ang
-    kb, lb = (-k[idx]).tolist(), ell[idx].tolist()
-    f1, f2 = _sinc_factors(-k[idx], ell[idx])
+    k_back = -k[idx]  # (laid along the reversed tangent: the curvature negated)
+    kb, lb = k_back.tolist(), ell[idx].tolist()
+    f1, f2 = _sinc_factors(k_back, ell[idx])
     px, py = float(end_p[0]), float(end_p[1])
     for n, i in enumerate(idx.tolist()):
         ang_s = end_ang - k[i] * ell[i]
         c, sn = math.cos(end_ang), math.sin(end_ang)
-        px, py = _end_of(px, py, -c, -sn, kb[n], lb[n], f1[n], f2[n])  # (along -tb: curvature -k)
+        px, py = _end_of(px, py, -c, -sn, kb[n], lb[n], f1[n], f2[n])
         b_starts.insert(0, np.array([px, py]))
         b_tans.insert(0, np.array([math.cos(ang_s), math.sin(ang_s)]))
         end_ang = ang_s

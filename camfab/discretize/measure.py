@@ -353,7 +353,8 @@ def _fit_curve_to_chain(chain: Chain, curve: ParametricCurve, samples: int, gap:
     neighbours: an upper bound, exact for a chain that follows its curve (any sample left too far only makes the
     certificate fail, and the default measurement runs).  Every local maximum within ``gap`` of the largest is
     refined by nested grids of exact points (by the bound of :mod:`camfab.discretize.certify`
-    only those can hold the true maximum)."""
+    only those can hold the true maximum); with ``bound``, the certificate's ``(K, max |P′|)``, only the brackets
+    that can still hold the largest distance are zoomed into a second time (:func:`_zoom_max`)."""
     ts, _ = sample_nodes(curve, max(int(samples), 8 * chain.n), 8)
     n_t = ts.size - 1
     order = np.argsort(foot, kind="stable")
@@ -376,7 +377,7 @@ def _fit_curve_to_chain(chain: Chain, curve: ParametricCurve, samples: int, gap:
     else:
         lo_t, hi_t = ts[np.maximum(top - 1, 0)], ts[np.minimum(top + 1, n_t)]
     near = ent[top]
-    # (with a bound: a bracket's samples Δt apart miss at most K·(max|P′|·Δt)²/8, certify's gap)
+    # (samples Δt apart miss at most K·(max|P′|·Δt)²/8: certify's gap)
     best_a = _zoom_max(lambda t, rows: _near_entities(chain, points_at(curve, t), near[rows, None], 2), lo_t, hi_t,
                        m=_FIT_ZOOM, per_step=None if bound is None else bound[0] * bound[1] ** 2 / 8.0)
     if best_a.max() > worst_a:

@@ -72,6 +72,7 @@ def profile_curve(contact) -> ParametricCurve:
         log.info("profile: the follower's velocity jumps at %s; the profile is the one the follower makes there",
                  corner_note(contact, corners))
         return cornered_curve(contact, corners)
+
     def both(t):
         s = contact.evaluate_fields(t, ("point", "point_d1"))
         return s["point"], s["point_d1"]
