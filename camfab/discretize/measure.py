@@ -192,6 +192,8 @@ def _zoom_max(f: Callable[[np.ndarray, np.ndarray], np.ndarray], lo: np.ndarray,
             step = u[:, 1] - u[:, 0]
             keep = (best[rows] + per_step * step * step) * (1.0 + 1e-9) >= best.max()
             rows, lo, hi = rows[keep], lo[keep], hi[keep]
+            if not rows.size:
+                break
     return best
 
 
