@@ -18,9 +18,9 @@ from tests.conftest import EXAMPLES
 cKDTree = pytest.importorskip("scipy.spatial").cKDTree
 
 
-def _kdtree_nearest(q, sites, cell, distance, reach=0.0):
+def _kdtree_nearest(q, sites, cell, distance, reach=0.0, cells=None):
     """The measurement's search before the grid: the 16 nearest sites by a k-d tree, every site for a point
-    the tree's candidates do not settle (`cell` is unused)."""
+    the tree's candidates do not settle (`cell` and `cells` are unused)."""
     q = np.asarray(q, dtype=float).reshape(-1, 2)
     m = sites.shape[0]
     k = min(16, m)
