@@ -18,8 +18,8 @@ both fits' arc counts and deviations (and whether the arcs are the same bit for 
 lists per fit the arcs, the measured deviation and the CPU time; with ``--root`` both trees' fits side by side
 (arcs before/after, whether they are the same bit for bit) and the totals.
 
-``--floor`` times what any fit verified by measurement, as this one is, must spend on the issue cam whatever its
-search: the Hermite stand-in's exact evaluations (points and derivatives at its nodes, points at its midpoints), the
+``--floor`` times what this fit's verification by measurement cannot skip on the issue cam, whatever its search:
+the Hermite stand-in's exact evaluations (points and derivatives at its nodes, points at its midpoints), the
 certificate's exact curve samples (one evaluation at the count the certificate asks for) and their distances to the
 fitted chain (each sample against its own entity and the two beside it, as the fit's measurement takes them).
 

@@ -225,7 +225,7 @@ def _signed_area(segs: Sequence[Segment]) -> float:
     for s in segs:
         (ax, ay), (bx, by) = s.start, s.end
         total += 0.5 * (ax * by - bx * ay)
-        if s.center is not None:
+        if s.is_arc:
             theta, r = s.sweep, s.radius
             total += 0.5 * r * r * (theta - math.sin(theta))
     return total

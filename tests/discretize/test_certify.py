@@ -166,11 +166,24 @@ def test_refinement_skips_brackets_the_bound_rules_out():
 
 
 @pytest.mark.parametrize("factor", [1.0, 1.0 + 2e-5])
-def test_fit_measurement_with_its_bound_is_the_same(factor):
+def test_fit_measurement_with_its_bound_is_the_same(factor, monkeypatch):
     """The fit's measurement given the certificate's ``(K, max|P′|)`` (it then zooms only into the brackets that
-    can hold the largest distance) reports exactly what it reports without: on the fit and on a chain 1–2.5 tol
-    off its curve."""
+    can hold the largest distance) reports exactly what it reports without, on the fit and on a chain 1–2.5 tol
+    off its curve, and measures fewer curve points doing it."""
+    import camfab.discretize.measure as measure_mod
+
     chain, curve, sur, (K, vmax), n, gap = _fit_measurement_case(factor)
-    plain, bounded = measure_fit(chain, curve, sur, n, gap), measure_fit(chain, curve, sur, n, gap, bound=(K, vmax))
+    points = []
+    near = measure_mod._near_entities
+
+    def counted(ch, q, ent, reach=1):
+        points.append(q.size // 2)
+        return near(ch, q, ent, reach)
+
+    monkeypatch.setattr(measure_mod, "_near_entities", counted)
+    plain = measure_fit(chain, curve, sur, n, gap)
+    plain_points, points[:] = sum(points), []
+    bounded = measure_fit(chain, curve, sur, n, gap, bound=(K, vmax))
     assert (bounded.max, bounded.curve_to_entities, bounded.entities_to_curve, bounded.at_param) == \
         (plain.max, plain.curve_to_entities, plain.entities_to_curve, plain.at_param)
+    assert sum(points) < plain_points  # the second zoom level left out for most brackets
