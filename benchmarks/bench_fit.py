@@ -243,20 +243,21 @@ def floor(repeat: int) -> None:
     """CPU of the verification's unavoidable parts on the issue cam (module notes, ``--floor``), mean of ``repeat``."""
     import numpy as np
 
-    from camfab.discretize.certify import CERTIFY_SHARE, curvature_bound, samples_for
+    from camfab.discretize.certify import CERTIFY_SHARE, LocalBound, curvature_bound
     from camfab.discretize.curve import points_at
-    from camfab.discretize.measure import _near_entities
-    from camfab.discretize.surrogate import HermiteSurrogate, fit_surrogate, sample_nodes
+    from camfab.discretize.measure import _near_entities, fit_chain_to_curve
+    from camfab.discretize.surrogate import HermiteSurrogate, fit_surrogate
 
     curve = issue_cam_curve()
     fit = arcs(curve, tol=1e-3)
     chain = fit.chain()
     sur, _ = fit_surrogate(curve, 1e-3)
-    K, vmax = curvature_bound(sur, chain, 1e-3)
-    n = samples_for(K, vmax, curve.period, CERTIFY_SHARE * 1e-3)
-    assert n is not None
-    t, _ = sample_nodes(curve, max(n, 8 * chain.n), 8)
-    t = t[:-1]
+    K, _ = curvature_bound(sur, chain, 1e-3)
+    # the certificate's samples: the local bound's nodes (the entities' feet from the chain-to-curve half)
+    foot = fit_chain_to_curve(chain, sur)[2]
+    nodes = LocalBound(sur, chain, K, foot).nodes(CERTIFY_SHARE * 1e-3, 8 * chain.n)
+    assert nodes is not None
+    t = nodes[:-1]
     pts = points_at(curve, t)
     # each sample's entity: the chain's entities by their start's nearest sample (the fit's measurement takes them
     # from its projected feet; any assignment costs the same)

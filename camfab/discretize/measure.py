@@ -33,6 +33,12 @@ _POLISH_ROUNDS = 6
 #: points of each nested grid of :func:`measure_fit`'s refinement (two levels: the peak's bracket shrinks to 1/64
 #: of the sample spacing, its value within ~10⁻⁸ of tol of the peak's on the examples)
 _FIT_ZOOM = 17
+#: nested grids of the refinement with the local bound: its samples are about ten times sparser, so one level more
+#: brings a peak's bracket to a fraction of the spacing the two levels reached before
+_LOCAL_LEVELS = 3
+#: how much farther than its nearest point (mm) a curve sample may be from an entity's joint for the local bound to
+#: read it against the entity across that joint (:func:`_interval_ends`)
+_JOINT_SLACK = 1e-12
 
 
 def as_chain(entities, closed: bool = True) -> Chain:
@@ -177,7 +183,8 @@ def _zoom_max(f: Callable[[np.ndarray, np.ndarray], np.ndarray], lo: np.ndarray,
     samples plus that bound stay below the largest value found so far is not zoomed into further.  The overall
     maximum and the bracket holding it are then the same bit for bit: such a bracket holds no value reaching
     the largest, so neither does any sample a further level would take (a 1e-9 relative margin covers the
-    rounding of the bound and of the distances); the entry of a bracket left out is its last level's maximum."""
+    rounding of the bound and of the distances); the entry of a bracket left out is its last level's maximum.
+    ``per_step`` may also be an array, one value per bracket."""
     best = np.full(lo.size, -np.inf)
     grid = np.linspace(0.0, 1.0, m)
     rows = np.arange(lo.size)
@@ -190,7 +197,8 @@ def _zoom_max(f: Callable[[np.ndarray, np.ndarray], np.ndarray], lo: np.ndarray,
         lo, hi = u[here, np.maximum(j - 1, 0)], u[here, np.minimum(j + 1, m - 1)]
         if per_step is not None and level + 1 < levels:
             step = u[:, 1] - u[:, 0]
-            keep = (best[rows] + per_step * step * step) * (1.0 + 1e-9) >= best.max()
+            ps = per_step if np.ndim(per_step) == 0 else np.asarray(per_step)[rows]
+            keep = (best[rows] + ps * step * step) * (1.0 + 1e-9) >= best.max()
             rows, lo, hi = rows[keep], lo[keep], hi[keep]
             if not rows.size:
                 break
@@ -307,10 +315,13 @@ def measure_deviation(entities, curve: ParametricCurve, *, samples: int = 20000,
                      entities_to_curve=worst_b, at_param=at, at_point=points_at(curve, np.array([at]))[0])
 
 
-def _near_entities(chain: Chain, q: np.ndarray, ent: np.ndarray, reach: int = 1) -> np.ndarray:
+def _near_entities(chain: Chain, q: np.ndarray, ent: np.ndarray, reach: int = 1, cyclic: bool = True,
+                   with_entity: bool = False):
     """Distance from each point ``q`` ``(..., 2)`` to the nearest of the entities ``ent - reach … ent + reach``
-    (``ent`` of ``q``'s leading shape, or broadcasting to it; cyclic): an upper bound of its distance to the
-    chain, exact when the nearest entity is among them.
+    (``ent`` of ``q``'s leading shape, or broadcasting to it; cyclic, or clipped to the chain's first and last
+    entities when ``cyclic`` is false): an upper bound of its distance to the chain, exact when the nearest entity
+    is among them.  ``with_entity``: also which of them is the nearest (the first of ``ent``, ``ent - 1``, ``ent + 1``,
+    … among equal distances), as a second array.
 
     The hot loop of :func:`measure_fit` (~10⁴ points × 3 entities, several times per fit): the chain's entities
     are laid out once as a table of contiguous columns, padded by ``reach`` entities at both ends, so that the
@@ -323,7 +334,8 @@ def _near_entities(chain: Chain, q: np.ndarray, ent: np.ndarray, reach: int = 1)
     ent = np.broadcast_to(ent, q.shape[:-1]).ravel()
     if ent.size and (ent.min() < 0 or ent.max() >= n):
         ent = ent % n
-    slots = np.arange(-reach, n + reach) % n  # the entity of every padded slot
+    slots = np.arange(-reach, n + reach)  # the entity of every padded slot
+    slots = slots % n if cyclic else np.clip(slots, 0, n - 1)
     table = np.stack([chain.start[:, 0], chain.start[:, 1], chain.tangent[:, 0], chain.tangent[:, 1],
                       chain.curvature, chain.length, chain.end[:, 0], chain.end[:, 1]])[:, slots]
     # slot of entity ent + off is ent + off + reach; the row of ``ent`` itself first (see below)
@@ -338,41 +350,112 @@ def _near_entities(chain: Chain, q: np.ndarray, ent: np.ndarray, reach: int = 1)
     # the distance to ``ent`` first: a neighbour's end distance can only matter when below it, and where the point
     # is far from that end (nearly everywhere) its two hypot are skipped (local_distance's ``above``)
     best = local_distance(x[0], y[0], k[0], length[0], w0[0], w1[0], f0[0], f1[0])
+    at = idx[0]
     if reach:
         rest = local_distance(x[1:].ravel(), y[1:].ravel(), k[1:].ravel(), length[1:].ravel(), w0[1:].ravel(),
                               w1[1:].ravel(), f0[1:].ravel(), f1[1:].ravel(), np.tile(best, 2 * reach))
-        for row in rest.reshape(2 * reach, -1):
+        for r, row in enumerate(rest.reshape(2 * reach, -1)):
+            if with_entity:  # (a neighbour's skipped end distance is above ``best``: never taken)
+                at = np.where(row < best, idx[r + 1], at)
             # distances are never -0 (nor zeros of mixed signs): the minimum is the same in any order
             best = np.minimum(best, row)
+    if with_entity:
+        return best.reshape(q.shape[:-1]), slots[at].reshape(q.shape[:-1])
     return best.reshape(q.shape[:-1])
 
 
-def _fit_curve_to_chain(chain: Chain, curve: ParametricCurve, samples: int, gap: float,
-                        foot: np.ndarray, bound: tuple[float, float] | None = None) -> tuple[float, float]:
-    """Largest distance from the exact curve to the chain and its parameter, from one call of the curve at the
-    nodes :func:`measure_deviation` takes for ``samples``.  A sample's distance is taken to the entity whose
-    start's foot ``foot`` (curve parameters, one per entity) comes last before it and to that entity's two
-    neighbours: an upper bound, exact for a chain that follows its curve (any sample left too far only makes the
-    certificate fail, and the default measurement runs).  Every local maximum within ``gap`` of the largest is
-    refined by nested grids of exact points (by the bound of :mod:`camfab.discretize.certify`
-    only those can hold the true maximum); with ``bound``, the certificate's ``(K, max |P′|)``, only the brackets
-    that can still hold the largest distance are zoomed into a second time (:func:`_zoom_max`)."""
-    ts, _ = sample_nodes(curve, max(int(samples), 8 * chain.n), 8)
-    n_t = ts.size - 1
+def owners(foot: np.ndarray, period: float) -> Callable[[np.ndarray], np.ndarray]:
+    """The entity a curve parameter belongs to: the one whose start's foot ``foot`` (curve parameters, one per
+    entity) comes last before it (cyclic)."""
     order = np.argsort(foot, kind="stable")
+    sorted_foot = foot[order]
+    n = foot.size
 
     def owner(t):
-        return order[(np.searchsorted(foot[order], np.mod(t, curve.period), side="right") - 1) % chain.n]
+        return order[(np.searchsorted(sorted_foot, np.mod(t, period), side="right") - 1) % n]
 
+    return owner
+
+
+def _interval_ends(chain: Chain, q: np.ndarray, d: np.ndarray, nearest: np.ndarray, n_t: int, closed: bool
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """For the ``n_t`` intervals between the curve samples ``q`` (a closed curve's last one back to the first):
+    ``(d0, d1, e0, e1)``, the distances at both ends and the entities from ``e0`` to ``e1`` the local bound reads.
+
+    A sample's entity is its nearest; where its nearest point is that entity's joint with the next entity inside
+    the interval (its start at the interval's end, its end at the interval's start, to :data:`_JOINT_SLACK`), the
+    entity across the joint is as near, and it is taken instead (its distance ``_JOINT_SLACK`` more): an interval
+    ending on the joint between two arcs of different curvature then reads only the arc it runs along."""
+    d0, e0 = d[:n_t], nearest[:n_t]
+    qa, qb = q[:n_t], (q[1:] if d.size > n_t else np.roll(q, -1, axis=0))
+    d1, e1 = (d[1:], nearest[1:]) if d.size > n_t else (np.roll(d, -1), np.roll(nearest, -1))
+    n = chain.n
+    span = (e1 - e0) % n if closed else e1 - e0
+    b_start = chain.start[e1]
+    before = (span >= 1) & (np.hypot(qb[:, 0] - b_start[:, 0], qb[:, 1] - b_start[:, 1]) <= d1 + _JOINT_SLACK)
+    e1 = np.where(before, (e1 - 1) % n, e1)
+    d1 = np.where(before, d1 + _JOINT_SLACK, d1)
+    span = span - before
+    a_end = chain.end[e0]
+    after = (span >= 1) & (np.hypot(qa[:, 0] - a_end[:, 0], qa[:, 1] - a_end[:, 1]) <= d0 + _JOINT_SLACK)
+    e0 = np.where(after, (e0 + 1) % n, e0)
+    d0 = np.where(after, d0 + _JOINT_SLACK, d0)
+    return d0, d1, e0, e1
+
+
+def fit_curve_to_chain(chain: Chain, curve: ParametricCurve, samples: int, gap: float,
+                       foot: np.ndarray, bound: tuple[float, float] | None = None, local=None,
+                       nodes: np.ndarray | None = None) -> tuple[float, float, float]:
+    """Largest distance from the exact curve to the chain, its parameter, and (with ``local``) the certified bound
+    of the true maximum, from one call of the curve at the nodes :func:`measure_deviation` takes for ``samples``.
+
+    A sample's distance is taken to the entity whose start's foot ``foot`` (curve parameters, one per entity) comes
+    last before it and to that entity's two neighbours: an upper bound, exact for a chain that follows its curve
+    (any sample left too far only makes the certificate fail, and the default measurement runs).  Without
+    ``local`` every local maximum within ``gap`` of the largest is refined by nested grids of exact points (by the
+    bound of :mod:`camfab.discretize.certify` only those can hold the true maximum); with ``bound``, the
+    certificate's ``(K, max |P′|)``, only the brackets that can still hold the largest distance are zoomed into a
+    second time (:func:`_zoom_max`); the third value is inf.
+
+    ``local`` (a :class:`~camfab.discretize.certify.LocalBound`) gives every sample interval its own bound ``c_i``
+    (the distance there is at most the larger sample plus ``c_i·Δt²``): the third value is the largest such bound,
+    only the local maxima whose bracket can exceed the largest sample are refined (each with its own ``c_i``), and a
+    refined value above its bracket's bound (the bound was wrong) makes the third value inf.  ``nodes``: the sample
+    parameters instead (every breakpoint and the period among them, increasing)."""
+    ts = sample_nodes(curve, max(int(samples), 8 * chain.n), 8)[0] if nodes is None else nodes
+    n_t = ts.size - 1
+    owner = owners(foot, curve.period)
     t_a = ts[:-1] if curve.closed else ts
     ent = owner(t_a)
-    d_a = _near_entities(chain, points_at(curve, t_a), ent)
+    # (the local bound reads the entities around a sample's own: an open chain's window does not wrap)
+    cyclic = curve.closed or local is None
+    q = points_at(curve, t_a)
+    if local is None:
+        d_a = _near_entities(chain, q, ent, 1, cyclic)
+    else:
+        d_a, nearest = _near_entities(chain, q, ent, 1, cyclic, with_entity=True)
     i_a = int(np.argmax(d_a))
     worst_a, at_a = float(d_a[i_a]), float(ts[i_a])
     top = _local_maxima(d_a, curve.closed, d_a.size)
-    top = top[d_a[top] >= worst_a - gap]
+    certified = np.inf
+    per_step = None if bound is None else bound[0] * bound[1] ** 2 / 8.0
+    if local is not None:
+        d0, d1, e0, e1 = _interval_ends(chain, q, d_a, nearest, n_t, curve.closed)
+        c = local.per_step(ts, d0, d1, e0, e1)
+        dt = ts[1:] - ts[:-1]
+        interval = np.maximum(d0, d1) + c * dt * dt  # each sample interval's bound
+        certified = float(interval.max())
+        # a local maximum's bracket is the two intervals beside it (one at an open curve's ends)
+        before = (top - 1) % n_t if curve.closed else np.maximum(top - 1, 0)
+        after = np.minimum(top, n_t - 1)
+        reach = np.maximum(interval[before], interval[after])
+        keep = reach * (1.0 + 1e-9) >= worst_a
+        top, reach = top[keep], reach[keep]
+        per_step = np.maximum(c[before], c[after])[keep]
+    else:
+        top = top[d_a[top] >= worst_a - gap]
     if not top.size:
-        return worst_a, at_a
+        return worst_a, at_a, certified
     if curve.closed:
         lo_t = np.where(top > 0, ts[top - 1], ts[n_t - 1] - curve.period)
         hi_t = ts[top + 1]
@@ -380,16 +463,18 @@ def _fit_curve_to_chain(chain: Chain, curve: ParametricCurve, samples: int, gap:
         lo_t, hi_t = ts[np.maximum(top - 1, 0)], ts[np.minimum(top + 1, n_t)]
     near = ent[top]
     # (samples Δt apart miss at most K·(max|P′|·Δt)²/8: certify's gap)
-    best_a = _zoom_max(lambda t, rows: _near_entities(chain, points_at(curve, t), near[rows, None], 2), lo_t, hi_t,
-                       m=_FIT_ZOOM, per_step=None if bound is None else bound[0] * bound[1] ** 2 / 8.0)
+    best_a = _zoom_max(lambda t, rows: _near_entities(chain, points_at(curve, t), near[rows, None], 2, cyclic),
+                       lo_t, hi_t, levels=2 if local is None else _LOCAL_LEVELS, m=_FIT_ZOOM, per_step=per_step)
+    if local is not None and np.any(best_a > reach * (1.0 + 1e-9) + 1e-15):
+        certified = np.inf  # a refined distance above its bracket's bound: no certificate
     if best_a.max() > worst_a:
         worst_a = float(best_a.max())
         at_a = float(np.mod(0.5 * (lo_t + hi_t)[best_a.argmax()], curve.period))
-    return worst_a, at_a
+    return worst_a, at_a, certified
 
 
-def _fit_chain_to_curve(chain: Chain, sur: HermiteSurrogate, per_entity: int, refine_top: int
-                        ) -> tuple[float, float, np.ndarray]:
+def fit_chain_to_curve(chain: Chain, sur: HermiteSurrogate, per_entity: int = 17, refine_top: int = 8
+                       ) -> tuple[float, float, np.ndarray]:
     """Largest distance from the chain to the exact curve, its foot's parameter, and the foot of every entity's
     start: entity samples projected on the fit's stand-in ``sur`` (Newton on its cubics), each distance taken to
     the exact curve point at the foot (one call: upper bounds); the ``refine_top`` worst local maxima refined by
@@ -403,6 +488,13 @@ def _fit_chain_to_curve(chain: Chain, sur: HermiteSurrogate, per_entity: int, re
     return worst_b, at_b, t_b.reshape(chain.n, per_entity)[:, 0]
 
 
+def fit_deviation(curve: ParametricCurve, worst_a: float, at_a: float, worst_b: float, at_b: float) -> Deviation:
+    """The :class:`Deviation` of the two directions' maxima and their parameters (curve to chain, chain to curve)."""
+    at = at_a if worst_a >= worst_b else at_b
+    return Deviation(max=max(worst_a, worst_b), curve_to_entities=worst_a,
+                     entities_to_curve=worst_b, at_param=at, at_point=points_at(curve, np.array([at]))[0])
+
+
 def measure_fit(chain: Chain, curve: ParametricCurve, sur: HermiteSurrogate, samples: int, gap: float, *,
                 per_entity: int = 17, refine_top: int = 8, bound: tuple[float, float] | None = None) -> Deviation:
     """The fit's own two-way measurement of ``chain`` on its stand-in ``sur`` (a :func:`fit_surrogate` result,
@@ -411,17 +503,15 @@ def measure_fit(chain: Chain, curve: ParametricCurve, sur: HermiteSurrogate, sam
     Curve to chain as :func:`measure_deviation` with ``samples`` (the same exact sample nodes, one call of the
     curve), refining every sampled local maximum within ``gap`` (the certificate's ``K·h²/8``) of the largest
     instead of a fixed number; chain to curve by projection on ``sur`` instead of a stand-in built from new
-    exact samples and derivatives, without polishing (:func:`_fit_chain_to_curve`).  About six calls of the exact
+    exact samples and derivatives, without polishing (:func:`fit_chain_to_curve`).  About six calls of the exact
     curve instead of ~25.  ``bound``: the certificate's ``(K, max |P′|)`` that gave ``gap``, when known; the
     refinement then zooms only into the brackets that can hold the largest distance (:func:`_zoom_max`: the same
     result)."""
     if chain.n == 0:
         raise GeometryError("no entities to measure: give at least one line or arc")
-    worst_b, at_b, foot = _fit_chain_to_curve(chain, sur, per_entity, refine_top)
-    worst_a, at_a = _fit_curve_to_chain(chain, curve, samples, gap, foot, bound)
-    at = at_a if worst_a >= worst_b else at_b
-    return Deviation(max=max(worst_a, worst_b), curve_to_entities=worst_a,
-                     entities_to_curve=worst_b, at_param=at, at_point=points_at(curve, np.array([at]))[0])
+    worst_b, at_b, foot = fit_chain_to_curve(chain, sur, per_entity, refine_top)
+    worst_a, at_a, _ = fit_curve_to_chain(chain, curve, samples, gap, foot, bound)
+    return fit_deviation(curve, worst_a, at_a, worst_b, at_b)
 
 
 def max_deviation(entities, curve: ParametricCurve, **kwargs) -> float:

@@ -244,7 +244,8 @@ def _exact_arcs(curve: ParametricCurve, sur: HermiteSurrogate, p: int):
     _, _, theta = span_model(sur, span.segs, 33)
     n = max(1, math.ceil(abs(theta[-1] - theta[0]) / (0.5 * math.pi)))
     p0, t0, p1, _ = span_ends(sur, span)
-    pts = np.concatenate([[p0], points_at(curve, lo + (hi - lo) * np.arange(1, n) / n).reshape(-1, 2), [p1]])
+    inner = points_at(curve, lo + (hi - lo) * np.arange(1, n) / n).reshape(-1, 2) if n > 1 else np.empty((0, 2))
+    pts = np.concatenate([[p0], inner, [p1]])  # (a quarter turn or less: no inner point, no call of the curve)
     S, TT, K, L = [], [], [], []
     tan = t0
     for i in range(n):

@@ -26,7 +26,15 @@ from __future__ import annotations
 import numpy as np
 
 from ..geom2d import cross, dot
-from .certify import CERTIFY_SHARE, DEFAULT_SAMPLES, curvature_bound, sample_gap, samples_for
+from .certify import (
+    CERTIFY_SHARE,
+    DEFAULT_SAMPLES,
+    curvature_bound,
+    local_certificate,
+    sample_gap,
+    samples_for,
+    standin_samples,
+)
 from .curve import ParametricCurve
 from .measure import as_chain, measure_deviation, measure_fit
 from .results import Deviation
@@ -70,8 +78,12 @@ def measure_within(entities, curve: ParametricCurve, tol: float) -> Deviation:
     sur, err = fit_surrogate(curve, tol)
     if not err <= tol / SURROGATE_FRACTION:
         return measure_deviation(chain, curve)
-    K, vmax = curvature_bound(sur, chain, tol)
+    samples = standin_samples(sur)
+    K, vmax = curvature_bound(sur, chain, tol, samples)
     gap = CERTIFY_SHARE * tol
+    dev = local_certificate(chain, curve, sur, tol, gap, K, vmax, samples)
+    if dev is not None:
+        return dev
     while gap >= MIN_GAP_SHARE * tol:
         n = samples_for(K, vmax, curve.period, gap)
         if n is None or n >= DEFAULT_SAMPLES:
