@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
 
 import camfab
 import camfab.discretize.measure as measure_mod
@@ -30,6 +31,7 @@ from camfab.formats import load_design
 from camfab.offset.cutter import profile_curve
 
 from .test_certify import _scaled, issue15_curve
+from .test_discretize import CAM_CV, CURVES, OPEN, cam, cam_programs
 
 EXAMPLES = Path(camfab.__file__).resolve().parent / "examples"
 
@@ -248,3 +250,30 @@ def test_fine_fits_are_certified_without_the_default_measurement(label, monkeypa
     assert res.max_deviation <= 1e-4
     independent = measure_deviation(chain, curve, samples=200_000)
     assert res.max_deviation == pytest.approx(independent.max, rel=1e-5)
+
+
+@settings(max_examples=15, deadline=None)
+@given(cam_programs())
+def test_every_interval_bound_holds_on_random_cams(case):
+    """Random cams (one or two rises of the common laws, dwells, a return; base radius 25–60 mm; tol 1e-2, 1e-3 or
+    1e-4 mm): every sample interval's bound holds against 16 exact distances inside it, and bounds the fit within
+    tol."""
+    rows, base, tol = case
+    curve = cam(rows, base)
+    chain, _, ts, top, _, c = _local_case(curve, tol)
+    _, bound_max, _ = _dense_check(curve, chain, ts, top, c)
+    assert bound_max <= tol
+
+
+SHAPES = {**CURVES, "cam_cv": lambda: cam(CAM_CV), **OPEN}
+
+
+@pytest.mark.parametrize("name", sorted(SHAPES))
+@pytest.mark.parametrize("tol", [1e-3, 1e-4])
+def test_every_interval_bound_holds_on_the_test_shapes(name, tol):
+    """The discretisation tests' shapes (a circle, an ellipse, a limaçon, a cam, closed and open curves with true
+    tangent kinks, whose chains have corners there): every sample interval's bound holds against 16 exact distances
+    inside it (a kink is a breakpoint, so a sample, and no interval straddles it)."""
+    curve = SHAPES[name]()
+    chain, _, ts, top, _, c = _local_case(curve, tol)
+    _dense_check(curve, chain, ts, top, c)
