@@ -104,8 +104,8 @@ DEFAULT_SAMPLES = 20000
 #: the sampled curvature and speed maxima of the stand-in are enlarged by this factor (their maxima between the
 #: samples: the stand-in has thousands of nodes over a smooth curve); the local bound is enlarged by it too
 _SAFETY = 1.25
-#: the local certificate takes this many times the samples its estimate asks for (the estimate reads one window
-#: per stand-in interval, a sample interval may straddle two)
+#: the local certificate takes this many times the samples its estimate asks for (the estimate reads the entities
+#: owning a stand-in interval's ends; a sample interval reads its samples' nearest ones)
 _LOCAL_MARGIN = 1.25
 #: fixed-point rounds of the local bound (its corrections depend on the bound itself; module notes)
 _LOCAL_ROUNDS = 3

@@ -382,22 +382,23 @@ def _interval_ends(chain: Chain, q: np.ndarray, d: np.ndarray, nearest: np.ndarr
     """For the ``n_t`` intervals between the curve samples ``q`` (a closed curve's last one back to the first):
     ``(d0, d1, e0, e1)``, the distances at both ends and the entities from ``e0`` to ``e1`` the local bound reads.
 
-    A sample's entity is its nearest; where its nearest point is that entity's joint with the next entity inside
-    the interval (its start at the interval's end, its end at the interval's start, to :data:`_JOINT_SLACK`), the
-    entity across the joint is as near, and it is taken instead (its distance ``_JOINT_SLACK`` more): an interval
-    ending on the joint between two arcs of different curvature then reads only the arc it runs along."""
+    A sample's entity is its nearest; where the sample is as near (to :data:`_JOINT_SLACK`) a point of the entity on
+    the interval's side of it (the end of the one before, at the interval's end; the start of the one after, at its
+    start), that entity is taken instead, its distance ``_JOINT_SLACK`` more: an interval ending on the joint between
+    two arcs of different curvature then reads only the arc it runs along."""
     d0, e0 = d[:n_t], nearest[:n_t]
     qa, qb = q[:n_t], (q[1:] if d.size > n_t else np.roll(q, -1, axis=0))
     d1, e1 = (d[1:], nearest[1:]) if d.size > n_t else (np.roll(d, -1), np.roll(nearest, -1))
     n = chain.n
     span = (e1 - e0) % n if closed else e1 - e0
-    b_start = chain.start[e1]
-    before = (span >= 1) & (np.hypot(qb[:, 0] - b_start[:, 0], qb[:, 1] - b_start[:, 1]) <= d1 + _JOINT_SLACK)
+    # the end of the entity before e1 (the joint, to rounding): no farther than the nearest point plus the slack
+    joint = chain.end[(e1 - 1) % n]
+    before = (span >= 1) & (np.hypot(qb[:, 0] - joint[:, 0], qb[:, 1] - joint[:, 1]) <= d1 + _JOINT_SLACK)
     e1 = np.where(before, (e1 - 1) % n, e1)
     d1 = np.where(before, d1 + _JOINT_SLACK, d1)
     span = span - before
-    a_end = chain.end[e0]
-    after = (span >= 1) & (np.hypot(qa[:, 0] - a_end[:, 0], qa[:, 1] - a_end[:, 1]) <= d0 + _JOINT_SLACK)
+    joint = chain.start[(e0 + 1) % n]  # the start of the entity after e0
+    after = (span >= 1) & (np.hypot(qa[:, 0] - joint[:, 0], qa[:, 1] - joint[:, 1]) <= d0 + _JOINT_SLACK)
     e0 = np.where(after, (e0 + 1) % n, e0)
     d0 = np.where(after, d0 + _JOINT_SLACK, d0)
     return d0, d1, e0, e1

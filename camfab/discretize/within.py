@@ -7,6 +7,9 @@ flattened STL outline, chords of large arcs) within ``tol`` of the curve, and by
 certificate answers (:mod:`camfab.discretize.certify`, derivation there): the curve's stand-in within ``tol/200``
 (:func:`~camfab.discretize.surrogate.fit_surrogate`), the curve sampled just densely enough that the
 certificate's gap ``K·h²/8`` is 5 % of ``tol``, and the measurement accepted only when ``measured + gap ≤ tol``.
+The local certificate (:class:`~camfab.discretize.certify.LocalBound`: each sample interval's gap from the
+curvature difference between the curve and the entities there, the samples where that is large) is tried first;
+the global one is what this paragraph describes.
 A chain measured closer than ``tol`` whose gap leaves no room (a flattened outline at 95 % of ``tol``) is
 measured once more with the gap half the room left (:data:`MIN_GAP_SHARE` of ``tol`` at least: a bounded number
 of samples).  When no certificate holds (a chain farther than ``tol``, an arc tighter than ``tol``) the full
@@ -67,9 +70,9 @@ def measure_within(entities, curve: ParametricCurve, tol: float) -> Deviation:
     Returns
     -------
     Deviation
-        The sampled maximum when the certificate proves the true maximum within ``tol`` (it is then below the
-        true maximum by at most 5 % of ``tol``); otherwise :func:`measure_deviation`'s full measurement, which
-        the caller compares with ``tol`` as before.
+        The sampled maximum when a certificate proves the true maximum within ``tol`` (it is then below the
+        true maximum by at most the certificate's gap: about 5 % of ``tol``); otherwise :func:`measure_deviation`'s
+        full measurement, which the caller compares with ``tol`` as before.
     """
     tol = validate_tol(tol)
     chain = as_chain(entities, curve.closed)
