@@ -26,6 +26,8 @@ __all__ = ["SPLINE_SPAN", "Span", "span_shape", "span_density", "span_ends", "cu
 SPLINE_SPAN = 40
 #: a breakpoint whose one-sided tangents differ by less than this (radians) is G1 (arcs may run across it)
 _G1_RAD = 1e-6
+#: one-piece stretches from which their shapes are made at once (:func:`single_piece_shapes`)
+_BATCH_SHAPES = 8
 
 
 def span_shape(sur: HermiteSurrogate, segs, n: int = 257):
@@ -45,6 +47,46 @@ def span_shape(sur: HermiteSurrogate, segs, n: int = 257):
         ps.append(np.full(t.size, seg[0]))
         s_off += float(s0[-1])
     return tuple(np.concatenate(a) for a in (ts, ss, dks, ks, ps))
+
+
+def _gradient_rows(f: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """``np.gradient(f[i], x[i])`` of every row ``i`` (first-order edges), operation for operation as numpy's: the
+    centred formula for unequal steps, its uniform-step form on a row whose steps are all equal."""
+    dx = x[:, 1:] - x[:, :-1]
+    dx1, dx2 = dx[:, :-1], dx[:, 1:]
+    out = np.empty_like(f)
+    a = -(dx2) / (dx1 * (dx1 + dx2))
+    b = (dx2 - dx1) / (dx1 * dx2)
+    c = dx1 / (dx2 * (dx1 + dx2))
+    out[:, 1:-1] = a * f[:, :-2] + b * f[:, 1:-1] + c * f[:, 2:]
+    even = np.flatnonzero((dx == dx[:, :1]).all(axis=1))
+    if even.size:
+        out[even, 1:-1] = (f[even, 2:] - f[even, :-2]) / (2.0 * dx[even, :1])
+    out[:, 0] = (f[:, 1] - f[:, 0]) / dx[:, 0]
+    out[:, -1] = (f[:, -1] - f[:, -2]) / dx[:, -1]
+    return out
+
+
+def single_piece_shapes(sur: HermiteSurrogate, segs: list, n: int = 257) -> list:
+    """:func:`span_shape` of every one-piece span ``[(piece, lo, hi)]`` of ``segs`` (one ``(piece, lo, hi)`` each) at
+    once: the same values bit for bit (every operation of :func:`~camfab.discretize.spanmodel.span_model` and
+    :func:`span_shape` elementwise along the rows, numpy's gradient by :func:`_gradient_rows`), for a curve of
+    hundreds of pieces (a knot table) whose spans would each cost their own few dozen small numpy calls."""
+    piece = np.array([sg[0] for sg in segs])
+    lo = np.array([sg[1] for sg in segs], dtype=float)
+    hi = np.array([sg[2] for sg in segs], dtype=float)
+    t = np.linspace(lo, hi, n, axis=1)
+    tm = 0.5 * (t[:, :-1] + t[:, 1:])
+    d = sur.derivative(t, piece[:, None])
+    dm = sur.derivative(tm, piece[:, None])
+    sp, spm = np.hypot(d[..., 0], d[..., 1]), np.hypot(dm[..., 0], dm[..., 1])
+    inc = (t[:, 1:] - t[:, :-1]) / 6.0 * (sp[:, :-1] + 4 * spm + sp[:, 1:])
+    s0 = 0.0 + np.concatenate([np.zeros((t.shape[0], 1)), np.cumsum(inc, axis=1)], axis=1)
+    theta = np.unwrap(np.arctan2(d[..., 1], d[..., 0]), axis=1)
+    kappa = _gradient_rows(theta, s0)
+    dk = np.abs(_gradient_rows(kappa, s0))
+    s = s0 + 0.0
+    return [(t[i], s[i], dk[i], np.abs(kappa[i]), np.full(n, piece[i])) for i in range(t.shape[0])]
 
 
 def span_density(sur: HermiteSurrogate, segs, target: float, n: int = 257, shape=None):
@@ -161,10 +203,12 @@ def _anchors(curve: ParametricCurve, sur: HermiteSurrogate, tol: float, anchored
     return anchors, exact
 
 
-def _split_stretch(sur: HermiteSurrogate, segs: list, target: float) -> tuple[list, tuple | None]:
+def _split_stretch(sur: HermiteSurrogate, segs: list, target: float, shape: tuple | None = None
+                   ) -> tuple[list, tuple | None]:
     """A stretch ``segs`` cut into equal shares of about :data:`SPLINE_SPAN` arcs (never on a junction):
-    the ``[(piece, lo, hi), ...]`` of every share, and the stretch's :func:`span_shape` when it is one share."""
-    shape = span_shape(sur, segs)
+    the ``[(piece, lo, hi), ...]`` of every share, and the stretch's :func:`span_shape` (``shape``, when already
+    made) when it is one share."""
+    shape = span_shape(sur, segs) if shape is None else shape
     t, s0, density, piece = span_density(sur, segs, target, shape=shape)
     cum = cumtrapz(density, s0)
     m = max(1, math.ceil(1.08 * float(cum[-1]) / SPLINE_SPAN))
@@ -204,22 +248,29 @@ def cut_spans(curve: ParametricCurve, sur: HermiteSurrogate, target: float, tol:
     corners = [i for i, t in enumerate(ts) if anchors[t][2]]
     if corners:
         ts = ts[corners[0]:] + ts[:corners[0]]
-    out, label = [], -1
+    stretches, label = [], -1  # (segs, fixed, label, exact arcs)
     for i, a in enumerate(ts):
         b = ts[(i + 1) % len(ts)]
         if anchors[a][2] or label < 0:
             label += 1
         segs = _segments(curve, a, b, wrap=len(ts) == 1 or b <= a)
-        fixed = (anchors[a][1], anchors[b][0])
         if len(segs) == 1 and segs[0][0] in exact and segs[0][1] == bp[segs[0][0]]:
-            out.append(Span(segs, (None, None), exact[segs[0][0]], label))
+            stretches.append((segs, (None, None), label, exact[segs[0][0]]))
+        elif segs:
+            stretches.append((segs, (anchors[a][1], anchors[b][0]), label, None))
+    # the shapes of one-piece stretches at once when there are many (a knot table's hundreds of pieces)
+    single = [k for k, st in enumerate(stretches) if st[3] is None and len(st[0]) == 1]
+    shapes = dict(zip(single, single_piece_shapes(sur, [stretches[k][0][0] for k in single]), strict=True)) \
+        if len(single) >= _BATCH_SHAPES else {}
+    out = []
+    for k, (segs, fixed, lab, arcs_exact) in enumerate(stretches):
+        if arcs_exact is not None:
+            out.append(Span(segs, fixed, arcs_exact, lab))
             continue
-        if not segs:
-            continue
-        shares, shape = _split_stretch(sur, segs, target)
+        shares, shape = _split_stretch(sur, segs, target, shapes.get(k))
         for q, sg in enumerate(shares):
             f = (fixed[0] if q == 0 else None, fixed[1] if q == len(shares) - 1 else None)
-            out.append(Span(sg, f, None, label, shape))
+            out.append(Span(sg, f, None, lab, shape))
     return out
 
 

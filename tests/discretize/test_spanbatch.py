@@ -57,3 +57,30 @@ def test_many_segment_profile_within_tol():
     res = arcs(curve, tol=TOL)
     assert res.max_deviation <= TOL
     assert check_arcs(res, Dense(curve)) <= TOL
+
+
+def test_single_piece_shapes_equal_per_span_shapes():
+    """The shapes of hundreds of one-piece spans made at once (:func:`~camfab.discretize.spans.single_piece_shapes`)
+    are :func:`~camfab.discretize.spans.span_shape`'s bit for bit, and the spans ``cut_spans`` makes with them
+    carry those shapes (the batch is taken from 8 stretches on); its row-wise gradient is ``np.gradient``'s,
+    uneven and even steps."""
+    from camfab.discretize.spans import _gradient_rows, single_piece_shapes, span_shape
+
+    curve = cam(ROWS, base=40.0)
+    sur, sur_err = fit_surrogate(curve, TOL)
+    bp = curve.breakpoints
+    segs = [(i, float(bp[i]), float(bp[i + 1])) for i in range(bp.size - 1)]
+    for sg, shape in zip(segs, single_piece_shapes(sur, segs), strict=True):
+        for mine, theirs in zip(shape, span_shape(sur, [sg]), strict=True):
+            assert mine.shape == theirs.shape and np.array_equal(mine, theirs)
+    spans = [sp for sp in cut_spans(curve, sur, 0.97 * TOL - sur_err, TOL) if sp.exact is None]
+    assert len(spans) >= 100
+    for sp in spans[:: len(spans) // 10]:
+        for mine, theirs in zip(sp.shape, span_shape(sur, sp.segs), strict=True):
+            assert np.array_equal(mine, theirs)
+    rng = np.random.default_rng(3)
+    f = rng.normal(size=(40, 30))
+    x = np.cumsum(rng.uniform(0.1, 1.0, size=(40, 30)), axis=1)
+    x[5] = 0.25 * np.arange(30)  # equal steps: numpy's uniform formula
+    g = _gradient_rows(f, x)
+    assert all(np.array_equal(g[i], np.gradient(f[i], x[i])) for i in range(40))
