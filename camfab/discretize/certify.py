@@ -298,15 +298,17 @@ def samples_for(K: float, vmax: float, period: float, gap: float) -> int | None:
 
 
 def local_certificate(chain: Chain, curve: ParametricCurve, sur: HermiteSurrogate, tol: float, gap: float,
-                      K: float, vmax: float, samples: tuple | None = None) -> Deviation | None:
+                      K: float, vmax: float, samples: tuple | None = None,
+                      chain_to_curve: tuple[float, float, np.ndarray] | None = None) -> Deviation | None:
     """The fit's measurement of ``chain`` with the samples the local bound asks for (module notes, "The local
     bound"), when it certifies the chain within ``tol``: every sample interval's bound, the sampled and refined
     maxima, and the chain-to-curve maximum plus ``gap`` all within it; else None.  ``gap``: the largest share of
     ``tol`` a sample interval's bound may add (as :func:`certified_deviation`'s); ``K``, ``vmax``: the global bound
-    (:func:`curvature_bound`); ``samples``: the stand-in's :func:`standin_samples`, when taken."""
-    if not (math.isfinite(K) and gap > 0):
+    (:func:`curvature_bound`); ``samples``: the stand-in's :func:`standin_samples`, ``chain_to_curve``:
+    :func:`~camfab.discretize.measure.fit_chain_to_curve`'s result, when taken."""
+    if not (math.isfinite(K) and gap > 0 and chain.n):
         return None
-    worst_b, at_b, foot = fit_chain_to_curve(chain, sur)
+    worst_b, at_b, foot = fit_chain_to_curve(chain, sur) if chain_to_curve is None else chain_to_curve
     local = LocalBound(sur, chain, K, foot, samples)
     ts = local.nodes(gap, 8 * chain.n)
     if ts is None:
@@ -327,13 +329,14 @@ def certified_deviation(chain: Chain, curve: ParametricCurve, sur: HermiteSurrog
     samples = standin_samples(sur)
     K, vmax = curvature_bound(sur, chain, tol, samples)
     gap = min(CERTIFY_SHARE * tol, 0.5 * (tol - WRITE_ROOM_MM - expected))
-    dev = local_certificate(chain, curve, sur, tol, gap, K, vmax, samples)
+    to_curve = fit_chain_to_curve(chain, sur) if chain.n else None  # (both certificates' chain-to-curve half)
+    dev = local_certificate(chain, curve, sur, tol, gap, K, vmax, samples, to_curve)
     if dev is not None:
         return dev
     n = samples_for(K, vmax, curve.period, gap)
     if n is not None and n < DEFAULT_SAMPLES:
         g = sample_gap(K, vmax, curve.period, n)
-        dev = measure_fit(chain, curve, sur, n, g, bound=(K, vmax))
+        dev = measure_fit(chain, curve, sur, n, g, bound=(K, vmax), chain_to_curve=to_curve)
         if within(dev.max + g, tol):
             return dev
     return measure_deviation(chain, curve)

@@ -497,7 +497,8 @@ def fit_deviation(curve: ParametricCurve, worst_a: float, at_a: float, worst_b: 
 
 
 def measure_fit(chain: Chain, curve: ParametricCurve, sur: HermiteSurrogate, samples: int, gap: float, *,
-                per_entity: int = 17, refine_top: int = 8, bound: tuple[float, float] | None = None) -> Deviation:
+                per_entity: int = 17, refine_top: int = 8, bound: tuple[float, float] | None = None,
+                chain_to_curve: tuple[float, float, np.ndarray] | None = None) -> Deviation:
     """The fit's own two-way measurement of ``chain`` on its stand-in ``sur`` (a :func:`fit_surrogate` result,
     error at most ``tol/200``), for :func:`~camfab.discretize.certify.certified_deviation`.
 
@@ -507,10 +508,12 @@ def measure_fit(chain: Chain, curve: ParametricCurve, sur: HermiteSurrogate, sam
     exact samples and derivatives, without polishing (:func:`fit_chain_to_curve`).  About six calls of the exact
     curve instead of ~25.  ``bound``: the certificate's ``(K, max |P′|)`` that gave ``gap``, when known; the
     refinement then zooms only into the brackets that can hold the largest distance (:func:`_zoom_max`: the same
-    result)."""
+    result).  ``chain_to_curve``: :func:`fit_chain_to_curve`'s result for ``per_entity`` and ``refine_top``, when
+    already taken (the local certificate took it)."""
     if chain.n == 0:
         raise GeometryError("no entities to measure: give at least one line or arc")
-    worst_b, at_b, foot = fit_chain_to_curve(chain, sur, per_entity, refine_top)
+    worst_b, at_b, foot = fit_chain_to_curve(chain, sur, per_entity, refine_top) if chain_to_curve is None \
+        else chain_to_curve
     worst_a, at_a, _ = fit_curve_to_chain(chain, curve, samples, gap, foot, bound)
     return fit_deviation(curve, worst_a, at_a, worst_b, at_b)
 

@@ -39,7 +39,7 @@ from .certify import (
     standin_samples,
 )
 from .curve import ParametricCurve
-from .measure import as_chain, measure_deviation, measure_fit
+from .measure import as_chain, fit_chain_to_curve, measure_deviation, measure_fit
 from .results import Deviation
 from .surrogate import SURROGATE_FRACTION, fit_surrogate
 from .tolerance import WRITE_ROOM_MM, validate_tol, within
@@ -84,7 +84,8 @@ def measure_within(entities, curve: ParametricCurve, tol: float) -> Deviation:
     samples = standin_samples(sur)
     K, vmax = curvature_bound(sur, chain, tol, samples)
     gap = CERTIFY_SHARE * tol
-    dev = local_certificate(chain, curve, sur, tol, gap, K, vmax, samples)
+    to_curve = fit_chain_to_curve(chain, sur)  # (every certificate's chain-to-curve half)
+    dev = local_certificate(chain, curve, sur, tol, gap, K, vmax, samples, to_curve)
     if dev is not None:
         return dev
     while gap >= MIN_GAP_SHARE * tol:
@@ -92,7 +93,7 @@ def measure_within(entities, curve: ParametricCurve, tol: float) -> Deviation:
         if n is None or n >= DEFAULT_SAMPLES:
             break
         g = sample_gap(K, vmax, curve.period, n)
-        dev = measure_fit(chain, curve, sur, n, g, bound=(K, vmax))
+        dev = measure_fit(chain, curve, sur, n, g, bound=(K, vmax), chain_to_curve=to_curve)
         if within(dev.max + g, tol):
             return dev
         if gap < CERTIFY_SHARE * tol:  # the second certificate failed too
