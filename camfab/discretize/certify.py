@@ -329,7 +329,8 @@ def certified_deviation(chain: Chain, curve: ParametricCurve, sur: HermiteSurrog
     samples = standin_samples(sur)
     K, vmax = curvature_bound(sur, chain, tol, samples)
     gap = min(CERTIFY_SHARE * tol, 0.5 * (tol - WRITE_ROOM_MM - expected))
-    to_curve = fit_chain_to_curve(chain, sur) if chain.n else None  # (both certificates' chain-to-curve half)
+    # (both certificates' chain-to-curve half; neither is made without entities or a finite bound)
+    to_curve = fit_chain_to_curve(chain, sur) if chain.n and math.isfinite(K) else None
     dev = local_certificate(chain, curve, sur, tol, gap, K, vmax, samples, to_curve)
     if dev is not None:
         return dev

@@ -84,7 +84,8 @@ def measure_within(entities, curve: ParametricCurve, tol: float) -> Deviation:
     samples = standin_samples(sur)
     K, vmax = curvature_bound(sur, chain, tol, samples)
     gap = CERTIFY_SHARE * tol
-    to_curve = fit_chain_to_curve(chain, sur)  # (every certificate's chain-to-curve half)
+    # (every certificate's chain-to-curve half; none is made without a finite bound)
+    to_curve = fit_chain_to_curve(chain, sur) if np.isfinite(K) else None
     dev = local_certificate(chain, curve, sur, tol, gap, K, vmax, samples, to_curve)
     if dev is not None:
         return dev
