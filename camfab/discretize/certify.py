@@ -56,18 +56,20 @@ entities from ``e₀`` to ``e₁``, and ``f`` there is the signed distance to th
 the bound above for the entity holding the foot.  On a sample interval (parameters ``[t₀, t₁]``) the bound takes:
 
 - ``κ``'s range from the stand-in's curvature at the ends and midpoint of every stand-in interval it overlaps,
-  widened by the largest change between two of those values (``_standin_ranges``), and ``k`` over the entities
-  ``e₀ … e₁`` (their largest curvature difference, at most :data:`_LOCAL_SPAN` entities apart, else the global ``K``);
-  a sample whose nearest point is the joint with the next entity inside the interval counts as on that entity
-  (``measure._interval_ends``), so an interval ending on the joint of two arcs of different curvature reads one;
+  widened by the largest change between two of those values (``_standin_ranges``), and the curvatures ``k`` of the
+  entities ``e₀ … e₁`` (at most :data:`_LOCAL_SPAN` entities apart, else the global ``K``): the mismatch is the
+  largest ``|k - κ|`` over both ranges.  ``e₀``, ``e₁`` are the samples' nearest entities, except that a sample as
+  near (to 1e-12 mm, which its distance then takes on) a joint's point of the entity on the interval's side is read
+  against that entity (``measure._interval_ends``): an interval ending on the joint of two arcs of different
+  curvature reads the one it runs along;
 - ``|f| ≤ F = max(d₀, d₁) + L·h²/8`` and ``sin β = |f'| ≤ (d₀ + d₁)/h + L·h/2`` (``f'`` differs from its mean
-  over the interval by at most ``L·h/2``), where ``h`` is the
-  interval's arc length (at most the stand-in's largest speed there times ``t₁ - t₀``) and ``L`` the bound being
-  computed: so ``L`` is a fixed point ``L = R(L)`` of the right-hand side, enlarged by :data:`_SAFETY`.
+  over the interval by at most ``L·h/2``), where ``d₀``, ``d₁`` are the samples' distances, ``h`` the interval's arc
+  length (at most the stand-in's largest speed there times ``t₁ - t₀``) and ``L`` a bound of ``|f''|`` on the
+  interval.  So the bound is a fixed point ``L = R(L)`` of the right-hand side (enlarged by :data:`_SAFETY`), and the
+  true supremum ``L*`` of ``|f''|`` satisfies ``L* ≤ R(L*)`` and, by the global argument, ``L* ≤ K``.
   :data:`_LOCAL_ROUNDS` rounds from ``L = mismatch`` give ``L̂``; it is taken when ``R(L̂) ≤ L̂`` and ``R(K) < K``:
-  ``R`` is convex and increasing in ``L``, so ``R(L) < L`` on all of ``[L̂, K]``, and the true ``|f''|`` bound — at
-  most ``K`` by the global argument, and at most ``R`` of itself — cannot lie there.  Otherwise the interval takes
-  ``K``.
+  ``R`` is convex in ``L`` (``sin β``'s bound is not capped at 1), so ``R(L) < L`` on all of ``[L̂, K]``, where
+  therefore ``L*`` cannot lie: ``L* < L̂``.  Otherwise the interval takes ``K``.
 
 Each interval's distance is then at most ``max(d₀, d₁) + L·h²/8``.  The samples follow the need: each stand-in
 interval gets ``(t₁ - t₀)·sqrt(per-step bound / gap)`` of them (its curvature mismatch with the entities that own its
