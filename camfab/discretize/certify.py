@@ -69,7 +69,7 @@ the bound above for the entity holding the foot.  On a sample interval (paramete
   true supremum ``L*`` of ``|f''|`` satisfies ``L* ≤ R(L*)`` and, by the global argument, ``L* ≤ K``.
   :data:`_LOCAL_ROUNDS` rounds from ``L = mismatch`` give ``L̂``; it is taken when ``R(L̂) ≤ L̂`` and ``R(K) < K``:
   ``R`` is convex in ``L`` (``sin β``'s bound is not capped at 1), so ``R(L) < L`` on all of ``[L̂, K]``, where
-  therefore ``L*`` cannot lie: ``L* < L̂``.  Otherwise the interval takes ``K``.
+  therefore ``L*`` cannot lie: ``L* ≤ L̂``.  Otherwise the interval takes ``K``.
 
 Each interval's distance is then at most ``max(d₀, d₁) + L·h²/8``.  The samples follow the need: each stand-in
 interval gets ``(t₁ - t₀)·sqrt(per-step bound / gap)`` of them (its curvature mismatch with the entities that own its
