@@ -20,8 +20,9 @@ lists per fit the arcs, the measured deviation and the CPU time; with ``--root``
 
 ``--floor`` times what this fit's verification by measurement cannot skip on the issue cam, whatever its search:
 the Hermite stand-in's exact evaluations (points and derivatives at its nodes, points at its midpoints), the
-certificate's exact curve samples (one evaluation at the count the certificate asks for) and their distances to the
-fitted chain (each sample against its own entity and the two beside it, as the fit's measurement takes them).
+certificate's exact curve samples (one evaluation at the nodes the local certificate asks for,
+``certify.LocalBound.nodes``) and their distances to the fitted chain (each sample against its own entity and the two
+beside it, as the fit's measurement takes them).
 
 ``--stages`` times the issue cam's fit by stage (CPU around each: the Hermite stand-in, cutting the spans, the
 spans' arc-count search, laying the arcs, the certification; the rest), what a faster fitter has to cut.
