@@ -4,6 +4,7 @@ checked against dense exact distances on every example profile, a wrong bound ca
 where the global one needed more than the default samples."""
 from __future__ import annotations
 
+import functools
 import math
 from pathlib import Path
 
@@ -36,8 +37,9 @@ from .test_discretize import CAM_CV, CURVES, OPEN, cam, cam_programs
 EXAMPLES = Path(camfab.__file__).resolve().parent / "examples"
 
 
-def _example_curves():
-    """``(label, curve)`` of every plane profile of every example design (the cylindrical cam has none)."""
+@functools.lru_cache(maxsize=1)
+def _example_curves() -> tuple:
+    """``(label, curve)`` of every plane profile of every example design (the cylindrical cam has none), made once."""
     out = []
     for path in sorted(EXAMPLES.glob("*.toml")):
         geometry = geometry_from_spec(load_design(path))
@@ -46,7 +48,7 @@ def _example_curves():
         except (AttributeError, TypeError, ValueError):
             continue
         out += [(f"{path.stem}[{i}]", c) for i, c in enumerate(curves)]
-    return out
+    return tuple(out)
 
 
 def test_distance_to_an_arc_bends_no_more_than_the_curvature_mismatch():
