@@ -158,6 +158,50 @@ def test_ctrl_c_during_package(designs, tmp_path, jobs):
                                                                   f"{folder.name}.dxf"}, names
 
 
+class _FailingCadquery:
+    """A meta-path finder whose import of ``cadquery`` fails as OCP's does when Ctrl-C comes during it: the
+    interrupt raised (``signal``: by a real SIGINT to this process, through the handler in place) and turned into
+    ``ImportError('initialization failed')``, or swallowed and followed by another ``ImportError``."""
+
+    def __init__(self, how: str):
+        self.how = how
+
+    def find_spec(self, name, path=None, target=None):
+        if name != "cadquery":
+            return None
+        if self.how == "chained":
+            try:
+                raise KeyboardInterrupt
+            except KeyboardInterrupt:
+                raise ImportError("initialization failed") from None  # (the interrupt stays its __context__)
+        if self.how == "signal":
+            try:
+                os.kill(os.getpid(), signal.SIGINT)
+                time.sleep(1.0)  # (the handler runs here)
+            except KeyboardInterrupt:
+                pass  # swallowed, as cadquery's optional imports do
+            raise ImportError("cannot import name 'IVtkOCC_Shape' from 'OCP.IVtkOCC'")
+        raise ImportError("No module named 'cadquery'")
+
+
+@pytest.mark.parametrize("how", ["chained", "signal", "missing"])
+def test_ctrl_c_during_the_cadquery_import_is_an_interrupt(monkeypatch, how):
+    """A Ctrl-C during ``import cadquery`` (a second or more of ``export --step``) is ``KeyboardInterrupt`` (exit
+    130), not "this install lacks cadquery" (exit 3): with the interrupt in the ``ImportError``'s chain, or with
+    SIGINT noted during the import and the interrupt swallowed; a plain ``ImportError`` is still the missing
+    dependency, and the SIGINT handler in place is restored."""
+    from camfab.cad.step import cadquery
+    from camfab.errors import MissingDependencyError
+
+    monkeypatch.delitem(sys.modules, "cadquery", raising=False)
+    monkeypatch.setattr(sys, "meta_path", [_FailingCadquery(how)] + sys.meta_path)
+    before = signal.getsignal(signal.SIGINT)
+    expected = MissingDependencyError if how == "missing" else KeyboardInterrupt
+    with pytest.raises(expected):
+        cadquery()
+    assert signal.getsignal(signal.SIGINT) is before
+
+
 @linux_only
 @pytest.mark.parametrize("argv", [["run", "ejemplo9rt"], ["export", "ejemplo9rt", "--dxf", "--stl", "--step"]],
                          ids=["run", "export"])

@@ -6,7 +6,9 @@ The file is made deterministic by fixing the timestamp in the STEP header.
 from __future__ import annotations
 
 import re
+import signal
 import tempfile
+import threading
 from pathlib import Path
 
 from ..errors import MissingDependencyError
@@ -21,13 +23,52 @@ __all__ = ["plate_solid", "groove_solid", "dumps", "groove_dumps", "stack_dumps"
 
 def cadquery():
     """The cadquery module (MissingDependencyError when it is not installed: it is a dependency of camfab,
-    but an install may lack it)."""
+    but an install may lack it).
+
+    A Ctrl-C during the import (one to three seconds of a command's start) is a ``KeyboardInterrupt``, never the
+    missing dependency: OCP's extension modules turn the interrupt raised in their initialisation into
+    ``ImportError('initialization failed')``, or cadquery's optional imports swallow it and a later one fails on a
+    half-made module.  So an import that fails while SIGINT came (noted by a handler that then calls the one in
+    place), or whose error chain holds the interrupt, raises ``KeyboardInterrupt``; so does one that succeeded
+    after swallowing it."""
+    came: list[int] = []
+    prev = signal.getsignal(signal.SIGINT)
+    own = threading.current_thread() is threading.main_thread() and callable(prev)
+
+    def note(signum, frame):
+        came.append(signum)
+        prev(signum, frame)  # type: ignore[operator]
+
+    if own:
+        signal.signal(signal.SIGINT, note)
     try:
         import cadquery as cq
     except ImportError as exc:
+        if came or _holds_interrupt(exc):
+            raise KeyboardInterrupt from exc
         raise MissingDependencyError("STEP export needs cadquery, a dependency of camfab that this install lacks: "
                                      "pip install cadquery (or reinstall camfab)") from exc
+    finally:
+        if own and signal.getsignal(signal.SIGINT) is note:  # (the handler in place may have replaced itself)
+            signal.signal(signal.SIGINT, prev)
+    if came:
+        raise KeyboardInterrupt
     return cq
+
+
+def _holds_interrupt(exc: BaseException) -> bool:
+    """Whether a ``KeyboardInterrupt`` is among the causes and contexts of ``exc``."""
+    seen: set[int] = set()
+    todo: list[BaseException | None] = [exc]
+    while todo:
+        e = todo.pop()
+        if e is None or id(e) in seen:
+            continue
+        if isinstance(e, KeyboardInterrupt):
+            return True
+        seen.add(id(e))
+        todo += [e.__cause__, e.__context__]
+    return False
 
 
 _cq = cadquery

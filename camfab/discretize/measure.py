@@ -174,7 +174,7 @@ class _CurveProjector:
 
 
 def _zoom_max(f: Callable[[np.ndarray, np.ndarray], np.ndarray], lo: np.ndarray, hi: np.ndarray,
-              levels: int = 2, m: int = 33, per_step: float | None = None) -> np.ndarray:
+              levels: int = 2, m: int = 33, per_step: float | np.ndarray | None = None) -> np.ndarray:
     """Maximum of ``f`` on each ``[lo, hi]`` by nested sample grids (one batched call of ``f`` per level);
     ``f(points, rows)`` takes the brackets (rows of ``lo``) its points belong to.
 
@@ -404,6 +404,23 @@ def _interval_ends(chain: Chain, q: np.ndarray, d: np.ndarray, nearest: np.ndarr
     return d0, d1, e0, e1
 
 
+def _local_brackets(chain: Chain, q: np.ndarray, ts: np.ndarray, d: np.ndarray, nearest: np.ndarray, top: np.ndarray,
+                    worst: float, local, closed: bool) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
+    """With the local bound: ``(certified, top, reach, per_step)``, the largest sample interval's bound and the
+    local maxima ``top`` (of the samples' distances ``d``) whose bracket, the two intervals beside each (one at an
+    open curve's ends), can hold a distance above ``worst``, with their brackets' bound and ``c_i``."""
+    n_t = ts.size - 1
+    d0, d1, e0, e1 = _interval_ends(chain, q, d, nearest, n_t, closed)
+    c = local.per_step(ts, d0, d1, e0, e1)
+    dt = ts[1:] - ts[:-1]
+    interval = np.maximum(d0, d1) + c * dt * dt  # each sample interval's bound
+    before = (top - 1) % n_t if closed else np.maximum(top - 1, 0)
+    after = np.minimum(top, n_t - 1)
+    reach = np.maximum(interval[before], interval[after])
+    keep = reach * (1.0 + 1e-9) >= worst
+    return float(interval.max()), top[keep], reach[keep], np.maximum(c[before], c[after])[keep]
+
+
 def fit_curve_to_chain(chain: Chain, curve: ParametricCurve, samples: int, gap: float,
                        foot: np.ndarray, bound: tuple[float, float] | None = None, local=None,
                        nodes: np.ndarray | None = None) -> tuple[float, float, float]:
@@ -439,20 +456,10 @@ def fit_curve_to_chain(chain: Chain, curve: ParametricCurve, samples: int, gap: 
     worst_a, at_a = float(d_a[i_a]), float(ts[i_a])
     top = _local_maxima(d_a, curve.closed, d_a.size)
     certified = np.inf
-    per_step = None if bound is None else bound[0] * bound[1] ** 2 / 8.0
+    per_step: float | np.ndarray | None = None if bound is None else bound[0] * bound[1] ** 2 / 8.0
     if local is not None:
-        d0, d1, e0, e1 = _interval_ends(chain, q, d_a, nearest, n_t, curve.closed)
-        c = local.per_step(ts, d0, d1, e0, e1)
-        dt = ts[1:] - ts[:-1]
-        interval = np.maximum(d0, d1) + c * dt * dt  # each sample interval's bound
-        certified = float(interval.max())
-        # a local maximum's bracket is the two intervals beside it (one at an open curve's ends)
-        before = (top - 1) % n_t if curve.closed else np.maximum(top - 1, 0)
-        after = np.minimum(top, n_t - 1)
-        reach = np.maximum(interval[before], interval[after])
-        keep = reach * (1.0 + 1e-9) >= worst_a
-        top, reach = top[keep], reach[keep]
-        per_step = np.maximum(c[before], c[after])[keep]
+        certified, top, reach, per_step = _local_brackets(chain, q, ts, d_a, nearest, top, worst_a, local,
+                                                          curve.closed)
     else:
         top = top[d_a[top] >= worst_a - gap]
     if not top.size:

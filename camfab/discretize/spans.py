@@ -232,6 +232,27 @@ def _split_stretch(sur: HermiteSurrogate, segs: list, target: float, shape: tupl
     return pieces_segs, None
 
 
+def _stretches(curve: ParametricCurve, anchors: dict, exact: dict) -> list:
+    """``(segs, fixed, label, exact arcs)`` of every stretch between consecutive anchors, in chain order (from the
+    first corner when there is one): a circular piece's exact arcs, or the curvatures its ends keep (``fixed``)."""
+    bp = curve.breakpoints
+    ts = sorted(anchors)
+    corners = [i for i, t in enumerate(ts) if anchors[t][2]]
+    if corners:
+        ts = ts[corners[0]:] + ts[:corners[0]]
+    out, label = [], -1
+    for i, a in enumerate(ts):
+        b = ts[(i + 1) % len(ts)]
+        if anchors[a][2] or label < 0:
+            label += 1
+        segs = _segments(curve, a, b, wrap=len(ts) == 1 or b <= a)
+        if len(segs) == 1 and segs[0][0] in exact and segs[0][1] == bp[segs[0][0]]:
+            out.append((segs, (None, None), label, exact[segs[0][0]]))
+        elif segs:
+            out.append((segs, (anchors[a][1], anchors[b][0]), label, None))
+    return out
+
+
 def cut_spans(curve: ParametricCurve, sur: HermiteSurrogate, target: float, tol: float,
               anchored: bool = True) -> list:
     """The free spans (:class:`Span`) in chain order.
@@ -242,22 +263,7 @@ def cut_spans(curve: ParametricCurve, sur: HermiteSurrogate, target: float, tol:
     are cut into equal shares of about :data:`SPLINE_SPAN` arcs, joined G1 at (surrogate) curve
     points with the curve's tangent.  Spans between two corners share a label (their arcs may merge).
     """
-    bp = curve.breakpoints
-    anchors, exact = _anchors(curve, sur, tol, anchored)
-    ts = sorted(anchors)
-    corners = [i for i, t in enumerate(ts) if anchors[t][2]]
-    if corners:
-        ts = ts[corners[0]:] + ts[:corners[0]]
-    stretches, label = [], -1  # (segs, fixed, label, exact arcs)
-    for i, a in enumerate(ts):
-        b = ts[(i + 1) % len(ts)]
-        if anchors[a][2] or label < 0:
-            label += 1
-        segs = _segments(curve, a, b, wrap=len(ts) == 1 or b <= a)
-        if len(segs) == 1 and segs[0][0] in exact and segs[0][1] == bp[segs[0][0]]:
-            stretches.append((segs, (None, None), label, exact[segs[0][0]]))
-        elif segs:
-            stretches.append((segs, (anchors[a][1], anchors[b][0]), label, None))
+    stretches = _stretches(curve, *_anchors(curve, sur, tol, anchored))
     # the shapes of one-piece stretches at once when there are many (a knot table's hundreds of pieces)
     single = [k for k, st in enumerate(stretches) if st[3] is None and len(st[0]) == 1]
     shapes = dict(zip(single, single_piece_shapes(sur, [stretches[k][0][0] for k in single]), strict=True)) \
