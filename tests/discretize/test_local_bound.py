@@ -229,7 +229,7 @@ def test_a_wrong_bound_is_caught():
 @pytest.mark.parametrize("label", ["ejemplo11ro[0]", "valve_exhaust_ej1[0]", "wedge_translating[0]"])
 def test_fine_fits_are_certified_without_the_default_measurement(label, monkeypatch):
     """At 1e-4 mm the global bound asks for more than the default 20 000 samples on these profiles (49 000, 207 000
-    and 24 000 at the fits' gaps), so their fits fell back to the default measurement; now the whole fit is
+    and 38 000 at the fits' gaps), so their fits fell back to the default measurement; now the whole fit is
     certified by the local bound, and its deviation is the independent measurement's."""
     import camfab.discretize.certify as certify_mod
 
