@@ -45,14 +45,14 @@ def cadquery():
         import cadquery as cq
     except ImportError as exc:
         if came or _holds_interrupt(exc):
-            raise KeyboardInterrupt from exc
+            signal.default_int_handler(signal.SIGINT, None)  # raises KeyboardInterrupt (its context: ``exc``)
         raise MissingDependencyError("STEP export needs cadquery, a dependency of camfab that this install lacks: "
                                      "pip install cadquery (or reinstall camfab)") from exc
     finally:
         if own and signal.getsignal(signal.SIGINT) is note:  # (the handler in place may have replaced itself)
             signal.signal(signal.SIGINT, prev)
     if came:
-        raise KeyboardInterrupt
+        signal.default_int_handler(signal.SIGINT, None)  # raises KeyboardInterrupt
     return cq
 
 
