@@ -15,7 +15,7 @@ import numpy as np
 
 from ..geom2d import cross, dot
 from .entities import MAX_TURNING_RAD
-from .spanmodel import peak
+from .spanmodel import peak, stacked_span_model
 
 __all__ = ["two_arc_fits", "TWO_ARC_GRID", "MIN_BATCH"]
 
@@ -33,15 +33,9 @@ def _cumhermite(f: np.ndarray, fp: np.ndarray, s: np.ndarray) -> np.ndarray:
 
 
 def _models(sur, segs: list, n: int):
-    """Stacked :func:`span_model` (curvature too) and :class:`SpanModel` fields of single-piece spans."""
-    piece = np.array([sg[0] for sg in segs])[:, None]
-    t = np.linspace(np.array([sg[1] for sg in segs]), np.array([sg[2] for sg in segs]), n, axis=-1)
-    tm = 0.5 * (t[:, :-1] + t[:, 1:])
-    d, dm = sur.derivative(t, piece), sur.derivative(tm, piece)
-    sp, spm = np.hypot(d[..., 0], d[..., 1]), np.hypot(dm[..., 0], dm[..., 1])
-    s = np.concatenate([np.zeros((t.shape[0], 1)),
-                        np.cumsum(np.diff(t, axis=1) / 6.0 * (sp[:, :-1] + 4 * spm + sp[:, 1:]), axis=1)], axis=1)
-    theta = np.unwrap(np.arctan2(d[..., 1], d[..., 0]), axis=1)
+    """Stacked :func:`~camfab.discretize.spanmodel.span_model` (curvature too) and
+    :class:`~camfab.discretize.spanmodel.SpanModel` fields of single-piece spans."""
+    t, s, theta, d, sp, piece = stacked_span_model(sur, segs, n)
     kappa = cross(d, sur.second_derivative(t, piece)) / np.maximum(sp, 1e-300) ** 3
     tng = np.stack([np.cos(theta), np.sin(theta)], axis=-1)
     nrm = np.stack([-np.sin(theta), np.cos(theta)], axis=-1)

@@ -14,7 +14,7 @@ import numpy as np
 from ..geom2d import TWO_PI, cross, dot
 from .surrogate import HermiteSurrogate
 
-__all__ = ["span_model", "cumtrapz", "SpanModel", "equioscillate", "peak"]
+__all__ = ["span_model", "stacked_span_model", "cumtrapz", "SpanModel", "equioscillate", "peak"]
 
 
 #: Lawson (minimax) reweighting iterations of the curvatures of given knots
@@ -53,6 +53,22 @@ def span_model(sur: HermiteSurrogate, segs, n_grid: int, curvature: bool = False
         s_off, th_off = float(sv[-1]), float(theta[-1])
     out = (np.concatenate(ts), np.concatenate(ss), np.concatenate(ths))
     return out + (np.concatenate(ks),) if curvature else out
+
+
+def stacked_span_model(sur: HermiteSurrogate, segs: list, n: int):
+    """:func:`span_model` of many one-piece spans ``[(piece, lo, hi)]`` at once, a row each: ``(t, s, theta, d,
+    speed, piece)`` (``d``: the surrogate's derivative at ``t``, ``speed`` its norm, ``piece`` a column).  Every
+    value is the same element-wise operation as :func:`span_model`'s, so the rows are its values bit for bit."""
+    piece = np.array([sg[0] for sg in segs])[:, None]
+    t = np.linspace(np.array([sg[1] for sg in segs], dtype=float), np.array([sg[2] for sg in segs], dtype=float), n,
+                    axis=1)
+    tm = 0.5 * (t[:, :-1] + t[:, 1:])
+    d, dm = sur.derivative(t, piece), sur.derivative(tm, piece)
+    sp, spm = np.hypot(d[..., 0], d[..., 1]), np.hypot(dm[..., 0], dm[..., 1])
+    inc = (t[:, 1:] - t[:, :-1]) / 6.0 * (sp[:, :-1] + 4 * spm + sp[:, 1:])
+    s = np.concatenate([np.zeros((t.shape[0], 1)), np.cumsum(inc, axis=1)], axis=1)
+    theta = np.unwrap(np.arctan2(d[..., 1], d[..., 0]), axis=1)
+    return t, s, theta, d, sp, piece
 
 
 def cumtrapz(f: np.ndarray, s: np.ndarray) -> np.ndarray:

@@ -15,7 +15,7 @@ from ..geom2d import cross, dot, rotate, unit
 from ..records import dataclass, field
 from .curve import ParametricCurve, piece_index, points_at
 from .entities import MAX_TURNING_RAD, arc_from
-from .spanmodel import cumtrapz, span_model
+from .spanmodel import cumtrapz, span_model, stacked_span_model
 from .surrogate import HermiteSurrogate
 
 __all__ = ["SPLINE_SPAN", "Span", "span_shape", "span_density", "span_ends", "cut_spans"]
@@ -69,24 +69,14 @@ def _gradient_rows(f: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 def single_piece_shapes(sur: HermiteSurrogate, segs: list, n: int = 257) -> list:
     """:func:`span_shape` of every one-piece span ``[(piece, lo, hi)]`` of ``segs`` (one ``(piece, lo, hi)`` each) at
-    once: the same values bit for bit (every operation of :func:`~camfab.discretize.spanmodel.span_model` and
-    :func:`span_shape` elementwise along the rows, numpy's gradient by :func:`_gradient_rows`), for a curve of
+    once: the same values bit for bit (the rows of :func:`~camfab.discretize.spanmodel.stacked_span_model`, then
+    every operation of :func:`span_shape` elementwise, numpy's gradient by :func:`_gradient_rows`), for a curve of
     hundreds of pieces (a knot table) whose spans would each cost their own few dozen small numpy calls."""
-    piece = np.array([sg[0] for sg in segs])
-    lo = np.array([sg[1] for sg in segs], dtype=float)
-    hi = np.array([sg[2] for sg in segs], dtype=float)
-    t = np.linspace(lo, hi, n, axis=1)
-    tm = 0.5 * (t[:, :-1] + t[:, 1:])
-    d = sur.derivative(t, piece[:, None])
-    dm = sur.derivative(tm, piece[:, None])
-    sp, spm = np.hypot(d[..., 0], d[..., 1]), np.hypot(dm[..., 0], dm[..., 1])
-    inc = (t[:, 1:] - t[:, :-1]) / 6.0 * (sp[:, :-1] + 4 * spm + sp[:, 1:])
-    s0 = 0.0 + np.concatenate([np.zeros((t.shape[0], 1)), np.cumsum(inc, axis=1)], axis=1)
-    theta = np.unwrap(np.arctan2(d[..., 1], d[..., 0]), axis=1)
+    t, s0, theta, _, _, piece = stacked_span_model(sur, segs, n)
     kappa = _gradient_rows(theta, s0)
     dk = np.abs(_gradient_rows(kappa, s0))
     s = s0 + 0.0
-    return [(t[i], s[i], dk[i], np.abs(kappa[i]), np.full(n, piece[i])) for i in range(t.shape[0])]
+    return [(t[i], s[i], dk[i], np.abs(kappa[i]), np.full(n, piece[i, 0])) for i in range(t.shape[0])]
 
 
 def span_density(sur: HermiteSurrogate, segs, target: float, n: int = 257, shape=None):

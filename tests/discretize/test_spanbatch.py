@@ -84,3 +84,23 @@ def test_single_piece_shapes_equal_per_span_shapes():
     x[5] = 0.25 * np.arange(30)  # equal steps: numpy's uniform formula
     g = _gradient_rows(f, x)
     assert all(np.array_equal(g[i], np.gradient(f[i], x[i])) for i in range(40))
+
+
+def test_stacked_span_model_rows_equal_span_model():
+    """The stacked model of one-piece spans (shared by the batched shapes and the batched two-arc fit) gives every
+    row :func:`~camfab.discretize.spanmodel.span_model`'s arc length and tangent angle bit for bit, and the
+    surrogate's derivative and speed at its parameters."""
+    from camfab.discretize.spanmodel import span_model, stacked_span_model
+
+    curve = cam(ROWS, base=40.0)
+    sur, _ = fit_surrogate(curve, TOL)
+    bp = curve.breakpoints
+    segs = [(i, float(bp[i]), float(bp[i + 1])) for i in range(0, bp.size - 1, 7)]
+    t, s, theta, d, speed, piece = stacked_span_model(sur, segs, 129)
+    assert t.shape == s.shape == theta.shape == speed.shape == (len(segs), 129) and d.shape == (len(segs), 129, 2)
+    for i, sg in enumerate(segs):
+        t1, s1, th1 = span_model(sur, [sg], 129)
+        assert np.array_equal(t[i], t1) and np.array_equal(s[i], s1) and np.array_equal(theta[i], th1)
+        assert piece[i, 0] == sg[0]
+        assert np.array_equal(d[i], sur.derivative(t1, sg[0]))
+        assert np.array_equal(speed[i], np.hypot(d[i, :, 0], d[i, :, 1]))
