@@ -90,7 +90,7 @@ import numpy as np
 from ..geom2d import cross
 from .chain import Chain
 from .curve import ParametricCurve
-from .measure import fit_chain_to_curve, fit_curve_to_chain, fit_deviation, measure_deviation, measure_fit, owners
+from .measure import fit_chain_to_curve, fit_curve_to_chain, measure_deviation, measure_fit, owners, two_way_deviation
 from .results import Deviation
 from .surrogate import HermiteSurrogate
 from .tolerance import WRITE_ROOM_MM, within
@@ -318,7 +318,7 @@ def local_certificate(chain: Chain, curve: ParametricCurve, sur: HermiteSurrogat
     worst_a, at_a, bound = fit_curve_to_chain(chain, curve, ts.size - 1, gap, foot, (K, vmax), local, nodes=ts)
     if not within(max(bound, worst_a, worst_b + gap), tol):
         return None
-    return fit_deviation(curve, worst_a, at_a, worst_b, at_b)
+    return two_way_deviation(curve, worst_a, at_a, worst_b, at_b)
 
 
 def certified_deviation(chain: Chain, curve: ParametricCurve, sur: HermiteSurrogate, tol: float,

@@ -310,9 +310,7 @@ def measure_deviation(entities, curve: ParametricCurve, *, samples: int = 20000,
     sur = HermiteSurrogate(curve, max(int(samples), 8 * chain.n), min_count=8)
     worst_a, at_a = _curve_to_chain(chain, curve, sur, refine_top)
     worst_b, at_b = _chain_to_curve(chain, sur, per_entity, refine_top)
-    at = at_a if worst_a >= worst_b else at_b
-    return Deviation(max=max(worst_a, worst_b), curve_to_entities=worst_a,
-                     entities_to_curve=worst_b, at_param=at, at_point=points_at(curve, np.array([at]))[0])
+    return two_way_deviation(curve, worst_a, at_a, worst_b, at_b)
 
 
 def _near_entities(chain: Chain, q: np.ndarray, ent: np.ndarray, reach: int = 1, cyclic: bool = True,
@@ -391,17 +389,21 @@ def _interval_ends(chain: Chain, q: np.ndarray, d: np.ndarray, nearest: np.ndarr
     d1, e1 = (d[1:], nearest[1:]) if d.size > n_t else (np.roll(d, -1), np.roll(nearest, -1))
     n = chain.n
     span = (e1 - e0) % n if closed else e1 - e0
-    # the end of the entity before e1 (the joint, to rounding): no farther than the nearest point plus the slack
-    joint = chain.end[(e1 - 1) % n]
-    before = (span >= 1) & (np.hypot(qb[:, 0] - joint[:, 0], qb[:, 1] - joint[:, 1]) <= d1 + _JOINT_SLACK)
-    e1 = np.where(before, (e1 - 1) % n, e1)
-    d1 = np.where(before, d1 + _JOINT_SLACK, d1)
-    span = span - before
-    joint = chain.start[(e0 + 1) % n]  # the start of the entity after e0
-    after = (span >= 1) & (np.hypot(qa[:, 0] - joint[:, 0], qa[:, 1] - joint[:, 1]) <= d0 + _JOINT_SLACK)
-    e0 = np.where(after, (e0 + 1) % n, e0)
-    d0 = np.where(after, d0 + _JOINT_SLACK, d0)
+    e1, d1, before = _toward_joint(qb, d1, e1, chain.end, -1, span >= 1, n)  # the end of the entity before e1
+    e0, d0, _ = _toward_joint(qa, d0, e0, chain.start, 1, span - before >= 1, n)  # the start of the one after e0
     return d0, d1, e0, e1
+
+
+def _toward_joint(p: np.ndarray, dist: np.ndarray, ent: np.ndarray, joints: np.ndarray, step: int, room: np.ndarray,
+                  n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The joint rule of :func:`_interval_ends` at one end of the intervals: ``(entity, distance, moved)``, each point
+    ``p`` whose joint with the entity ``ent + step`` (``joints``: the chain's ends for ``step`` -1, starts for +1) lies
+    no farther than its distance ``dist`` plus :data:`_JOINT_SLACK` read against that entity, its distance that slack
+    more, where the interval has ``room`` (spans more than one entity)."""
+    j = (ent + step) % n
+    joint = joints[j]
+    moved = room & (np.hypot(p[:, 0] - joint[:, 0], p[:, 1] - joint[:, 1]) <= dist + _JOINT_SLACK)
+    return np.where(moved, j, ent), np.where(moved, dist + _JOINT_SLACK, dist), moved
 
 
 def _local_brackets(chain: Chain, q: np.ndarray, ts: np.ndarray, d: np.ndarray, nearest: np.ndarray, top: np.ndarray,
@@ -496,8 +498,9 @@ def fit_chain_to_curve(chain: Chain, sur: HermiteSurrogate, per_entity: int = 17
     return worst_b, at_b, t_b.reshape(chain.n, per_entity)[:, 0]
 
 
-def fit_deviation(curve: ParametricCurve, worst_a: float, at_a: float, worst_b: float, at_b: float) -> Deviation:
-    """The :class:`Deviation` of the two directions' maxima and their parameters (curve to chain, chain to curve)."""
+def two_way_deviation(curve: ParametricCurve, worst_a: float, at_a: float, worst_b: float, at_b: float) -> Deviation:
+    """The :class:`Deviation` of the two directions' maxima and their parameters (curve to chain, chain to curve),
+    located at the larger one's parameter (the curve to chain one on a tie)."""
     at = at_a if worst_a >= worst_b else at_b
     return Deviation(max=max(worst_a, worst_b), curve_to_entities=worst_a,
                      entities_to_curve=worst_b, at_param=at, at_point=points_at(curve, np.array([at]))[0])
@@ -522,7 +525,7 @@ def measure_fit(chain: Chain, curve: ParametricCurve, sur: HermiteSurrogate, sam
     worst_b, at_b, foot = fit_chain_to_curve(chain, sur, per_entity, refine_top) if chain_to_curve is None \
         else chain_to_curve
     worst_a, at_a, _ = fit_curve_to_chain(chain, curve, samples, gap, foot, bound)
-    return fit_deviation(curve, worst_a, at_a, worst_b, at_b)
+    return two_way_deviation(curve, worst_a, at_a, worst_b, at_b)
 
 
 def max_deviation(entities, curve: ParametricCurve, **kwargs) -> float:
