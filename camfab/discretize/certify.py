@@ -234,7 +234,40 @@ class LocalBound:
         levels = lo[piece] + (hi - lo)[piece] * (j / counts[piece])
         ts = np.interp(levels, cum, x)
         ts[j == 0] = x[self.first[:-1]]
-        return np.append(ts, x[-1])
+        return self._split(np.append(ts, x[-1]), gap)
+
+    def _split(self, ts: np.ndarray, gap: float) -> np.ndarray | None:
+        """``ts`` with every interval cut evenly into as many as the curvature mismatch of its own window asks for
+        (the entities owning its two ends, the stand-in intervals it overlaps; :data:`_LOCAL_MARGIN` more): a sample
+        interval over a joint reads both arcs' curvatures along all its length, where :meth:`nodes` charged them to
+        the stand-in interval holding the joint only.  None when that makes :data:`DEFAULT_SAMPLES` or more."""
+        e = self.owner(ts)
+        k_min, k_max, _, _ = self._window(e[:-1], e[1:])
+        k_lo, k_hi, v_hi = self._overlap(ts)
+        dt = ts[1:] - ts[:-1]
+        per_step = _SAFETY * np.maximum(k_max - k_lo, k_hi - k_min) * v_hi ** 2 / 8.0
+        with np.errstate(invalid="ignore", over="ignore"):
+            parts = np.maximum(np.ceil(_LOCAL_MARGIN * dt * np.sqrt(per_step / gap)), 1.0)
+        total = float(parts.sum())
+        if not (math.isfinite(total) and total < DEFAULT_SAMPLES):
+            return None
+        if total == dt.size:
+            return ts
+        parts = parts.astype(int)
+        idx = np.repeat(np.arange(dt.size), parts)
+        sub = np.arange(idx.size) - np.repeat(np.cumsum(parts) - parts, parts)
+        return np.append(ts[idx] + dt[idx] * (sub / parts[idx]), ts[-1])
+
+    def _overlap(self, ts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per sample interval ``[ts[i], ts[i + 1]]``: the curvature range and highest speed of the stand-in intervals
+        it overlaps, ``(κ_lo, κ_hi, v_hi)``."""
+        last = self.k_lo.size - 1
+        m0 = np.clip(self.x.searchsorted(ts[:-1], side="right") - 1, 0, last)
+        m1 = np.maximum(np.clip(self.x.searchsorted(ts[1:], side="left") - 1, 0, last), m0)
+        at = np.stack([m0, m1 + 1], axis=1).ravel()
+        return (np.minimum.reduceat(np.append(self.k_lo, 0.0), at)[::2],
+                np.maximum.reduceat(np.append(self.k_hi, 0.0), at)[::2],
+                np.maximum.reduceat(np.append(self.v_hi, 0.0), at)[::2])
 
     def per_step(self, ts: np.ndarray, d0: np.ndarray, d1: np.ndarray, e0: np.ndarray, e1: np.ndarray) -> np.ndarray:
         """Per sample interval ``[ts[i], ts[i + 1]]``: ``c_i`` such that the curve's distance to the chain there is
@@ -243,14 +276,7 @@ class LocalBound:
         comes from the global bound where more than :data:`_LOCAL_SPAN` entities lie between ``e0`` and ``e1`` or
         the local one does not prove itself (module notes)."""
         dt = ts[1:] - ts[:-1]
-        # the stand-in intervals each sample interval overlaps: their curvature range and speed
-        last = self.k_lo.size - 1
-        m0 = np.clip(self.x.searchsorted(ts[:-1], side="right") - 1, 0, last)
-        m1 = np.maximum(np.clip(self.x.searchsorted(ts[1:], side="left") - 1, 0, last), m0)
-        at = np.stack([m0, m1 + 1], axis=1).ravel()
-        k_lo = np.minimum.reduceat(np.append(self.k_lo, 0.0), at)[::2]
-        k_hi = np.maximum.reduceat(np.append(self.k_hi, 0.0), at)[::2]
-        v_hi = np.maximum.reduceat(np.append(self.v_hi, 0.0), at)[::2]
+        k_lo, k_hi, v_hi = self._overlap(ts)
         k_min, k_max, k_abs, wide = self._window(e0, e1)
         mismatch = np.maximum(k_max - k_lo, k_hi - k_min)
         h = v_hi * dt

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 
 import camfab
 import camfab.discretize.measure as measure_mod
@@ -205,7 +205,7 @@ def test_nodes_keep_every_breakpoint_and_follow_the_need():
 def test_a_wrong_bound_is_caught():
     """A local bound that claims no excursion between samples (every ``c_i`` zero) is caught by the refinement,
     which finds distances above it: the measurement returns no certificate (inf); the honest bound certifies the
-    same samples."""
+    same samples, its refinement finding at least what the wrong one's did."""
     curve = issue15_curve()
     chain = arcs(curve, tol=1e-3).chain()
     sur = fit_surrogate(curve, 1e-3)[0]
@@ -223,7 +223,7 @@ def test_a_wrong_bound_is_caught():
     honest = LocalBound(sur, chain, K, foot)
     worst_h, _, certified_h = fit_curve_to_chain(chain, curve, ts.size - 1, 5e-5, foot, (K, vmax), honest, nodes=ts)
     assert worst_h <= certified_h <= 1e-3
-    assert worst < worst_h  # what the wrong bound steered the refinement away from
+    assert worst <= worst_h  # it refines the brackets whose sampled ends reach the top: a subset of the honest ones
 
 
 @pytest.mark.parametrize("label", ["ejemplo11ro[0]", "valve_exhaust_ej1[0]", "wedge_translating[0]"])
@@ -256,6 +256,9 @@ def test_fine_fits_are_certified_without_the_default_measurement(label, monkeypa
 
 @settings(max_examples=15, deadline=None)
 @given(cam_programs())
+# (found by this test: a sample interval over a joint read both arcs' curvatures along its whole length, where the
+# plan had charged them to one stand-in interval; the fit's local certificate failed, 1.006e-3 > tol)
+@example(([("poly345", 5.0, 78), ("dwell", 0, 25), ("cycloidal", -5.0, 25), ("dwell", 0, 232)], 25.0, 1e-3))
 def test_every_interval_bound_holds_on_random_cams(case):
     """Random cams (one or two rises of the common laws, dwells, a return; base radius 25–60 mm; tol 1e-2, 1e-3 or
     1e-4 mm): every sample interval's bound holds against 16 exact distances inside it, and bounds the fit within
