@@ -25,7 +25,7 @@ from .exitcodes import EXIT_BROKEN_PIPE, EXIT_CHECKS, EXIT_INPUT, EXIT_INTERRUPT
 from .io import atomic_write, inside, output_folder, write_all
 from .pipeline import Cam, Output, Request
 from .results import Severity, Verdict
-from .terminal import first_interrupt_only, log_to_stderr, stdout_to_devnull
+from .terminal import first_interrupt_only, log_to_stderr, raise_if_interrupted, stdout_to_devnull
 from .textsafe import plain
 from .version import __version__
 
@@ -567,11 +567,16 @@ def _guarded(args: argparse.Namespace) -> int:
     """Run the command; the deliberate errors become their exit codes and a one-line message: a missing
     optional dependency 3; every other :class:`~camfab.errors.CamfabError` (SpecError, UsageError,
     GeometryError, InputError, ExportError, ...) is invalid input, 2.  ApiError and InternalError are bugs
-    of camfab, not of the input: they keep their traceback."""
+    of camfab, not of the input: they keep their traceback.  Any error after a Ctrl-C is the interrupt
+    (:func:`~camfab.terminal.interrupt_came`): exit 130, "interrupted", not the error's message."""
     fn: Any = COMMANDS[args.command][0]
     token = _ALLOW_OUTSIDE.set(bool(getattr(args, "allow_outside_files", False)))
     try:
-        return int(fn(args))
+        try:
+            return int(fn(args))
+        except Exception:
+            raise_if_interrupted()  # the interrupt, turned into this error (terminal.interrupt_came)
+            raise
     except (MissingDependencyError, UnreachableError) as exc:  # the environment lacks something: exit 3
         print(f"camfab {args.command}: error: {exc}", file=sys.stderr)
         return EXIT_IO

@@ -61,6 +61,7 @@ from .pipeline import Cam, Output, Request, RunResult, build_files, shop_file_na
 from .records import dataclass, replace
 from .report.overview import cam_summary, index_html
 from .results import Verdict
+from .terminal import interrupt_came
 from .textsafe import bounded, plain
 from .threads import blas_single_threaded
 from .version import __version__
@@ -146,6 +147,8 @@ def _read(path: Path, allow_outside_files: bool = False) -> tuple[DesignSpec | N
     try:
         spec = load_design(path, allow_outside_files=allow_outside_files)
     except Exception as exc:  # any failure is reported in this design's entry, with the others kept
+        if interrupt_came():  # the interrupt, turned into this error: not this design's failure
+            raise
         log.info("%s cannot be read (%s: %s); its key hashes the file alone", path, type(exc).__name__, exc)
         return None, (path,), exc
     return spec, spec.sources, None
@@ -196,6 +199,8 @@ def build_cam(job: Job) -> dict:
         entry.update(cam_summary(spec, cam.geometry, cam.check(), res.deviations.values()))
         entry["output"] = {"files": files, "deviations": res.deviations, "shop": sorted(shop_file_names(cam))}
     except Exception as exc:  # contained: one design's failure must not lose the others
+        if interrupt_came():  # the interrupt, turned into this error: not this design's failure
+            raise
         _failed(entry, exc, back)
     entry.setdefault("name", job.name)
     entry["seconds"] = time.perf_counter() - t0
@@ -240,6 +245,8 @@ def _commit(entry: dict, out: Path, recorded: frozenset[str]) -> dict:
         swap_dir(staging, folder)
         entry["files"] = [_file_entry(folder / n, out, files[n], made["deviations"].get(n)) for n in sorted(files)]
     except Exception as exc:  # contained, like a failure of the build
+        if interrupt_came():  # the interrupt, turned into this error: not this design's failure
+            raise
         where = str(staging) if staging is not None else None
         _failed(entry, exc, (lambda t: t.replace(where, str(folder))) if where else str)
     finally:

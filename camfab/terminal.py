@@ -10,7 +10,10 @@ import sys
 import threading
 from typing import Any
 
-__all__ = ["log_to_stderr", "first_interrupt_only", "stdout_to_devnull"]
+__all__ = ["log_to_stderr", "first_interrupt_only", "interrupt_came", "raise_if_interrupted", "stdout_to_devnull"]
+
+#: the Ctrl-Cs :func:`first_interrupt_only` has seen since it was entered (in this process)
+_CAME: list[int] = []
 
 
 @contextlib.contextmanager
@@ -42,14 +45,31 @@ def first_interrupt_only():
         return
 
     def first(signum: int, frame: Any) -> None:
+        _CAME.append(signum)
         signal.signal(signal.SIGINT, signal.SIG_DFL)
         signal.default_int_handler(signum, frame)  # raises KeyboardInterrupt
 
+    _CAME.clear()
     signal.signal(signal.SIGINT, first)
     try:
         yield
     finally:
         signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
+def interrupt_came() -> bool:
+    """Whether a Ctrl-C came while :func:`first_interrupt_only` was in force.  Its ``KeyboardInterrupt`` can reach
+    the command as another error: an extension module whose initialisation it interrupts fails its import with
+    ``ImportError('initialization failed')`` (pybind11's: OCP's, matplotlib's), and code that catches that error
+    (an optional import, a contained failure) goes on without it.  Such an error is the interrupt."""
+    return bool(_CAME)
+
+
+def raise_if_interrupted() -> None:
+    """``KeyboardInterrupt`` if :func:`interrupt_came` (raised as Python's own handler raises it; inside an
+    ``except`` clause its context is the error handled)."""
+    if _CAME:
+        signal.default_int_handler(signal.SIGINT, None)
 
 
 def stdout_to_devnull() -> None:
