@@ -12,7 +12,7 @@ from typing import Any
 
 __all__ = ["log_to_stderr", "first_interrupt_only", "interrupt_came", "raise_if_interrupted", "stdout_to_devnull"]
 
-#: the Ctrl-Cs :func:`first_interrupt_only` has seen since it was entered (in this process)
+#: the Ctrl-Cs :func:`first_interrupt_only` has seen while in force (in this process)
 _CAME: list[int] = []
 
 
@@ -55,6 +55,7 @@ def first_interrupt_only():
         yield
     finally:
         signal.signal(signal.SIGINT, signal.default_int_handler)
+        _CAME.clear()  # (a later command, or the API's package in this process, starts without it)
 
 
 def interrupt_came() -> bool:

@@ -216,6 +216,7 @@ def _swallowed_ctrl_c_then(error: BaseException):
     return stage
 
 
+@linux_only
 @pytest.mark.parametrize("error", [ImportError("initialization failed"), OSError(5, "Input/output error"),
                                    AttributeError("partially initialized module 'matplotlib'")],
                          ids=["import", "os", "other"])
@@ -224,6 +225,7 @@ def test_an_error_after_ctrl_c_is_the_interrupt(monkeypatch, capsys, tmp_path, e
     error's message or traceback, nothing written, and the SIGINT handler restored; without a Ctrl-C the same
     error is still itself."""
     from camfab.errors import MissingDependencyError
+    from camfab.terminal import interrupt_came
 
     monkeypatch.setattr(pipeline, "build_files", _swallowed_ctrl_c_then(error))
     out = tmp_path / "out"
@@ -232,6 +234,7 @@ def test_an_error_after_ctrl_c_is_the_interrupt(monkeypatch, capsys, tmp_path, e
     assert capsys.readouterr().err.strip().splitlines() == ["camfab run: interrupted"]
     assert not out.exists()
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    assert not interrupt_came()  # (cleared with the command: the API's package after it contains errors again)
 
     def plain(*args, **kwargs):
         raise MissingDependencyError("the report needs matplotlib")
@@ -241,6 +244,7 @@ def test_an_error_after_ctrl_c_is_the_interrupt(monkeypatch, capsys, tmp_path, e
     assert "needs matplotlib" in capsys.readouterr().err
 
 
+@linux_only
 def test_a_contained_design_failure_after_ctrl_c_is_the_interrupt(monkeypatch, capsys, designs, tmp_path):
     """``package --jobs 1`` contains a design's failure and goes on with the others; a failure after a Ctrl-C
     is the interrupt instead: exit 130, no cam folder, no leftovers."""
