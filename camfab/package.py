@@ -1,13 +1,12 @@
 """Drawing packages: many designs in parallel, a manifest, an index, incremental rebuilds.
 
-``package(paths, out)`` finds the designs (``*.toml`` and ``*.xlsx`` files, folders
-searched recursively), runs each design through :mod:`camfab.pipeline` in its own
-folder ``out/<name>/`` on a process pool, and writes ``out/manifest.json`` (each
-file's sha256 and size, measured deviation, tolerance, verdict, key figures and the reasons for the verdict
-(:func:`camfab.report.overview.cam_summary`), stage timings), ``out/index.html``
-(:func:`camfab.report.overview.index_html`) and, when any cam has a PDF sheet, ``out/drawings.pdf``: a contents
-page, then every cam's sheet (:func:`camfab.cad.pdf.write_drawing_set`; docs/decisions.md, "The package index and
-the drawing set").
+``package(paths, out)`` finds the designs (``*.toml`` and ``*.xlsx`` files, folders searched recursively), runs
+each design through :mod:`camfab.pipeline` in its own folder ``out/<name>/`` on a process pool, and writes
+``out/manifest.json`` (each file's sha256 and size, measured deviation, tolerance, verdict, key figures and the
+reasons for the verdict (:func:`camfab.report.overview.cam_summary`), stage timings), ``out/index.html``
+(:func:`camfab.report.overview.index_html`) and, when any cam has a PDF sheet, ``out/drawings.pdf``: a contents page,
+then every cam's sheet (:func:`camfab.cad.pdf.write_drawing_set`; docs/decisions.md, "The package index and the
+drawing set").
 
 Folders: each design's folder is :func:`~camfab.io.safe_stem` of its name (of its file's stem when it cannot
 be read), made unique in the order the designs are found (:func:`folders`): a stem already taken — by an
@@ -17,19 +16,17 @@ earlier design or by the package's own ``manifest.json`` / ``index.html``, compa
 A failing design's error is recorded bounded (:func:`camfab.textsafe.bounded`: at most 10 lines of 300
 characters, control characters removed), since it may quote a line of any file.
 
-Incremental: each cam's *input key* hashes its design file, the files it
-references (knot tables), the camfab version, the shipped templates and the
-job options.  A cam whose key is unchanged and whose files are all present with
-their recorded hashes is not rebuilt.  A design that fails is recorded with its
-error (in the manifest, the index and the exit status) without stopping the
-others.
+Incremental: each cam's *input key* hashes its design file, the files it references (knot tables), the camfab
+version, the shipped templates and the job options.  A cam whose key is unchanged and whose files are all present
+with their recorded hashes is not rebuilt.  A design that fails is recorded with its error (in the manifest, the
+index and the exit status) without stopping the others; an error after a Ctrl-C is the interrupt instead
+(:func:`camfab.terminal.raise_if_interrupted`).
 
-Faults (docs/decisions.md, "Faults: staging, locks, durability"): the output folder is locked
-while a package is written into it; each cam is written into a staging folder
-``out/.<name>.camfab-staging-<pid>`` and swapped in whole, so a cam folder holds either its old or
-its new complete set; files an earlier package wrote (recorded in its manifest) that the new
-manifest does not list are removed, any other file is kept; worker processes ignore Ctrl-C (the
-parent stops them) and die with their parent.
+Faults (docs/decisions.md, "Faults: staging, locks, durability"): the output folder is locked while a package is
+written into it; each cam is written into a staging folder ``out/.<name>.camfab-staging-<pid>`` and swapped in
+whole, so a cam folder holds either its old or its new complete set; files an earlier package wrote (recorded in its
+manifest) that the new manifest does not list are removed, any other file is kept; worker processes ignore Ctrl-C
+(the parent stops them) and die with their parent.
 """
 from __future__ import annotations
 
@@ -61,7 +58,7 @@ from .pipeline import Cam, Output, Request, RunResult, build_files, shop_file_na
 from .records import dataclass, replace
 from .report.overview import cam_summary, index_html
 from .results import Verdict
-from .terminal import interrupt_came
+from .terminal import raise_if_interrupted
 from .textsafe import bounded, plain
 from .threads import blas_single_threaded
 from .version import __version__
@@ -126,8 +123,7 @@ def input_key(sources: Sequence[str | Path], options: dict, templates: str) -> s
     options : dict
         The job options.
     templates : str
-        Hash of the shipped templates.
-    """
+        Hash of the shipped templates."""
     h = hashlib.sha256()
     design, *refs = map(Path, sources)
     h.update(design.read_bytes())
@@ -147,8 +143,7 @@ def _read(path: Path, allow_outside_files: bool = False) -> tuple[DesignSpec | N
     try:
         spec = load_design(path, allow_outside_files=allow_outside_files)
     except Exception as exc:  # any failure is reported in this design's entry, with the others kept
-        if interrupt_came():  # the interrupt, turned into this error: not this design's failure
-            raise
+        raise_if_interrupted()  # (the interrupt turned into this error: not this design's failure)
         log.info("%s cannot be read (%s: %s); its key hashes the file alone", path, type(exc).__name__, exc)
         return None, (path,), exc
     return spec, spec.sources, None
@@ -199,8 +194,7 @@ def build_cam(job: Job) -> dict:
         entry.update(cam_summary(spec, cam.geometry, cam.check(), res.deviations.values()))
         entry["output"] = {"files": files, "deviations": res.deviations, "shop": sorted(shop_file_names(cam))}
     except Exception as exc:  # contained: one design's failure must not lose the others
-        if interrupt_came():  # the interrupt, turned into this error: not this design's failure
-            raise
+        raise_if_interrupted()  # (the interrupt turned into this error: not this design's failure)
         _failed(entry, exc, back)
     entry.setdefault("name", job.name)
     entry["seconds"] = time.perf_counter() - t0
@@ -245,8 +239,7 @@ def _commit(entry: dict, out: Path, recorded: frozenset[str]) -> dict:
         swap_dir(staging, folder)
         entry["files"] = [_file_entry(folder / n, out, files[n], made["deviations"].get(n)) for n in sorted(files)]
     except Exception as exc:  # contained, like a failure of the build
-        if interrupt_came():  # the interrupt, turned into this error: not this design's failure
-            raise
+        raise_if_interrupted()  # (the interrupt turned into this error: not this design's failure)
         where = str(staging) if staging is not None else None
         _failed(entry, exc, (lambda t: t.replace(where, str(folder))) if where else str)
     finally:

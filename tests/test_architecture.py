@@ -48,9 +48,10 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "camfab.pipeline": BASE + ("camfab.io", "camfab.design", "camfab.discretize", "camfab.offset",
                                "camfab.formats", "camfab.cad", "camfab.gcode", "camfab.report", "camfab.assets",
                                "camfab.pipeline"),
+    # (camfab.terminal: its Ctrl-C record tells the containment an interrupt turned into an error from a failure)
     "camfab.package": BASE + ("camfab.io", "camfab.design", "camfab.formats", "camfab.pipeline",
                               "camfab.assets", "camfab.package", "camfab.package_dask", "camfab.cad",
-                              "camfab.report"),
+                              "camfab.report", "camfab.terminal"),
     "camfab.package_dask": BASE,  # Dask imported inside its functions only
     "camfab.cli": ("camfab",),
     "camfab.terminal": (),
