@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import math
 import os
+import signal
 from pathlib import Path
 
 import pytest
@@ -12,6 +13,13 @@ from hypothesis import settings
 settings.register_profile("ci", derandomize=True, print_blob=True)
 if os.environ.get("CI"):
     settings.load_profile("ci")
+
+# The Ctrl-C tests send SIGINT to camfab, in this process and in commands it starts.  A suite started as an
+# asynchronous job of a shell without job control (`bash .ci/run &` in a script) inherits SIGINT ignored, and so would
+# every command: camfab then rightly obeys that and goes on (13 of those tests failed so).  Python's own handler
+# here makes SIGINT deliverable again, and the commands started from here get the default action back.
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "camfab" / "examples"
 
