@@ -72,10 +72,9 @@ def single_piece_shapes(sur: HermiteSurrogate, segs: list, n: int = 257) -> list
     once: the same values bit for bit (the rows of :func:`~camfab.discretize.spanmodel.stacked_span_model`, then
     every operation of :func:`span_shape` elementwise, numpy's gradient by :func:`_gradient_rows`), for a curve of
     hundreds of pieces (a knot table) whose spans would each cost their own few dozen small numpy calls."""
-    t, s0, theta, _, _, piece = stacked_span_model(sur, segs, n)
-    kappa = _gradient_rows(theta, s0)
-    dk = np.abs(_gradient_rows(kappa, s0))
-    s = s0 + 0.0
+    t, s, theta, _, _, piece = stacked_span_model(sur, segs, n)
+    kappa = _gradient_rows(theta, s)
+    dk = np.abs(_gradient_rows(kappa, s))
     return [(t[i], s[i], dk[i], np.abs(kappa[i]), np.full(n, piece[i, 0])) for i in range(t.shape[0])]
 
 
