@@ -122,7 +122,7 @@ def write_all(files: Mapping[Path, str | bytes], *, durable: bool | None = None)
     try:
         for path, data in files.items():
             raw = data.encode("utf-8") if isinstance(data, str) else data
-            temps.append((_write_temp(Path(path), raw, sync), Path(path)))
+            _write_temp(Path(path), raw, sync, temps)
         with hold_sigint():
             for tmp, path in temps:
                 try:
@@ -171,8 +171,10 @@ def atomic_stream(path: str | Path, *, durable: bool | None = None) -> Iterator[
     An ``OSError`` names ``path``."""
     path = Path(path)
     sync = DURABLE if durable is None else durable
-    fd, tmp = _new_temp(path)
+    tmp = ""
     try:
+        with hold_sigint():  # the name is known before an interrupt can land (delivered here, inside the try)
+            fd, tmp = _new_temp(path)
         with os.fdopen(fd, "wb") as fh:
             yield _Stream(fh, path)
             if sync:
@@ -182,7 +184,8 @@ def atomic_stream(path: str | Path, *, durable: bool | None = None) -> Iterator[
         with hold_sigint():
             os.replace(tmp, path)
     except BaseException as exc:
-        Path(tmp).unlink(missing_ok=True)
+        if tmp:
+            Path(tmp).unlink(missing_ok=True)
         if isinstance(exc, OSError) and str(path) not in str(exc):
             raise named(exc, path) from exc
         raise
@@ -200,22 +203,24 @@ def _new_temp(path: Path) -> tuple[int, str]:
         raise named(exc, path) from exc
 
 
-def _write_temp(path: Path, raw: bytes, sync: bool) -> str:
-    """``raw`` in a new temporary file beside ``path`` (its name returned); nothing left on failure."""
-    fd, tmp = _new_temp(path)
+def _write_temp(path: Path, raw: bytes, sync: bool, temps: list[tuple[str, Path]]) -> None:
+    """``raw`` in a new temporary file beside ``path``, ``(name, path)`` appended to ``temps`` as soon as the file
+    exists: Ctrl-C is held back from its creation until it is listed, so the caller's cleanup (which removes every
+    listed name on any failure) always sees it: an interrupt that landed between ``mkstemp`` and the list once left
+    ``.X.nc.camfab-tmp-…`` behind.  An ``OSError`` names ``path``."""
+    with hold_sigint():
+        fd, tmp = _new_temp(path)
+        temps.append((tmp, path))
+        fh = os.fdopen(fd, "wb")  # closed by its finaliser if the held interrupt lands before the block below
     try:
-        with os.fdopen(fd, "wb") as fh:
+        with fh:
             write_bytes(fh, raw, path)
             if sync:
                 fh.flush()
                 os.fsync(fh.fileno())
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp creates 0600; give the usual file mode
-    except BaseException as exc:
-        Path(tmp).unlink(missing_ok=True)
-        if isinstance(exc, OSError):
-            raise named(exc, path) from exc
-        raise
-    return tmp
+    except OSError as exc:
+        raise named(exc, path) from exc
 
 
 def write_bytes(fh: BinaryIO, raw: bytes, path: Path) -> None:
@@ -398,9 +403,10 @@ def _busy(folder: Path, why: str) -> OSError:
 def _probe(folder: Path) -> None:
     """Create and remove a temporary file in ``folder``: an ``OSError`` naming it if it cannot be written."""
     try:
-        fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".probe{TEMP_MARK}tmp-{os.getpid()}-")
-        os.close(fd)
-        os.unlink(tmp)
+        with hold_sigint():  # an interrupt never lands between the probe's creation and its removal
+            fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".probe{TEMP_MARK}tmp-{os.getpid()}-")
+            os.close(fd)
+            os.unlink(tmp)
     except OSError as exc:
         raise named(exc, folder, "cannot write into the output folder") from exc
 
@@ -417,8 +423,9 @@ def swap_dir(new: Path, target: Path) -> None:
         shutil.rmtree(new, ignore_errors=True)  # now the old contents
     else:
         aside = target.with_name(leftover_name(target.name, "old"))
-        os.rename(target, aside)
-        os.rename(new, target)
+        with hold_sigint():  # never interrupted between the two renames, with nothing at ``target``
+            os.rename(target, aside)
+            os.rename(new, target)
         shutil.rmtree(aside, ignore_errors=True)
     if DURABLE:
         fsync_dir(target.parent)

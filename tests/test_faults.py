@@ -405,6 +405,41 @@ def test_a_cam_folder_is_swapped_whole(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["cam"]
 
 
+
+def _sigint_once_made(monkeypatch) -> None:
+    """``tempfile.mkstemp`` as camfab's writers call it, followed at once by a real SIGINT to this process: the
+    interrupt is due the moment the temporary exists, before its name is back in the writer's hands."""
+    real = cio.tempfile.mkstemp
+
+    def mkstemp(*args, **kwargs):
+        made = real(*args, **kwargs)
+        os.kill(os.getpid(), signal.SIGINT)
+        return made
+
+    monkeypatch.setattr(cio.tempfile, "mkstemp", mkstemp)
+
+
+@pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="POSIX: Ctrl-C held back by the signal mask")
+@pytest.mark.parametrize("how", ["write_all", "atomic_stream", "probe"])
+def test_ctrl_c_the_instant_a_temporary_exists_leaves_none(tmp_path, monkeypatch, how):
+    """The window that once left ``.Ejemplo9RT.nc.camfab-tmp-…`` after ``camfab run`` was interrupted at 0.8 s
+    (tests/test_interrupt_timing.py): a Ctrl-C between ``mkstemp`` and the writer's cleanup list.  Every writer
+    (a set of files, a stream, the output folder's probe) ends with the interrupt and no temporary, and the file
+    it was replacing is untouched."""
+    (tmp_path / "b.nc").write_text("old")
+    _sigint_once_made(monkeypatch)
+    with pytest.raises(KeyboardInterrupt):
+        if how == "write_all":
+            write_all({tmp_path / "a.dxf": b"0", tmp_path / "b.nc": b"G0"})
+        elif how == "atomic_stream":
+            with cio.atomic_stream(tmp_path / "b.nc") as fh:
+                fh.write(b"G0")
+        else:
+            cio._probe(tmp_path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["b.nc"]
+    assert (tmp_path / "b.nc").read_text() == "old"
+
+
 # ---------------------------------------------------------------------------
 # 4. one writer per output folder
 def test_a_locked_folder_is_refused_with_exit_3_naming_it(tmp_path, capsys):
