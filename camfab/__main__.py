@@ -4,6 +4,10 @@ BLAS runs on one thread in the command line unless the user set a thread count: 
 when numpy is imported and keeps them spinning, which cost ~0.1 s of CPU of every command's start on 2 cores while
 camfab's linear algebra is small (the fit already pins BLAS to one thread; docs/decisions.md, "One BLAS thread in
 the fitter").  This runs before numpy is imported (``import camfab`` imports no numpy).
+
+numpy's and OpenBLAS's kernels are pinned the same way, to those every x86-64 CPU with AVX2 runs, so that the files'
+bytes do not depend on the CPU (:mod:`camfab.kernels`; docs/decisions.md, "The same bytes on every x86-64 CPU with
+AVX2"). ``package``'s workers inherit both settings.
 """
 from __future__ import annotations
 
@@ -15,6 +19,7 @@ from collections.abc import MutableMapping
 from typing import Any
 
 from .exitcodes import EXIT_INTERRUPTED
+from .kernels import same_kernels_by_default
 
 #: variables any BLAS build reads for its thread count; a user's explicit setting of any of them wins
 BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "GOTO_NUM_THREADS")
@@ -28,6 +33,7 @@ def one_blas_thread_by_default(environ: MutableMapping[str, str] = os.environ) -
 
 
 one_blas_thread_by_default()
+same_kernels_by_default()
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -9,6 +9,12 @@ from pathlib import Path
 import pytest
 from hypothesis import settings
 
+from camfab.kernels import same_kernels_by_default
+
+# numpy's and OpenBLAS's kernels as the command line pins them (docs/decisions.md, "The same bytes on every x86-64
+# CPU with AVX2"): numpy is not imported yet here, so the tests compute with the bits of the files camfab writes
+same_kernels_by_default()
+
 # CI runs property tests with a fixed seed sequence (reproducible runs); locally they explore freely.
 settings.register_profile("ci", derandomize=True, print_blob=True)
 if os.environ.get("CI"):

@@ -56,7 +56,8 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "camfab.cli": ("camfab",),
     "camfab.terminal": (),
     "camfab.exitcodes": (),
-    "camfab.__main__": ("camfab.cli", "camfab.exitcodes"),
+    "camfab.kernels": (),
+    "camfab.__main__": ("camfab.cli", "camfab.exitcodes", "camfab.kernels"),
     "camfab": ("camfab",),  # the façade re-exports
 }
 #: calls that read or write files

@@ -15,7 +15,8 @@ LinuxCNC program, and a ``compare`` of two examples.  Exit codes are recorded to
 Hashes of files made by outside libraries (matplotlib PNG/SVG, cadquery STEP, ezdxf headers) depend on
 their versions, so the manifest records the versions; ``check`` compares those files only when the
 versions are the same and says so otherwise.  BLAS is pinned to one thread (the arc fit's small
-least-squares problems round differently with more threads).
+least-squares problems round differently with more threads), and numpy's and OpenBLAS's kernels as the command
+line pins them (``camfab.kernels``: AVX-512 machines gave 230 differences before).
 """
 from __future__ import annotations
 
@@ -23,6 +24,9 @@ import os
 
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"
+from camfab.kernels import same_kernels_by_default  # noqa: E402  (imports no numpy)
+
+same_kernels_by_default()  # numpy's and OpenBLAS's kernels as the command line pins them, before numpy is imported
 
 import argparse  # noqa: E402
 import concurrent.futures  # noqa: E402
