@@ -17,7 +17,8 @@ import os
 import sys
 from collections.abc import MutableMapping
 
-__all__ = ["NUMPY_AVX512_GROUPS", "OPENBLAS_CORE", "cpu_flags", "numpy_version", "same_kernels_by_default"]
+__all__ = ["NUMPY_AVX512_GROUPS", "OPENBLAS_CORE", "cpu_flags", "numpy_version", "same_kernels_by_default",
+           "fingerprint"]
 
 #: numpy's dispatched x86 groups above AVX2 (numpy >= 2.4's names; X86_V3, AVX2 and FMA3, stays on)
 NUMPY_AVX512_GROUPS = "X86_V4 AVX512_ICL AVX512_SPR"
@@ -85,3 +86,21 @@ def same_kernels_by_default(environ: MutableMapping[str, str] = os.environ, flag
         out["OPENBLAS_CORETYPE"] = OPENBLAS_CORE
     environ.update(out)
     return out
+
+
+def fingerprint() -> dict[str, list[str]]:
+    """The kernels this process computes with: numpy's dispatched targets in use, and each BLAS library's core
+    (threadpoolctl). Two processes with the same fingerprint (and the same versions) write the same bytes. This
+    imports numpy."""
+    import importlib
+
+    from threadpoolctl import threadpool_info
+
+    try:
+        umath = importlib.import_module("numpy._core._multiarray_umath")
+    except ImportError:  # numpy < 2
+        umath = importlib.import_module("numpy.core._multiarray_umath")
+    features = umath.__cpu_features__
+    return {"numpy": sorted(k for k in umath.__cpu_dispatch__ if features.get(k)),
+            "blas": sorted(f"{i.get('internal_api')}:{i.get('architecture')}" for i in threadpool_info()
+                           if i.get("user_api") == "blas")}

@@ -27,7 +27,9 @@ from typing import Any
 from .errors import InputError, MissingDependencyError, UnreachableError
 
 __all__ = ["dask_executor", "close_workers_first", "LOCAL_CONFIG", "NO_DASHBOARD", "CONNECT_TIMEOUT_S",
-           "parse_config", "executor_options"]
+           "parse_config", "executor_options", "other_kernels"]
+
+log = logging.getLogger(__name__)
 
 #: seconds to reach the scheduler, and for it to have a worker, before giving up (exit 3, nothing written)
 CONNECT_TIMEOUT_S = 10.0
@@ -176,6 +178,7 @@ def _map(distributed: Any, client: Any, fn: Callable, items: list, lost: Callabl
     Leaving early (an interrupt) cancels what is left."""
     if not items:
         return
+    other_kernels(client)
     run = uuid.uuid4().hex[:12]
     futures = {client.submit(fn, item, key=f"camfab-build-{run}-{i}", pure=False, retries=1): item
                for i, item in enumerate(items)}
@@ -187,6 +190,27 @@ def _map(distributed: Any, client: Any, fn: Callable, items: list, lost: Callabl
                 yield lost(futures[future], _why(exc))
     finally:
         client.cancel(list(futures), force=True)
+
+
+def other_kernels(client: Any) -> list[str]:
+    """The workers whose numpy or OpenBLAS kernels differ from this process's, named in a warning: their files may
+    differ from this machine's in the last digits (docs/decisions.md, "The same bytes on every x86-64 CPU with
+    AVX2"). A local cluster's workers inherit the command line's kernels; a remote cluster's have their own."""
+    from .kernels import NUMPY_AVX512_GROUPS, OPENBLAS_CORE, fingerprint
+
+    mine = fingerprint()
+    try:
+        theirs = client.run(fingerprint)
+    except Exception:  # a worker without camfab: its tasks say so
+        return []
+    other = sorted(address for address, kernels in theirs.items() if kernels != mine)
+    if other:
+        shown = ", ".join(other[:3]) + (f" and {len(other) - 3} more" if len(other) > 3 else "")
+        log.warning("Dask worker(s) %s compute with other numpy or BLAS kernels than this machine (%s, here %s): "
+                    "their files may differ from a build here in the last digits; start the workers with "
+                    "NPY_DISABLE_CPU_FEATURES=\"%s\" (AVX-512 CPUs, numpy >= 2.4) and OPENBLAS_CORETYPE=%s "
+                    "(AVX2 CPUs)", shown, theirs[other[0]], mine, NUMPY_AVX512_GROUPS, OPENBLAS_CORE)
+    return other
 
 
 def _why(exc: Exception) -> str:

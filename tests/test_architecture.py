@@ -52,7 +52,7 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "camfab.package": BASE + ("camfab.io", "camfab.design", "camfab.formats", "camfab.pipeline",
                               "camfab.assets", "camfab.package", "camfab.package_dask", "camfab.cad",
                               "camfab.report", "camfab.terminal"),
-    "camfab.package_dask": BASE,  # Dask imported inside its functions only
+    "camfab.package_dask": BASE + ("camfab.kernels",),  # Dask imported inside its functions only
     "camfab.cli": ("camfab",),
     "camfab.terminal": (),
     "camfab.exitcodes": (),

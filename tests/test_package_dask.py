@@ -81,6 +81,50 @@ def _wait_for_workers(cluster, n: int = 2, timeout: float = 60) -> None:
 
 
 # ---------------------------------------------------------------------------
+# the workers' numeric kernels (docs/decisions.md, "The same bytes on every x86-64 CPU with AVX2")
+def test_local_workers_compute_with_this_processs_kernels(cluster, caplog):
+    """They inherit the pinned kernels from this process's environment: no warning."""
+    from distributed import Client
+
+    from camfab.package_dask import other_kernels
+
+    with Client(cluster, set_as_default=False) as client, caplog.at_level(logging.WARNING, logger="camfab"):
+        assert other_kernels(client) == []
+    assert not [r for r in caplog.records if r.name.startswith("camfab")]
+
+
+@pytest.mark.slow
+def test_a_worker_with_other_kernels_is_named(caplog, monkeypatch):
+    """A worker started with another OpenBLAS core (as a remote machine would pick its own) is named, with the
+    variables that give it this machine's kernels."""
+    distributed = pytest.importorskip("distributed", reason="Dask distributed is not installed")
+    import dask
+
+    from camfab.kernels import OPENBLAS_CORE, cpu_flags, fingerprint
+    from camfab.package_dask import LOCAL_CONFIG, NO_DASHBOARD, other_kernels
+
+    flags, mine = cpu_flags(), fingerprint()
+    if flags is None or "avx" not in flags or not any(b.startswith("openblas") for b in mine["blas"]) \
+            or any(b.endswith(":Sandybridge") for b in mine["blas"]):
+        pytest.skip("needs OpenBLAS on an x86-64 CPU with AVX, not already on its Sandybridge core")
+    # the worker process inherits it when it starts (a nanny's ``env`` is set after numpy has loaded OpenBLAS)
+    monkeypatch.setenv("OPENBLAS_CORETYPE", "Sandybridge")
+    with dask.config.set(LOCAL_CONFIG):
+        c = distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None,
+                                     scheduler_kwargs=NO_DASHBOARD, silence_logs=logging.CRITICAL)
+    try:
+        with distributed.Client(c, set_as_default=False) as client, \
+                caplog.at_level(logging.WARNING, logger="camfab"):
+            other = other_kernels(client)
+            workers = list(client.scheduler_info()["workers"])
+    finally:
+        c.close()
+    assert other == workers and len(other) == 1
+    text = caplog.text
+    assert other[0] in text and "Sandybridge" in text and f"OPENBLAS_CORETYPE={OPENBLAS_CORE}" in text
+
+
+# ---------------------------------------------------------------------------
 # the same package as the built-in pool, and the incremental rebuild
 @pytest.mark.slow
 def test_dask_builds_the_same_files_and_manifest_as_the_builtin_pool(cluster, tmp_path):
