@@ -89,9 +89,9 @@ def same_kernels_by_default(environ: MutableMapping[str, str] = os.environ, flag
 
 
 def fingerprint() -> dict[str, list[str]]:
-    """The kernels this process computes with: numpy's dispatched targets in use, and each BLAS library's core
-    (threadpoolctl). Two processes with the same fingerprint (and the same versions) write the same bytes. This
-    imports numpy."""
+    """The kernels this process computes with: numpy's dispatched targets in use, and the cores of the BLAS
+    libraries loaded (threadpoolctl; each core once, however many copies are loaded). Two processes with the same
+    fingerprint (and the same versions) write the same bytes. This imports numpy."""
     import importlib
 
     from threadpoolctl import threadpool_info
@@ -102,5 +102,5 @@ def fingerprint() -> dict[str, list[str]]:
         umath = importlib.import_module("numpy.core._multiarray_umath")
     features = umath.__cpu_features__
     return {"numpy": sorted(k for k in umath.__cpu_dispatch__ if features.get(k)),
-            "blas": sorted(f"{i.get('internal_api')}:{i.get('architecture')}" for i in threadpool_info()
-                           if i.get("user_api") == "blas")}
+            "blas": sorted({f"{i.get('internal_api')}:{i.get('architecture')}" for i in threadpool_info()
+                            if i.get("user_api") == "blas"})}  # (a set: scipy loads its own copy, or not yet)

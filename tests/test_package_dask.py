@@ -83,7 +83,9 @@ def _wait_for_workers(cluster, n: int = 2, timeout: float = 60) -> None:
 # ---------------------------------------------------------------------------
 # the workers' numeric kernels (docs/decisions.md, "The same bytes on every x86-64 CPU with AVX2")
 def test_local_workers_compute_with_this_processs_kernels(cluster, caplog):
-    """They inherit the pinned kernels from this process's environment: no warning."""
+    """They inherit the pinned kernels from this process's environment: no warning.  This process has loaded
+    scipy's OpenBLAS beside numpy's and the workers have not (the first full run counted the copies)."""
+    import scipy.linalg  # noqa: F401
     from distributed import Client
 
     from camfab.package_dask import other_kernels
