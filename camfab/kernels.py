@@ -9,13 +9,16 @@ files: on an AVX-512 machine 230 of the golden manifest's records differed, ever
 to ``Haswell`` where the CPU has what those kernels need. numpy and OpenBLAS read them once, when numpy is imported.
 A variable the user has set is left alone. Nothing is changed on other CPUs or systems, or for a numpy before 2.4
 (other feature names: a name numpy does not dispatch is an ``ImportWarning``, an error under ``-W error``).
-docs/decisions.md, "The same bytes on every x86-64 CPU with AVX2". This module imports nothing of camfab or numpy.
+docs/decisions.md, "The same bytes on every x86-64 CPU with AVX2". This module imports no numpy (and of camfab only
+:mod:`camfab.installed`).
 """
 from __future__ import annotations
 
 import os
 import sys
 from collections.abc import MutableMapping
+
+from .installed import installed_version
 
 __all__ = ["NUMPY_AVX512_GROUPS", "OPENBLAS_CORE", "cpu_flags", "numpy_version", "same_kernels_by_default",
            "fingerprint"]
@@ -45,27 +48,11 @@ def cpu_flags(path: str = "/proc/cpuinfo") -> frozenset[str] | None:
 
 def numpy_version() -> tuple[int, int] | None:
     """numpy's ``(major, minor)`` from its ``version.py``, without importing numpy; None when not found."""
-    import importlib.util
-
+    parts = (installed_version("numpy", "version") or "").split(".")
     try:
-        spec = importlib.util.find_spec("numpy")
-    except (ImportError, ValueError):
+        return int(parts[0]), int(parts[1])
+    except (IndexError, ValueError):
         return None
-    where = list(spec.submodule_search_locations or ()) if spec is not None else []
-    for folder in where:
-        try:
-            with open(os.path.join(folder, "version.py"), encoding="utf-8") as fh:
-                text = fh.read(4096)
-        except OSError:
-            continue
-        for line in text.splitlines():
-            if line.startswith("version") and "=" in line:
-                parts = line.partition("=")[2].strip().strip("\"'").split(".")
-                try:
-                    return int(parts[0]), int(parts[1])
-                except (IndexError, ValueError):
-                    return None
-    return None
 
 
 def same_kernels_by_default(environ: MutableMapping[str, str] = os.environ, flags: object = _READ,

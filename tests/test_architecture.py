@@ -17,7 +17,7 @@ PACKAGE = ROOT / "camfab"
 #: fails the test, so a new package must take its place in the layers
 BASE = ("camfab.version", "camfab.errors", "camfab.units", "camfab.tolerances", "camfab.results", "camfab.numeric",
         "camfab.geom2d", "camfab.textsafe", "camfab.limits", "camfab.threads", "camfab.brent", "camfab.sets",
-        "camfab.words", "camfab.records")
+        "camfab.words", "camfab.records", "camfab.installed")
 LAYERS: dict[str, tuple[str, ...]] = {
     "camfab.version": (),
     "camfab.errors": ("camfab.textsafe", "camfab.records"),  # messages quote values through textsafe.excerpt
@@ -56,7 +56,8 @@ LAYERS: dict[str, tuple[str, ...]] = {
     "camfab.cli": ("camfab",),
     "camfab.terminal": (),
     "camfab.exitcodes": (),
-    "camfab.kernels": (),
+    "camfab.installed": (),
+    "camfab.kernels": ("camfab.installed",),
     "camfab.__main__": ("camfab.cli", "camfab.exitcodes", "camfab.kernels"),
     "camfab": ("camfab",),  # the façade re-exports
 }

@@ -25,11 +25,10 @@ from __future__ import annotations
 
 import functools
 import importlib.util
-import re
 from collections.abc import Iterator
-from pathlib import Path
 
 from ..geom2d import ArcChain
+from ..installed import installed_version
 from ..textsafe import dxf_string
 from . import dxf_skeleton as sk
 from .dxf import LAYERS, DxfContent, centre_mark_size, loop_nurbs, r12_pieces
@@ -169,15 +168,7 @@ def _fill(texts: tuple[str, ...], slots: tuple[int | str, ...], named: dict[str,
 def installed_ezdxf_version() -> str | None:
     """The installed ezdxf's version, read from its ``version.py`` without importing it (~0.4 ms; importing
     ezdxf costs ~0.3 s, ``importlib.metadata`` ~30 ms); None without ezdxf or when the file does not say."""
-    spec = importlib.util.find_spec("ezdxf")
-    if spec is None or spec.origin is None:
-        return None
-    try:
-        text = (Path(spec.origin).parent / "version.py").read_text(encoding="utf-8")
-    except OSError:
-        return None
-    found = re.search(r'^__version__\s*=\s*"([^"]+)"', text, re.M)
-    return found.group(1) if found else None
+    return installed_version("ezdxf")
 
 
 @functools.cache
