@@ -24,7 +24,7 @@ from .congruent import CongruentSpans
 from .curve import ParametricCurve, points_at
 from .entities import LINE_SWEEP_RAD, MAX_TURNING_RAD, arc_from, biarc, entity_point
 from .spanbatch import two_arc_fits
-from .spanmodel import SpanModel, cumtrapz, equioscillate
+from .spanmodel import SpanModel, cumtrapz, equioscillate, lawson_start
 from .spans import Span, cut_spans, span_density, span_ends, span_shape
 from .surrogate import HermiteSurrogate
 from .tolerance import within
@@ -42,8 +42,9 @@ _SPLINE_FILL = 0.97
 _SPLINE_MIN_GRID = 129
 #: the first arc count tried is this multiple of the asymptotic estimate
 _EST_FACTOR = 1.0
-#: one arc fewer is tried while the predicted error (∝ 1/m³) stays below this multiple of the target
-_DOWN_SLACK = 1.2
+#: one arc fewer is tried while the predicted error (∝ 1/m³) stays below this multiple of the target (1.2 until
+#: the counts had two starts: of the descents it let through above the target, 1 in 11 fitted; docs/decisions.md)
+_DOWN_SLACK = 1.0
 #: a span is only fitted up to this many arcs (else interpolating biarcs are used)
 _SPAN_MAX_ARCS = 64
 #: relative lengths of the two end arcs at each clamped end of a piece (an LP over C¹ patterns:
@@ -64,6 +65,9 @@ _FIXED_END_ARCS_ALT: tuple = ()
 #: dozen counts per span before the whole spline fell back to spans clamped at every breakpoint.  Fits that do
 #: converge start at most 16× over (the examples at 1e-2…1e-4 mm), the hopeless ones at 80–1700×.
 _FIXED_HOPELESS = 40.0
+#: a count that misses the target by at most this factor gets other starts (:meth:`_SpanFit.other_start` at
+#: once, :meth:`_SpanFit.retry_one_fewer` after the count above has fitted)
+_NARROW = 1.3
 #: spans whose search starts at this many arcs or more take the arcs of a congruent span already fitted
 _CONGRUENT_MIN = 4
 
@@ -91,37 +95,97 @@ class _SpanFit:
         self.sur, self.span, self.target = sur, span, target
         if span.shape is None:
             span.shape = span_shape(sur, span.segs)
+        self.shape: tuple = span.shape
         _, self.s0, self.density, _ = span_density(sur, span.segs, target, shape=span.shape)
         self.est = float(cumtrapz(self.density, self.s0)[-1])
         self.n_fixed = sum(f is not None for f in span.fixed)
         self.m_min = 2 + self.n_fixed
         self.tried: dict = {}
         self.models: dict = {}
+        self.others: dict = {}  # per count: the starts not yet optimised (:meth:`_starts`)
         self.pre: dict = {}  # attempts at the placed knots computed in a batch (spanbatch), by arc count
 
     def first_count(self) -> int:
         """The arc count :meth:`search` tries first."""
         return max(self.m_min, math.ceil(_EST_FACTOR * self.est))
 
-    def attempt(self, m: int, ends=_END_ARCS, knots=None, fixed_ends=_FIXED_END_ARCS):
-        """``(error, fits, (knots, k, error))`` of ``m`` arcs optimised from ``knots`` (default: placed)."""
+    def _model(self, m: int) -> SpanModel:
+        """The span's model for ``m`` arcs (made once)."""
+        if m not in self.models:
+            self.models[m] = SpanModel(self.sur, self.span.segs, max(_SPLINE_MIN_GRID, _SPLINE_SAMPLES * m + 1),
+                                       self.span.fixed)
+        return self.models[m]
+
+    def _placed(self, model: SpanModel, m: int, ends=_END_ARCS, fixed_ends=_FIXED_END_ARCS) -> np.ndarray:
+        """``m`` arcs placed by the density on ``model``'s grid, the end-arc ratios ``ends`` at a free end and
+        ``fixed_ends`` at one of fixed curvature."""
+        fixed = self.span.fixed
+        return _place_knots(model.s, np.interp(model.s, self.s0, self.density), m,
+                            fixed_ends if fixed[0] is not None else ends, fixed_ends if fixed[1] is not None else ends)
+
+    def attempt(self, m: int, ends=_END_ARCS, knots=None, fixed_ends=_FIXED_END_ARCS, start=None):
+        """``(error, fits, (knots, k, error))`` of ``m`` arcs optimised from ``knots`` (``start``: their
+        :func:`~camfab.discretize.spanmodel.lawson_start`, when made); without ``knots``, from the better of the
+        count's starts (:meth:`_starts`), or from the knots placed with the end-arc ratios ``ends`` and
+        ``fixed_ends`` when those are not the defaults."""
         span = self.span
         if knots is None and ends is _END_ARCS and fixed_ends is _FIXED_END_ARCS and m in self.pre:
             return self.pre.pop(m)
-        if m not in self.models:
-            self.models[m] = SpanModel(self.sur, span.segs, max(_SPLINE_MIN_GRID, _SPLINE_SAMPLES * m + 1),
-                                       span.fixed)
-        model = self.models[m]
-        if knots is None:
-            knots = _place_knots(model.s, np.interp(model.s, self.s0, self.density), m,
-                                 fixed_ends if span.fixed[0] is not None else ends,
-                                 fixed_ends if span.fixed[1] is not None else ends)
-        err, knots, k = equioscillate(model, knots)
+        model = self._model(m)
+        if knots is None and ends is _END_ARCS and fixed_ends is _FIXED_END_ARCS:
+            (knots, start), *self.others[m] = self._starts(model, m)
+        elif knots is None:
+            knots = self._placed(model, m, ends, fixed_ends)
+        err, knots, k = equioscillate(model, knots, start=start)
         free = np.ones(m, bool)
         free[0] = span.fixed[0] is None
         free[-1] = span.fixed[1] is None
         ok = err <= self.target and np.all(np.abs(k * np.diff(knots))[free] < MAX_TURNING_RAD * 1.5)
         return err, ok, (knots, k, err)
+
+    def _narrow(self, m: int, err: float) -> bool:
+        """Whether ``m`` arcs (error ``err``) missed the target narrowly enough for another start at that count."""
+        return m >= max(4, self.m_min) and err <= _NARROW * self.target
+
+    def centred_knots(self, m: int) -> np.ndarray | None:
+        """Knots of ``m`` arcs with one long arc over the span's largest curvature maximum: ``m + 1`` arcs placed by
+        the density, less their interior joint (not an end arc's) nearest that maximum; None without an interior
+        maximum or with fewer than 4 arcs.  The density ``|κ'|^(1/3)`` vanishes at a curvature extremum, where
+        the error of an arc is set by ``κ″`` instead, so the placed knots may put a joint next to the maximum where
+        the optimum has an arc centred on it (docs/decisions.md, "Arc-fit cost")."""
+        _, s, _, kappa, _ = self.shape
+        inner = (kappa[1:-1] > kappa[:-2]) & (kappa[1:-1] >= kappa[2:])
+        if m < 4 or not inner.any():
+            return None
+        at = s[1:-1][inner][np.argmax(kappa[1:-1][inner])]
+        model = self._model(m)
+        knots = self._placed(model, m + 1)
+        j = 2 + int(np.argmin(np.abs(knots[2:-2] - at)))
+        return np.delete(knots, j)
+
+    def _starts(self, model: SpanModel, m: int) -> list:
+        """The starts of ``m`` arcs in the order they are optimised, ``[(knots, lawson_start), ...]``: the knots
+        placed by the density, preceded by :meth:`centred_knots` (4 arcs or more, an interior curvature maximum)
+        when the minimax curvatures of those deviate less before the knots move.  A centred start that begins no
+        lower than the placed knots is not optimised at all (it costs one linear fit)."""
+        placed = self._placed(model, m)
+        starts = [(placed, lawson_start(model, placed))]
+        centred = self.centred_knots(m)
+        if centred is not None:
+            start = lawson_start(model, centred)
+            if float(np.abs(start[4]).max()) < float(np.abs(starts[0][1][4]).max()):
+                starts.insert(0, (centred, start))
+        return starts
+
+    def other_start(self, m: int):
+        """The fit of ``m`` arcs from the count's second start (:meth:`_starts`: the placed knots, after the centred
+        ones missed) when it fits (once), else None."""
+        others = self.others.pop(m, [])
+        for knots, start in others:
+            _, ok, fit = self.attempt(m, knots=knots, start=start)
+            if ok:
+                return fit
+        return None
 
     def search(self):
         """The fewest arcs that fit from the count search, or None (no fit, or more than the span allows)."""
@@ -134,6 +198,10 @@ class _SpanFit:
                 return None
             err, ok, fit = self.attempt(m)
             self.tried[m] = err
+            if not ok and self._narrow(m, err):
+                other = self.other_start(m)
+                if other is not None:
+                    return other  # (without it the search ends at m arcs at best: m failed from its first start)
             if self.n_fixed and len(self.tried) == 1 and not (err <= _FIXED_HOPELESS * self.target):
                 return None  # the fixed end curvature does not fit the curve (see _FIXED_HOPELESS)
             if ok and (best is None or m < best[0].size - 1):
@@ -161,7 +229,7 @@ class _SpanFit:
         optimised knots of ``best`` less the joint of the smallest curvature jump (not an end arc), then
         other end-arc ratios."""
         m = best[0].size - 2
-        if not (m >= max(4, self.m_min) and m in self.tried and self.tried[m] <= 1.3 * self.target):
+        if not (m in self.tried and self._narrow(m, self.tried[m])):
             return best
         kb, kk = best[0], best[1]
         jump = np.abs(np.diff(kk))[1:-1]
@@ -185,9 +253,11 @@ def _fit_span(sur: HermiteSurrogate, span: Span, target: float, fit: _SpanFit | 
     The arc count starts from the asymptotic estimate ``∫ (|κ'| / (124.7·target))^(1/3) ds``;
     every count gets knots equidistributing that density (end arcs shortened at clamped ends),
     then knots and curvatures are optimised together (:func:`equioscillate`);
-    the count goes down while the span still fits ``target`` and up until it does.
-    The optimum is not monotone in the count: at the smallest failing count a warm start
-    and other end-arc ratios (:data:`_END_ARCS_ALT`) are tried when it failed narrowly.
+    the count goes down while the span still fits ``target`` (one arc fewer when its predicted error does) and up
+    until it does.  A count starts from knots with one long arc over the curvature maximum
+    (:meth:`_SpanFit.centred_knots`) when their linear fit deviates less than that of the placed knots, which
+    follow when it misses narrowly.  The optimum is not monotone in the count: at the smallest failing count a
+    warm start and other end-arc ratios (:data:`_END_ARCS_ALT`) are tried when it failed narrowly.
     A span with a fixed end curvature that misses by far at its first count (:data:`_FIXED_HOPELESS`) is fitted
     again with free end curvatures (``fixed`` returned: the curvatures the fit imposes).  ``fit``: the span's
     search when already made (:func:`_fit_span_chains`).

@@ -14,7 +14,7 @@ import numpy as np
 from ..geom2d import TWO_PI, cross, dot
 from .surrogate import HermiteSurrogate
 
-__all__ = ["span_model", "stacked_span_model", "cumtrapz", "SpanModel", "equioscillate", "peak"]
+__all__ = ["span_model", "stacked_span_model", "cumtrapz", "SpanModel", "lawson_start", "equioscillate", "peak"]
 
 
 #: Lawson (minimax) reweighting iterations of the curvatures of given knots
@@ -356,7 +356,15 @@ def _linearisation(model: SpanModel, A: np.ndarray, C: np.ndarray, d: np.ndarray
     return _normal_equations(J, r)
 
 
-def equioscillate(model: SpanModel, knots: np.ndarray, iters: int = _EQUI_ITERS):
+def lawson_start(model: SpanModel, knots: np.ndarray):
+    """Where :func:`equioscillate` starts from ``knots``: ``(A, C, d, k, e)``, the system of the knots and the
+    (approximate) minimax curvatures ``k`` with their deviation ``e`` on the grid."""
+    A, C, d = model.system(knots)
+    k, e = _lawson(A, model.b, C, d, iters=4)
+    return A, C, d, k, e
+
+
+def equioscillate(model: SpanModel, knots: np.ndarray, iters: int = _EQUI_ITERS, start=None):
     """Jointly optimise knots and curvatures of a clamped span: ``(max |e|, knots, k)``.
 
     Starts from the (approximate) minimax curvatures of the given knots, then
@@ -364,9 +372,9 @@ def equioscillate(model: SpanModel, knots: np.ndarray, iters: int = _EQUI_ITERS)
     extremum of the deviation to one common level (a Remez-like exchange: the
     extrema are re-located after every step), the knot moves damped
     (Levenberg) and each step accepted only if the largest deviation drops.
+    ``start``: :func:`lawson_start` of ``knots``, when already made.
     """
-    A, C, d = model.system(knots)
-    k, e = _lawson(A, model.b, C, d, iters=4)
+    A, C, d, k, e = lawson_start(model, knots) if start is None else start
     best = (float(np.abs(e).max()), knots, k, e)
     m = k.size
     if m < 3:
