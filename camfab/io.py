@@ -255,15 +255,38 @@ def fsync_dir(folder: str | Path) -> None:
 @contextlib.contextmanager
 def hold_sigint() -> Iterator[None]:
     """Hold SIGINT back while the block runs (it is delivered at the end), on POSIX in the main thread: a set of
-    renames is not cut in half, and processes started inside begin with SIGINT blocked."""
+    renames is not cut in half, and processes started inside begin with SIGINT blocked.
+
+    Two layers (docs/decisions.md, "Faults: staging, locks, durability", "Later"): the signal mask, which processes
+    started inside inherit, and a Python handler that only records the signal.  The mask alone holds nothing in a
+    process with other threads (a BLAS worker, a pool's thread): the kernel hands a process-directed SIGINT to a
+    thread that does not block it, and Python then runs the handler in the main thread at once, whichever thread
+    took the signal.  A signal recorded is passed to the previous handler when the block ends."""
     if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
         yield
         return
+    previous = signal.getsignal(signal.SIGINT)
+    caught: list = []
+    if previous is not None:  # (None: a handler installed outside Python, which cannot be put back)
+        signal.signal(signal.SIGINT, lambda signum, frame: caught.append((signum, frame)))
     old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     try:
         yield
     finally:
         signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
+            if caught:
+                _deliver(previous, *caught[0])
+
+
+def _deliver(handler, signum: int, frame) -> None:
+    """Pass a SIGINT that :func:`hold_sigint` recorded to the handler it replaced (the default action: the signal
+    raised again; ignored: dropped)."""
+    if callable(handler):
+        handler(signum, frame)
+    elif handler == signal.SIG_DFL:
+        signal.raise_signal(signum)
 
 
 # ---------------------------------------------------------------------------

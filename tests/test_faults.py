@@ -419,6 +419,67 @@ def _sigint_once_made(monkeypatch) -> None:
     monkeypatch.setattr(cio.tempfile, "mkstemp", mkstemp)
 
 
+def _other_thread_takes_sigint(monkeypatch) -> None:
+    """As :func:`_sigint_once_made`, in a process where another thread has SIGINT unblocked (a BLAS worker, a pool's
+    thread): the kernel hands it the signal the main thread holds back, and Python runs the handler in the main
+    thread at its next chance (here: right after a pause that lets the other thread take it, still inside
+    ``mkstemp``)."""
+    real = cio.tempfile.mkstemp
+
+    def mkstemp(*args, **kwargs):
+        made = real(*args, **kwargs)
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.05)
+        return made
+
+    monkeypatch.setattr(cio.tempfile, "mkstemp", mkstemp)
+
+
+@pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="POSIX: Ctrl-C held back by the signal mask")
+@pytest.mark.parametrize("how", ["write_all", "atomic_stream", "probe"])
+def test_ctrl_c_taken_by_another_thread_still_waits_for_the_writer(tmp_path, monkeypatch, how):
+    """The CI run of 2026-11-27 (fifth sitting) lost the test below to a Ctrl-C that landed after ``pytest.raises``
+    had ended: another thread of the test process took the signal, so the main thread's mask held nothing.  With a
+    thread that does not block SIGINT alive, every writer still ends with the interrupt, no temporary, and the
+    replaced file untouched."""
+    (tmp_path / "b.nc").write_text("old")
+    _other_thread_takes_sigint(monkeypatch)
+    stop = threading.Event()
+    other = threading.Thread(target=stop.wait, daemon=True)
+    other.start()  # (made here, with SIGINT unblocked: the kernel's only choice while the writer holds it back)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            if how == "write_all":
+                write_all({tmp_path / "a.dxf": b"0", tmp_path / "b.nc": b"G0"})
+            elif how == "atomic_stream":
+                with cio.atomic_stream(tmp_path / "b.nc") as fh:
+                    fh.write(b"G0")
+            else:
+                cio._probe(tmp_path)
+    finally:
+        stop.set()
+        other.join()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["b.nc"]
+    assert (tmp_path / "b.nc").read_text() == "old"
+
+
+def test_a_held_ctrl_c_goes_to_the_handler_it_replaced_once():
+    """Nested holds pass one recorded SIGINT outward to the handler in place before them, once; without one, none."""
+    seen = []
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: seen.append(signum))
+    try:
+        with cio.hold_sigint(), cio.hold_sigint():
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.01)
+            assert seen == []
+        assert seen == [signal.SIGINT]
+        with cio.hold_sigint():
+            pass
+        assert seen == [signal.SIGINT]
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 @pytest.mark.skipif(not hasattr(signal, "pthread_sigmask"), reason="POSIX: Ctrl-C held back by the signal mask")
 @pytest.mark.parametrize("how", ["write_all", "atomic_stream", "probe"])
 def test_ctrl_c_the_instant_a_temporary_exists_leaves_none(tmp_path, monkeypatch, how):
