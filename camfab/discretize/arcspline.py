@@ -65,9 +65,12 @@ _FIXED_END_ARCS_ALT: tuple = ()
 #: dozen counts per span before the whole spline fell back to spans clamped at every breakpoint.  Fits that do
 #: converge start at most 16× over (the examples at 1e-2…1e-4 mm), the hopeless ones at 80–1700×.
 _FIXED_HOPELESS = 40.0
-#: a count that misses the target by at most this factor gets other starts (:meth:`_SpanFit.other_start` at
-#: once, :meth:`_SpanFit.retry_one_fewer` after the count above has fitted)
+#: the smallest failing count, when it missed the target by at most this factor, gets other starts after the count
+#: above has fitted (:meth:`_SpanFit.retry_one_fewer`)
 _NARROW = 1.3
+#: a span whose curvature varies by less than this share of its largest is taken as of constant curvature (no
+#: maximum to centre an arc on: the stand-in's curvature of a circle varies by ~1e-9 of it)
+_FLAT_KAPPA = 1e-6
 #: spans whose search starts at this many arcs or more take the arcs of a congruent span already fitted
 _CONGRUENT_MIN = 4
 
@@ -144,19 +147,20 @@ class _SpanFit:
         return err, ok, (knots, k, err)
 
     def _narrow(self, m: int, err: float) -> bool:
-        """Whether ``m`` arcs (error ``err``) missed the target narrowly enough for another start at that count."""
+        """Whether ``m`` arcs (error ``err``) missed the target narrowly enough for a warm start at that count."""
         return m >= max(4, self.m_min) and err <= _NARROW * self.target
 
     def centred_knots(self, m: int) -> np.ndarray | None:
         """Knots of ``m`` arcs with one long arc over the span's largest curvature maximum: ``m + 1`` arcs placed by
         the density, less their interior joint (not an end arc's) nearest that maximum; None without an interior
-        maximum or with fewer than 4 arcs.  The density ``|κ'|^(1/3)`` vanishes at a curvature extremum, where
-        the error of an arc is set by ``κ″`` instead, so the placed knots may put a joint next to the maximum where
-        the optimum has an arc centred on it (docs/decisions.md, "Arc-fit cost")."""
+        maximum (a curvature constant to :data:`_FLAT_KAPPA` has none) or with fewer than 4 arcs.  The density
+        ``|κ'|^(1/3)`` vanishes at a curvature extremum, where the error of an arc is set by ``κ″`` instead, so the
+        placed knots may put a joint next to the maximum where the optimum has an arc centred on it
+        (docs/decisions.md, "Arc-fit cost")."""
         _, s, _, kappa, _ = self.shape
         inner = (kappa[1:-1] > kappa[:-2]) & (kappa[1:-1] >= kappa[2:])
-        if m < 4 or not inner.any():
-            return None
+        if m < 4 or not inner.any() or not kappa.max() - kappa.min() > _FLAT_KAPPA * kappa.max():
+            return None  # (no maximum, or one of rounding: the curvature is constant along the span)
         at = s[1:-1][inner][np.argmax(kappa[1:-1][inner])]
         model = self._model(m)
         knots = self._placed(model, m + 1)
@@ -179,7 +183,7 @@ class _SpanFit:
 
     def other_start(self, m: int):
         """The fit of ``m`` arcs from the count's second start (:meth:`_starts`: the placed knots, after the centred
-        ones missed) when it fits (once), else None."""
+        ones missed, so that every count still tries the knots it used to) when it fits (once), else None."""
         others = self.others.pop(m, [])
         for knots, start in others:
             _, ok, fit = self.attempt(m, knots=knots, start=start)
@@ -198,10 +202,10 @@ class _SpanFit:
                 return None
             err, ok, fit = self.attempt(m)
             self.tried[m] = err
-            if not ok and self._narrow(m, err):
+            if not ok:
                 other = self.other_start(m)
                 if other is not None:
-                    return other  # (without it the search ends at m arcs at best: m failed from its first start)
+                    err, ok, fit = other[2], True, other
             if self.n_fixed and len(self.tried) == 1 and not (err <= _FIXED_HOPELESS * self.target):
                 return None  # the fixed end curvature does not fit the curve (see _FIXED_HOPELESS)
             if ok and (best is None or m < best[0].size - 1):
@@ -256,7 +260,7 @@ def _fit_span(sur: HermiteSurrogate, span: Span, target: float, fit: _SpanFit | 
     the count goes down while the span still fits ``target`` (one arc fewer when its predicted error does) and up
     until it does.  A count starts from knots with one long arc over the curvature maximum
     (:meth:`_SpanFit.centred_knots`) when their linear fit deviates less than that of the placed knots, which
-    follow when it misses narrowly.  The optimum is not monotone in the count: at the smallest failing count a
+    follow when it misses.  The optimum is not monotone in the count: at the smallest failing count a
     warm start and other end-arc ratios (:data:`_END_ARCS_ALT`) are tried when it failed narrowly.
     A span with a fixed end curvature that misses by far at its first count (:data:`_FIXED_HOPELESS`) is fitted
     again with free end curvatures (``fixed`` returned: the curvatures the fit imposes).  ``fit``: the span's
