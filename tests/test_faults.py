@@ -419,6 +419,18 @@ def _sigint_once_made(monkeypatch) -> None:
     monkeypatch.setattr(cio.tempfile, "mkstemp", mkstemp)
 
 
+def _write_as(how: str, folder: Path) -> None:
+    """One of camfab's writers into ``folder``: a set of files (``a.dxf``, ``b.nc``), a stream (``b.nc``) or the
+    output folder's probe."""
+    if how == "write_all":
+        write_all({folder / "a.dxf": b"0", folder / "b.nc": b"G0"})
+    elif how == "atomic_stream":
+        with cio.atomic_stream(folder / "b.nc") as fh:
+            fh.write(b"G0")
+    else:
+        cio._probe(folder)
+
+
 def _other_thread_takes_sigint(monkeypatch) -> None:
     """As :func:`_sigint_once_made`, in a process where another thread has SIGINT unblocked (a BLAS worker, a pool's
     thread): the kernel hands it the signal the main thread holds back, and Python runs the handler in the main
@@ -449,13 +461,7 @@ def test_ctrl_c_taken_by_another_thread_still_waits_for_the_writer(tmp_path, mon
     other.start()  # (made here, with SIGINT unblocked: the kernel's only choice while the writer holds it back)
     try:
         with pytest.raises(KeyboardInterrupt):
-            if how == "write_all":
-                write_all({tmp_path / "a.dxf": b"0", tmp_path / "b.nc": b"G0"})
-            elif how == "atomic_stream":
-                with cio.atomic_stream(tmp_path / "b.nc") as fh:
-                    fh.write(b"G0")
-            else:
-                cio._probe(tmp_path)
+            _write_as(how, tmp_path)
     finally:
         stop.set()
         other.join()
@@ -490,13 +496,7 @@ def test_ctrl_c_the_instant_a_temporary_exists_leaves_none(tmp_path, monkeypatch
     (tmp_path / "b.nc").write_text("old")
     _sigint_once_made(monkeypatch)
     with pytest.raises(KeyboardInterrupt):
-        if how == "write_all":
-            write_all({tmp_path / "a.dxf": b"0", tmp_path / "b.nc": b"G0"})
-        elif how == "atomic_stream":
-            with cio.atomic_stream(tmp_path / "b.nc") as fh:
-                fh.write(b"G0")
-        else:
-            cio._probe(tmp_path)
+        _write_as(how, tmp_path)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["b.nc"]
     assert (tmp_path / "b.nc").read_text() == "old"
 
