@@ -161,18 +161,20 @@ def _one_sided(t, near, t1, t2, vals) -> np.ndarray:
 
 
 def points_and_derivatives_at(curve: ParametricCurve, x, t, lo, hi) -> tuple[np.ndarray, np.ndarray]:
-    """``(points_at(curve, x), derivatives_at(curve, t, lo, hi))`` (``x`` and ``t`` 1-D), from one evaluation when
-    the curve has ``point_and_derivative`` (the same values: its contract), else from the two."""
+    """``(points_at(curve, x), derivatives_at(curve, t, lo, hi))`` (``x`` and ``t`` 1-D; ``x`` None: at ``t``, whose
+    points then come from the same parameters as its derivatives), from one evaluation when the curve has
+    ``point_and_derivative`` (the same values: its contract), else from the two."""
     if curve.point_and_derivative is None or curve.derivative is None:
-        return points_at(curve, x), derivatives_at(curve, t, lo, hi)
-    x = _inside(curve, np.asarray(x, dtype=float).ravel())
+        return points_at(curve, t if x is None else x), derivatives_at(curve, t, lo, hi)
     t, lo, hi = (np.asarray(v, dtype=float).ravel() for v in np.broadcast_arrays(t, lo, hi))
+    at_t = x is None
+    x = np.empty(0) if at_t else _inside(curve, np.asarray(x, dtype=float).ravel())
     near, t1, t2 = _near_ends(t, lo, hi)
-    p, d = curve.point_and_derivative(np.concatenate([x, t, t1, t2]))
+    p, d = curve.point_and_derivative(np.concatenate([x, _inside(curve, t), t1, t2]))
     n = x.size + t.size + t1.size + t2.size
     p = _checked(p, n, "point_and_derivative", "(points, derivatives), each np.column_stack([x, y])")
     d = _checked(d, n, "point_and_derivative", "(points, derivatives), each np.column_stack([x, y])")
-    return p[:x.size], _one_sided(t, near, t1, t2, d[x.size:])
+    return p[:t.size] if at_t else p[:x.size], _one_sided(t, near, t1, t2, d[x.size:])
 
 
 def derivatives_at(curve: ParametricCurve, t, lo, hi) -> np.ndarray:

@@ -43,8 +43,11 @@ class HermiteSurrogate:
         # at each piece's end, whose one-sided derivative comes from that piece (points and derivatives from one
         # evaluation when the curve offers it)
         ends = np.cumsum(counts) - 1  # the last interval of every piece (each piece has one at least)
-        p, d = points_and_derivatives_at(curve, x, np.concatenate([a, b[ends]]), np.concatenate([lo[piece], lo]),
-                                         np.concatenate([hi[piece], hi]))
+        # (the nodes are the interval starts and the last end, the period, which is the last piece's end: every
+        # point comes from the parameters the derivatives are taken at, one evaluation of each)
+        p, d = points_and_derivatives_at(curve, None, np.concatenate([a, b[ends]]),
+                                         np.concatenate([lo[piece], lo]), np.concatenate([hi[piece], hi]))
+        p = np.concatenate([p[:a.size], p[-1:]])
         if curve.closed:
             p[-1] = p[0]
         d0 = d[:a.size]

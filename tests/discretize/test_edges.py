@@ -169,6 +169,14 @@ def test_points_and_derivatives_from_one_evaluation_are_the_two_calls():
     fallback = points_and_derivatives_at(plain, x, t, lo, hi)
     np.testing.assert_array_equal(fallback[0], ref[0])
     np.testing.assert_array_equal(fallback[1], ref[1])
+    # without x: the points at t, from the same call (and the same values either way)
+    calls.clear()
+    for curve in (one, plain):
+        at_t = points_and_derivatives_at(curve, None, t, lo, hi)
+        np.testing.assert_array_equal(at_t[0], points_at(plain, t))
+        np.testing.assert_array_equal(at_t[1], ref[1])
+    assert len(calls) == 1
+    assert points_and_derivatives_at(one, np.empty(0), t, lo, hi)[0].shape == (0, 2)
     wrong = ParametricCurve(point, bp, derivative=deriv, point_and_derivative=lambda t: (point(t)[:, 0], deriv(t)))
     with pytest.raises(CurveError, match="point_and_derivative must return an"):
         points_and_derivatives_at(wrong, x, t, lo, hi)
