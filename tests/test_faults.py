@@ -470,7 +470,8 @@ def test_ctrl_c_taken_by_another_thread_still_waits_for_the_writer(tmp_path, mon
 
 
 def test_a_held_ctrl_c_goes_to_the_handler_it_replaced_once():
-    """Nested holds pass one recorded SIGINT outward to the handler in place before them, once; without one, none."""
+    """Nested holds pass one recorded SIGINT outward to the handler in place before them, once; without one, none;
+    an ignored SIGINT stays ignored."""
     seen = []
     previous = signal.signal(signal.SIGINT, lambda signum, frame: seen.append(signum))
     try:
@@ -482,6 +483,11 @@ def test_a_held_ctrl_c_goes_to_the_handler_it_replaced_once():
         with cio.hold_sigint():
             pass
         assert seen == [signal.SIGINT]
+        signal.signal(signal.SIGINT, signal.SIG_IGN)  # ignored before the hold: dropped after it, and kept ignored
+        with cio.hold_sigint():
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.01)
+        assert signal.getsignal(signal.SIGINT) == signal.SIG_IGN and seen == [signal.SIGINT]
     finally:
         signal.signal(signal.SIGINT, previous)
 

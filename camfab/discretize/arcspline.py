@@ -206,6 +206,7 @@ class _SpanFit:
                 other = self.other_start(m)
                 if other is not None:
                     err, ok, fit = other[2], True, other
+                    self.tried[m] = err
             if self.n_fixed and len(self.tried) == 1 and not (err <= _FIXED_HOPELESS * self.target):
                 return None  # the fixed end curvature does not fit the curve (see _FIXED_HOPELESS)
             if ok and (best is None or m < best[0].size - 1):
