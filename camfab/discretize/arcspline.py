@@ -502,8 +502,7 @@ def _span_deviations(curve: ParametricCurve, spans: list, parts: list, merged: C
     d, _ = merged.distance(points_at(curve, np.concatenate(t)))
     worst = np.maximum.reduceat(d, np.concatenate([[0], np.cumsum([x.size for x in t])[:-1]]))
     at = float(dev.at_param)
-    j = next((i for i, sp in enumerate(spans) if sp.contains(at)), None)
-    if j is not None:
+    for j in (i for i, sp in enumerate(spans) if sp.contains(at)):  # (both spans of a joint it lies on)
         worst[j] = max(worst[j], dev.max)
     return worst
 
@@ -540,16 +539,23 @@ def fit_spline(curve: ParametricCurve, surrogate: tuple[HermiteSurrogate, float]
         if within(dev.max, tol):
             return merged, dev.max, params
         worst = _span_deviations(curve, spans, parts, merged, dev)
+        refitted = False
         for j in np.flatnonzero(worst > 0.99 * tol):
             if spans[j].exact is not None:
                 return None
             if carried[j]:  # a congruent span's arcs: fitted on its own first
                 carried[j] = False
             else:  # the measured / model ratio of this span scales its next target
-                targets[j] = min(0.98 * targets[j], 0.97 * tol * errs[j] / worst[j])
+                lower = min(0.98 * targets[j], 0.97 * tol * errs[j] / worst[j])
+                if not lower > 0:  # no model error (a straight piece's line): a lower target cannot help it
+                    continue
+                targets[j] = lower
             with np.errstate(invalid="ignore", divide="ignore"):
                 fit = _fit_span_chain(curve, sur, spans[j], targets[j])
             if fit is None:
                 return None
             parts[j], errs[j] = fit
+            refitted = True
+        if not refitted:
+            return None
     return None

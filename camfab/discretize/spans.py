@@ -187,8 +187,8 @@ def _anchors(curve: ParametricCurve, sur: HermiteSurrogate, tol: float, anchored
                 a0[0] = float(arcs_p[2][0])
             if g1[(p + 1) % n]:
                 a1[1] = float(arcs_p[2][-1])
-    if not anchors:
-        anchors = {float(t): [None, None, False] for t in bp[:-1]}
+    if not anchors:  # (every breakpoint a span end; a corner stays one)
+        anchors = {float(bp[p]): [None, None, not bool(g1[p])] for p in range(n)}
     return anchors, exact
 
 

@@ -252,3 +252,54 @@ def test_two_starts_and_the_tighter_descent_are_about_neutral_on_the_examples(mo
     assert sum(f.n_entities for f in new.values()) <= 1.01 * sum(f.n_entities for f in old.values())
     for (name, tol), f in new.items():
         assert check_arcs(f, example(name)[2]) <= tol
+
+
+# --- the spline clamped at every breakpoint (arcs()'s fallback) on a curve with corners
+
+def test_the_spline_clamped_at_every_breakpoint_keeps_the_corners():
+    """The wedge cam's plate outline (straight edges meeting the profile at corners) through the spline clamped at
+    every breakpoint: within tol by the independent dense check, a vertex at every corner.  That path used to mark
+    no breakpoint a corner, so its spans were joined as if tangent there (53.9 mm off), and its refits then raised
+    ``ValueError`` (below)."""
+    from camfab.discretize.arcspline import fit_spline
+    from camfab.discretize.surrogate import fit_surrogate
+
+    _, curve, dense = example("wedge_translating")
+    sur = fit_surrogate(curve, 1e-3)
+    out = fit_spline(curve, sur, 1e-3, anchored=False)
+    assert out is not None
+    chain, measured, nodes = out
+    res = ArcDiscretisation.from_chain(chain, nodes, measured, 1e-3, curve.closed)
+    assert measured <= 1e-3 and check_arcs(res, dense) <= 1e-3
+    corners = [t for t in curve.breakpoints[:-1] if tangent_jump_at(curve, t) > 1e-3]
+    assert corners and all(np.min(np.abs(nodes - t)) == 0.0 for t in corners)
+
+
+def tangent_jump_at(curve, t: float) -> float:
+    """The angle (rad) between the one-sided tangents of ``curve`` at the breakpoint ``t``."""
+    bp = curve.breakpoints
+    i = int(np.searchsorted(bp, t))
+    before = (bp[i - 1], bp[i]) if i > 0 else (bp[-2], bp[-1])
+    after = (bp[i], bp[i + 1])
+    d0 = derivatives_at(curve, np.array([before[1] if i > 0 else curve.period]), before[0], before[1])[0]
+    d1 = derivatives_at(curve, np.array([t]), after[0], after[1])[0]
+    return abs(math.atan2(d0[0] * d1[1] - d0[1] * d1[0], d0 @ d1))
+
+
+def test_a_refit_that_cannot_lower_a_span_gives_up_instead_of_raising(monkeypatch):
+    """A span without model error (a straight piece's line) flagged by the measurement cannot be helped by a lower
+    target (it would be 0, and the arc estimate NaN): the spline returns None, for the next fallback, instead of
+    raising ``ValueError``.  Reproduced with the corners hidden from the clamped spline, as they used to be."""
+    import camfab.discretize.spans as spans
+    from camfab.discretize.arcspline import fit_spline
+    from camfab.discretize.surrogate import fit_surrogate
+
+    pieces = spans._circle_pieces
+
+    def no_corners(curve, sur, tol):
+        g1, circ, k = pieces(curve, sur, tol)
+        return np.ones_like(g1), circ, k
+
+    monkeypatch.setattr(spans, "_circle_pieces", no_corners)
+    _, curve, _ = example("wedge_translating")
+    assert fit_spline(curve, fit_surrogate(curve, 1e-3), 1e-3, anchored=False) is None
