@@ -24,11 +24,15 @@ certificate's exact curve samples (one evaluation at the nodes the local certifi
 ``certify.LocalBound.nodes``) and their distances to the fitted chain (each sample against its own entity and the two
 beside it, as the fit's measurement takes them).
 
+``--yardstick`` times the issue cam's fit against the issue's yardstick, a lean numpy evaluation of the same profile
+at 361 angles (:func:`lean_evaluation`), and prints the ratio.  ``--examples`` also counts each fit's
+equioscillations (the count search's unit of cost).
+
 ``--stages`` times the issue cam's fit by stage (CPU around each: the Hermite stand-in, cutting the spans, the
 spans' arc-count search, laying the arcs, the certification; the rest), what a faster fitter has to cut.
 
 Run:  PYTHONPATH=. python3 benchmarks/bench_fit.py [--repeat 20] [--root /work/main --rounds 3] [--examples]
-      [--stages] [--floor]
+      [--stages] [--floor] [--yardstick]
 """
 from __future__ import annotations
 
@@ -156,9 +160,18 @@ def compare(root: Path, repeat: int, rounds: int, which: list[int]) -> None:
 def example_fits() -> list[dict]:
     """Every profile of every example design fitted at 1e-3 and 1e-4 mm in this process: arcs, deviation, CPU."""
     import camfab
+    import camfab.discretize.arcspline as spline
 
     examples = Path(camfab.__file__).resolve().parent / "examples"
     out = []
+    runs = [0]  # equioscillations of the fit (the count search's unit of cost)
+    equi = spline.equioscillate
+
+    def counted(*args, **kwargs):
+        runs[0] += 1
+        return equi(*args, **kwargs)
+
+    spline.equioscillate = counted
     for path in sorted(examples.glob("*.toml")):
         try:
             curves = design_curves(path.read_text(), examples)
@@ -166,13 +179,14 @@ def example_fits() -> list[dict]:
             continue
         for i, c in enumerate(curves):
             for tol in (1e-3, 1e-4):
+                runs[0] = 0
                 t0 = time.process_time()
                 f = arcs(c, tol=tol)
                 cpu = time.process_time() - t0
                 ch = f.chain()
                 digest = hashlib.sha256(ch.start.tobytes() + ch.curvature.tobytes() + ch.length.tobytes())
                 out.append({"label": f"{path.stem}[{i}] {tol:g}", "arcs": f.n_entities, "dev": f.max_deviation,
-                            "tol": tol, "cpu": cpu, "hash": digest.hexdigest()[:12]})
+                            "tol": tol, "cpu": cpu, "hash": digest.hexdigest()[:12], "equi": runs[0]})
     return out
 
 
@@ -197,7 +211,8 @@ def compare_examples(root: Path | None) -> None:
               f"{1e3 * o['cpu']:8.1f} -> {1e3 * n['cpu']:8.1f} ms  ({same}){flag}", flush=True)
     to, tn = sum(r["arcs"] for r in old), sum(r["arcs"] for r in new)
     print(f"{len(new)} fits: arcs {to} -> {tn} ({100.0 * (tn - to) / to:+.2f} %), largest growth {max(grow)}, "
-          f"identical {sum(o['hash'] == n['hash'] for o, n in zip(old, new, strict=True))}, CPU "
+          f"identical {sum(o['hash'] == n['hash'] for o, n in zip(old, new, strict=True))}, equioscillations "
+          f"{sum(r.get('equi', 0) for r in old)} -> {sum(r.get('equi', 0) for r in new)}, CPU "
           f"{sum(r['cpu'] for r in old):.2f} -> {sum(r['cpu'] for r in new):.2f} s, all within tol: "
           f"{all(r['dev'] <= r['tol'] for r in new)}")
 
@@ -285,6 +300,41 @@ def floor(repeat: int) -> None:
     print(f"  {label:52}{sum(ms for _, ms in parts):7.2f} ms")
 
 
+def lean_evaluation(angles: int = 361):
+    """The issue cam's profile as a lean numpy evaluation at ``angles`` angles, the issue's yardstick: the two
+    cycloids by ``clip`` (their derivative vanishes at both ends, so no mask), the pitch point and its derivative,
+    the roller offset along the unit normal.  ``(n, 2)`` points: the profile camfab evaluates, mirrored (the
+    angle runs the other way), to the sampling's resolution."""
+    import numpy as np
+
+    h, beta, r0, rr = 25.0, 2.0 * np.pi / 3.0, 55.0, 5.0
+    th = np.linspace(0.0, 2.0 * np.pi, angles)
+    x, y = np.clip(th / beta, 0.0, 1.0), np.clip((th - np.pi) / beta, 0.0, 1.0)
+    s = h * (x - y - (np.sin(2.0 * np.pi * x) - np.sin(2.0 * np.pi * y)) / (2.0 * np.pi))
+    ds = h / beta * (np.cos(2.0 * np.pi * y) - np.cos(2.0 * np.pi * x))
+    c, sn = np.cos(th), np.sin(th)
+    r = r0 + s
+    px, py = r * sn, r * c
+    dx, dy = ds * sn + r * c, ds * c - r * sn
+    norm = np.hypot(dx, dy)
+    return np.column_stack([px + rr * dy / norm, py - rr * dx / norm])  # (inward: the pitch curve runs clockwise)
+
+
+def yardstick(repeat: int) -> None:
+    """The issue cam's 1 µm fit against :func:`lean_evaluation` at 361 angles: both CPU times (best of many) and
+    their ratio (the issue's goal: 300×)."""
+    curve = issue_cam_curve()
+    fit, _ = cpu_per_fit([curve], 1e-3, repeat)
+    lean = float("inf")
+    for _ in range(20):
+        t0 = time.process_time()
+        for _ in range(200):
+            lean_evaluation()
+        lean = min(lean, (time.process_time() - t0) / 200)
+    print(f"issue-15 roller cam: fit {1e3 * fit:.2f} ms CPU, lean numpy evaluation at 361 angles {1e3 * lean:.4f} ms: "
+          f"{fit / lean:.0f}x (goal 300x)")
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=20, help="fits timed, the best kept (constant width: a quarter, "
@@ -297,6 +347,8 @@ def main(argv=None) -> None:
                     "deviation, CPU per fit (with --root: both trees)")
     ap.add_argument("--stages", action="store_true", help="the issue cam's fit timed by stage")
     ap.add_argument("--floor", action="store_true", help="what the issue cam's verification cannot skip, timed")
+    ap.add_argument("--yardstick", action="store_true", help="the issue cam's fit against a lean numpy evaluation "
+                    "of its profile at 361 angles")
     ap.add_argument("--case", type=int, help=argparse.SUPPRESS)
     ap.add_argument("--examples-json", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
@@ -308,6 +360,9 @@ def main(argv=None) -> None:
         return
     if args.floor:
         floor(args.repeat)
+        return
+    if args.yardstick:
+        yardstick(args.repeat)
         return
     if args.examples:
         compare_examples(args.root.resolve() if args.root is not None else None)
